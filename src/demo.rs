@@ -1,0 +1,186 @@
+//! The lens demo: a picture of what a lens does to the sphere of directions (a 10° grid and
+//! rings every 30° off the axis), rendered on the GPU. It is also the frame whose cost
+//! [`DirectionSource::Computed`] and [`DirectionSource::Table`] are benchmarked on.
+
+use std::path::Path;
+
+use crate::error::{Error, Result};
+use crate::gpu::GpuContext;
+use crate::lens::LensCamera;
+use crate::lens::gpu::{DirectionSource, LensRays, lens_constants, params_buffer};
+use crate::shader::{self, WORKGROUP_2D};
+
+/// The demo pass for one camera: owns its pipeline, layout, output and (for the table
+/// source) the direction table, computed once at creation.
+pub struct LensDemo {
+    pipeline: wgpu::ComputePipeline,
+    bind_group: wgpu::BindGroup,
+    pixels: wgpu::Buffer,
+    camera: LensCamera,
+}
+
+fn storage_entry(binding: u32, read_only: bool) -> wgpu::BindGroupLayoutEntry {
+    wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility: wgpu::ShaderStages::COMPUTE,
+        ty: wgpu::BindingType::Buffer {
+            ty: wgpu::BufferBindingType::Storage { read_only },
+            has_dynamic_offset: false,
+            min_binding_size: None,
+        },
+        count: None,
+    }
+}
+
+impl LensDemo {
+    /// Creates the pass; with [`DirectionSource::Table`] also computes the table (one
+    /// [`LensRays`] dispatch, submitted here, not per frame).
+    pub fn new(ctx: &GpuContext, camera: &LensCamera, source: DirectionSource) -> Result<Self> {
+        let bytes = 4 * camera.size.pixels() as u64;
+        ctx.check_binding("the demo image", bytes)?;
+        let table = match source {
+            DirectionSource::Table => {
+                let rays = LensRays::new(ctx, camera)?;
+                let mut encoder = ctx.device.create_command_encoder(&Default::default());
+                rays.encode(&mut encoder, None);
+                ctx.queue.submit([encoder.finish()]);
+                Some(rays)
+            }
+            DirectionSource::Computed => None,
+        };
+        ctx.checked("creating the lens demo", || {
+            let device = &ctx.device;
+            // Declared in binding order, matching wgsl/lens_demo.wgsl. Explicit, because the
+            // table binding is dead code when directions are computed.
+            let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+                label: Some("fisheye.lens_demo"),
+                entries: &[
+                    wgpu::BindGroupLayoutEntry {
+                        binding: 0,
+                        visibility: wgpu::ShaderStages::COMPUTE,
+                        ty: wgpu::BindingType::Buffer {
+                            ty: wgpu::BufferBindingType::Uniform,
+                            has_dynamic_offset: false,
+                            min_binding_size: None,
+                        },
+                        count: None,
+                    },
+                    storage_entry(1, true),
+                    storage_entry(2, false),
+                ],
+            });
+            let mut constants = lens_constants(camera).to_vec();
+            constants.push(("DIRECTION_SOURCE", f64::from(source as u32)));
+            let module = shader::module(device, "lens_demo");
+            let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+                label: Some("fisheye.lens_demo"),
+                layout: Some(
+                    &device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+                        label: Some("fisheye.lens_demo"),
+                        bind_group_layouts: &[Some(&layout)],
+                        immediate_size: 0,
+                    }),
+                ),
+                module: &module,
+                entry_point: Some("main"),
+                compilation_options: wgpu::PipelineCompilationOptions {
+                    constants: &constants,
+                    ..Default::default()
+                },
+                cache: None,
+            });
+            let pixels = device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("fisheye.lens_demo.pixels"),
+                size: bytes,
+                usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
+                mapped_at_creation: false,
+            });
+            // Without a table the binding still needs a buffer; a 16-byte one is never read.
+            let placeholder;
+            let table_buffer = match &table {
+                Some(rays) => &rays.directions,
+                None => {
+                    placeholder = device.create_buffer(&wgpu::BufferDescriptor {
+                        label: Some("fisheye.lens_demo.no_table"),
+                        size: 16,
+                        usage: wgpu::BufferUsages::STORAGE,
+                        mapped_at_creation: false,
+                    });
+                    &placeholder
+                }
+            };
+            let params = params_buffer(device, camera);
+            let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some("fisheye.lens_demo"),
+                layout: &layout,
+                entries: &[
+                    wgpu::BindGroupEntry {
+                        binding: 0,
+                        resource: params.as_entire_binding(),
+                    },
+                    wgpu::BindGroupEntry {
+                        binding: 1,
+                        resource: table_buffer.as_entire_binding(),
+                    },
+                    wgpu::BindGroupEntry {
+                        binding: 2,
+                        resource: pixels.as_entire_binding(),
+                    },
+                ],
+            });
+            Self {
+                pipeline,
+                bind_group,
+                pixels,
+                camera: *camera,
+            }
+        })
+    }
+
+    /// Records one frame, optionally timed.
+    pub fn encode(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        timestamp_writes: Option<wgpu::ComputePassTimestampWrites<'_>>,
+    ) {
+        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+            label: Some("fisheye.lens_demo"),
+            timestamp_writes,
+        });
+        pass.set_pipeline(&self.pipeline);
+        pass.set_bind_group(0, &self.bind_group, &[]);
+        pass.dispatch_workgroups(
+            self.camera.size.width.div_ceil(WORKGROUP_2D),
+            self.camera.size.height.div_ceil(WORKGROUP_2D),
+            1,
+        );
+    }
+
+    /// Renders one frame and reads it back.
+    pub fn render(&self, ctx: &GpuContext) -> Result<image::RgbaImage> {
+        ctx.checked("rendering the lens demo", || {
+            let mut encoder = ctx.device.create_command_encoder(&Default::default());
+            self.encode(&mut encoder, None);
+            ctx.queue.submit([encoder.finish()]);
+        })?;
+        let pixels: Vec<u32> = ctx.read_buffer(&self.pixels)?;
+        let bytes = bytemuck::cast_slice::<u32, u8>(&pixels).to_vec();
+        let size = self.camera.size;
+        Ok(image::RgbaImage::from_raw(size.width, size.height, bytes)
+            .expect("the pixel buffer holds width × height RGBA8 pixels"))
+    }
+}
+
+/// Writes an image as PNG, creating the parent folder.
+pub fn save_png(image: &image::RgbaImage, path: &Path) -> Result<()> {
+    if let Some(parent) = path.parent().filter(|p| !p.as_os_str().is_empty()) {
+        std::fs::create_dir_all(parent).map_err(|source| Error::Io {
+            path: parent.to_path_buf(),
+            source,
+        })?;
+    }
+    image.save(path).map_err(|source| Error::Image {
+        path: path.to_path_buf(),
+        source,
+    })
+}

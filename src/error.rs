@@ -1,0 +1,118 @@
+//! The library's errors. Every variant names what was wrong and, where it helps, what to do.
+
+use thiserror::Error;
+
+/// A bad lens, lens spec or image size.
+#[derive(Clone, Debug, Error, PartialEq)]
+pub enum LensError {
+    /// A numeric lens parameter outside its range.
+    #[error("lens parameter {name} = {value}: {reason}")]
+    Parameter {
+        /// The parameter's name as written in specs (`f`, `k1`, `k2`, `fov`).
+        name: &'static str,
+        /// The offending value (degrees for `fov`).
+        value: f64,
+        /// The range it must lie in.
+        reason: &'static str,
+    },
+    /// A lens spec that does not parse.
+    #[error("lens spec {spec:?}: {reason}")]
+    Spec {
+        /// The spec as given.
+        spec: String,
+        /// What is wrong with it.
+        reason: String,
+    },
+    /// An image size of 0 or beyond what we can address.
+    #[error("image size {text:?}: {reason}")]
+    ImageSize {
+        /// The size as given.
+        text: String,
+        /// What is wrong with it.
+        reason: String,
+    },
+}
+
+impl LensError {
+    pub(crate) fn parameter(name: &'static str, value: f64, reason: &'static str) -> Self {
+        Self::Parameter {
+            name,
+            value,
+            reason,
+        }
+    }
+}
+
+/// Any error of the library.
+#[derive(Debug, Error)]
+pub enum Error {
+    /// No adapter was found on any enabled backend.
+    #[error(
+        "no GPU adapter found (backends tried: {backends}). On a machine without a GPU, install \
+         a software Vulkan driver: on Debian/Ubuntu `apt-get install mesa-vulkan-drivers` \
+         (Mesa 25 or later, e.g. from bookworm-backports, for ray queries)"
+    )]
+    NoAdapter {
+        /// The backends that were enumerated.
+        backends: String,
+    },
+    /// `WGPU_ADAPTER_NAME` matched no adapter.
+    #[error("WGPU_ADAPTER_NAME={wanted:?} matches no adapter; available: {available}")]
+    AdapterNotFound {
+        /// The requested name (a case-insensitive substring).
+        wanted: String,
+        /// The adapters that exist.
+        available: String,
+    },
+    /// The adapter refused to create a device.
+    #[error("could not create a device on {adapter}: {source}")]
+    RequestDevice {
+        /// The adapter's name.
+        adapter: String,
+        /// wgpu's reason.
+        source: wgpu::RequestDeviceError,
+    },
+    /// An operation needs a device feature the adapter lacks.
+    #[error("{what} needs the GPU feature {feature}, which {adapter} does not have")]
+    MissingFeature {
+        /// What needed it.
+        what: &'static str,
+        /// The wgpu feature.
+        feature: &'static str,
+        /// The adapter's name.
+        adapter: String,
+    },
+    /// A validation, out-of-memory or internal error reported by wgpu.
+    #[error("GPU error during {during}: {message}")]
+    Gpu {
+        /// The operation that failed.
+        during: String,
+        /// wgpu's message.
+        message: String,
+    },
+    /// The device was lost (driver reset, GPU removed, or an earlier fatal error).
+    #[error("the GPU device was lost: {0}")]
+    DeviceLost(String),
+    /// A bad lens or image size.
+    #[error(transparent)]
+    Lens(#[from] LensError),
+    /// A file could not be read or written.
+    #[error("{path}: {source}")]
+    Io {
+        /// The file.
+        path: std::path::PathBuf,
+        /// The OS's reason.
+        source: std::io::Error,
+    },
+    /// An image could not be encoded or written.
+    #[error("{path}: {source}")]
+    Image {
+        /// The file.
+        path: std::path::PathBuf,
+        /// The encoder's reason.
+        source: image::ImageError,
+    },
+}
+
+/// The library's result type.
+pub type Result<T, E = Error> = std::result::Result<T, E>;

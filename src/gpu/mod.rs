@@ -1,0 +1,275 @@
+//! The one place that creates the wgpu instance, adapter and device, plus the small helpers
+//! every pass shares: error scopes, buffer readback and timestamp queries.
+
+mod timing;
+
+use std::sync::{Arc, Mutex};
+
+pub use timing::Queries;
+
+use crate::error::{Error, Result};
+
+/// Optional device features the project uses when the adapter has them.
+pub const OPTIONAL_FEATURES: [(wgpu::Features, &str); 5] = [
+    (wgpu::Features::TIMESTAMP_QUERY, "timestamp queries"),
+    (
+        wgpu::Features::TIMESTAMP_QUERY_INSIDE_ENCODERS,
+        "timestamps inside encoders",
+    ),
+    (wgpu::Features::EXPERIMENTAL_RAY_QUERY, "ray query"),
+    (wgpu::Features::MULTIVIEW, "multiview"),
+    (wgpu::Features::SHADER_F64, "f64 in shaders"),
+];
+
+/// An adapter, its device and queue: the GPU everything else runs on.
+pub struct GpuContext {
+    /// The adapter the device was created on.
+    pub adapter: wgpu::Adapter,
+    /// The device; passes take `&Device`.
+    pub device: wgpu::Device,
+    /// The device's queue.
+    pub queue: wgpu::Queue,
+    lost: Arc<Mutex<Option<String>>>,
+}
+
+/// Ranks device types: hardware first, software (lavapipe) last.
+fn preference(kind: wgpu::DeviceType) -> u8 {
+    match kind {
+        wgpu::DeviceType::DiscreteGpu => 0,
+        wgpu::DeviceType::IntegratedGpu => 1,
+        wgpu::DeviceType::VirtualGpu => 2,
+        wgpu::DeviceType::Other => 3,
+        wgpu::DeviceType::Cpu => 4,
+    }
+}
+
+fn describe(info: &wgpu::AdapterInfo) -> String {
+    format!("{} ({:?}, {:?})", info.name, info.backend, info.device_type)
+}
+
+impl GpuContext {
+    /// Picks an adapter and creates the device.
+    ///
+    /// Honours `WGPU_BACKEND` (e.g. `vulkan`, `gl`) and `WGPU_ADAPTER_NAME` (a case-insensitive
+    /// substring of the adapter's name); otherwise prefers a hardware adapter and falls back to
+    /// a software one. Requests the adapter's own limits and every feature of
+    /// [`OPTIONAL_FEATURES`] it has.
+    pub fn new() -> Result<Self> {
+        let instance =
+            wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle_from_env());
+        let backends = wgpu::Backends::from_env().unwrap_or_default();
+        let mut adapters = pollster::block_on(instance.enumerate_adapters(backends));
+        if adapters.is_empty() {
+            return Err(Error::NoAdapter {
+                backends: format!("{backends:?}"),
+            });
+        }
+        let adapter = match std::env::var("WGPU_ADAPTER_NAME") {
+            Ok(wanted) => {
+                let needle = wanted.to_lowercase();
+                let found = adapters
+                    .iter()
+                    .position(|a| a.get_info().name.to_lowercase().contains(&needle));
+                match found {
+                    Some(i) => adapters.swap_remove(i),
+                    None => {
+                        let available = adapters
+                            .iter()
+                            .map(|a| describe(&a.get_info()))
+                            .collect::<Vec<_>>()
+                            .join("; ");
+                        return Err(Error::AdapterNotFound { wanted, available });
+                    }
+                }
+            }
+            Err(_) => {
+                adapters.sort_by_key(|a| preference(a.get_info().device_type));
+                adapters.swap_remove(0)
+            }
+        };
+        Self::with_adapter(adapter)
+    }
+
+    /// Creates the device on a given adapter (as [`GpuContext::new`] does once it has chosen).
+    pub fn with_adapter(adapter: wgpu::Adapter) -> Result<Self> {
+        let wanted = OPTIONAL_FEATURES
+            .iter()
+            .fold(wgpu::Features::empty(), |all, (f, _)| all | *f);
+        let features = adapter.features() & wanted;
+        let mut limits = adapter.limits();
+        let mut experimental = wgpu::ExperimentalFeatures::disabled();
+        if features.contains(wgpu::Features::EXPERIMENTAL_RAY_QUERY) {
+            limits = limits.using_acceleration_structure_values(adapter.limits());
+            // SAFETY: wgpu asks callers of experimental features to accept that bugs in its
+            // implementation may be undefined behaviour. We only use ray query through wgpu's
+            // validated API, with acceleration structures built from checked, finite geometry.
+            experimental = unsafe { wgpu::ExperimentalFeatures::enabled() };
+        }
+        let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
+            label: Some("fisheye.device"),
+            required_features: features,
+            required_limits: limits,
+            experimental_features: experimental,
+            memory_hints: wgpu::MemoryHints::Performance,
+            trace: wgpu::Trace::Off,
+        }))
+        .map_err(|source| Error::RequestDevice {
+            adapter: describe(&adapter.get_info()),
+            source,
+        })?;
+        let lost = Arc::new(Mutex::new(None));
+        let flag = lost.clone();
+        device.set_device_lost_callback(move |reason, message| {
+            *flag.lock().unwrap() = Some(format!("{reason:?}: {message}"));
+        });
+        Ok(Self {
+            adapter,
+            device,
+            queue,
+            lost,
+        })
+    }
+
+    /// The adapter's name, backend and type, e.g. `llvmpipe (LLVM 19.1.7, 256 bits) (Vulkan, Cpu)`.
+    pub fn adapter_name(&self) -> String {
+        describe(&self.adapter.get_info())
+    }
+
+    /// Whether the device was created with `feature`.
+    pub fn has(&self, feature: wgpu::Features) -> bool {
+        self.device.features().contains(feature)
+    }
+
+    /// A human-readable report of the adapter, driver, optional features and key limits.
+    pub fn report(&self) -> String {
+        let info = self.adapter.get_info();
+        let limits = self.device.limits();
+        let mut out = format!(
+            "adapter: {}\ndriver: {} {}\nfeatures:\n",
+            describe(&info),
+            info.driver,
+            info.driver_info
+        );
+        for (feature, name) in OPTIONAL_FEATURES {
+            let mark = if self.has(feature) { "yes" } else { "no" };
+            out.push_str(&format!("  {name:<28} {mark}\n"));
+        }
+        out.push_str(&format!(
+            "limits:\n  max storage binding          {} MiB\n  max buffer size              {} MiB\n  max 2D texture side          {}\n",
+            limits.max_storage_buffer_binding_size >> 20,
+            limits.max_buffer_size >> 20,
+            limits.max_texture_dimension_2d,
+        ));
+        if let Some(period) = self.timestamp_period() {
+            out.push_str(&format!("  timestamp period             {period} ns\n"));
+        }
+        out
+    }
+
+    /// Nanoseconds per timestamp tick, if the device has timestamp queries.
+    pub fn timestamp_period(&self) -> Option<f32> {
+        self.has(wgpu::Features::TIMESTAMP_QUERY)
+            .then(|| self.queue.get_timestamp_period())
+    }
+
+    /// Runs `work` inside validation, out-of-memory and internal error scopes and turns what
+    /// they catch, or a lost device, into an [`Error`] naming `during`.
+    pub fn checked<T>(&self, during: &str, work: impl FnOnce() -> T) -> Result<T> {
+        self.check_lost()?;
+        let scopes = [
+            wgpu::ErrorFilter::Internal,
+            wgpu::ErrorFilter::OutOfMemory,
+            wgpu::ErrorFilter::Validation,
+        ]
+        .map(|filter| self.device.push_error_scope(filter));
+        let value = work();
+        // Popped innermost first.
+        let mut first = None;
+        for scope in scopes.into_iter().rev() {
+            if let Some(error) = pollster::block_on(scope.pop()) {
+                first.get_or_insert(error);
+            }
+        }
+        self.check_lost()?;
+        match first {
+            Some(error) => Err(Error::Gpu {
+                during: during.to_string(),
+                message: error.to_string(),
+            }),
+            None => Ok(value),
+        }
+    }
+
+    fn check_lost(&self) -> Result<()> {
+        match self.lost.lock().unwrap().as_ref() {
+            Some(reason) => Err(Error::DeviceLost(reason.clone())),
+            None => Ok(()),
+        }
+    }
+
+    /// Blocks until the GPU has finished all submitted work.
+    pub fn wait(&self) -> Result<()> {
+        self.device
+            .poll(wgpu::PollType::wait_indefinitely())
+            .map_err(|e| Error::Gpu {
+                during: "waiting for the GPU".into(),
+                message: e.to_string(),
+            })?;
+        self.check_lost()
+    }
+
+    /// Copies `buffer` (which must have `COPY_SRC`) to the CPU as `T`s.
+    pub fn read_buffer<T: bytemuck::Pod>(&self, buffer: &wgpu::Buffer) -> Result<Vec<T>> {
+        let size = buffer.size();
+        let staging = self.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("fisheye.readback"),
+            size,
+            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let mut encoder = self
+            .device
+            .create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                label: Some("fisheye.readback"),
+            });
+        encoder.copy_buffer_to_buffer(buffer, 0, &staging, 0, size);
+        self.queue.submit([encoder.finish()]);
+        let (sender, receiver) = std::sync::mpsc::channel();
+        staging.map_async(wgpu::MapMode::Read, .., move |r| {
+            let _ = sender.send(r);
+        });
+        self.wait()?;
+        let mapped = receiver
+            .recv()
+            .map_err(|_| Error::DeviceLost("the readback was never answered".into()))?;
+        let map_error = |message: String| Error::Gpu {
+            during: "reading a buffer back".into(),
+            message,
+        };
+        mapped.map_err(|e| map_error(e.to_string()))?;
+        let view = staging
+            .get_mapped_range(..)
+            .map_err(|e| map_error(e.to_string()))?;
+        let out = bytemuck::cast_slice(&view).to_vec();
+        drop(view);
+        staging.unmap();
+        Ok(out)
+    }
+
+    /// Checks that a storage binding of `bytes` fits the device, naming `what` if not.
+    pub fn check_binding(&self, what: &str, bytes: u64) -> Result<()> {
+        let limit = u64::from(self.device.limits().max_storage_buffer_binding_size);
+        if bytes > limit {
+            return Err(Error::Gpu {
+                during: what.to_string(),
+                message: format!(
+                    "needs a storage buffer of {} MiB, above this adapter's limit of {} MiB \
+                     per binding; use a smaller image",
+                    bytes.div_ceil(1 << 20),
+                    limit >> 20
+                ),
+            });
+        }
+        Ok(())
+    }
+}

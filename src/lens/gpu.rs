@@ -1,0 +1,428 @@
+//! The lens on the GPU: the parameters WGSL reads, the ids of its specialisations, and two
+//! passes: [`LensRays`] (the direction of every pixel: the direction table) and
+//! [`LensPoints`] (project or unproject arbitrary points).
+
+use bytemuck::{Pod, Zeroable};
+use glam::{DVec2, DVec3, Vec2, Vec3};
+use wgpu::util::DeviceExt;
+
+use super::{Family, LensCamera, LensModel};
+use crate::error::Result;
+use crate::gpu::GpuContext;
+use crate::shader::{self, WORKGROUP_1D, WORKGROUP_2D};
+
+/// Which WGSL code path a lens runs: the `LENS_KIND` override. The classic models keep their
+/// own closed forms; `General*` are the trigonometric paths of the general form.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[repr(u32)]
+pub enum LensKind {
+    /// `r = f tan θ`.
+    Rectilinear = 0,
+    /// `r = 2f tan(θ/2)`.
+    Stereographic = 1,
+    /// `r = f θ` (also the general form with `k2 = 0`).
+    Equidistant = 2,
+    /// `r = 2f sin(θ/2)`.
+    Equisolid = 3,
+    /// `r = f sin θ`.
+    Orthographic = 4,
+    /// `r = (f/k1) tan(k2 θ)`.
+    GeneralTan = 5,
+    /// `r = (f/k1) sin(|k2| θ)`.
+    GeneralSin = 6,
+}
+
+impl LensKind {
+    /// Every kind, for emitting the WGSL constants.
+    pub const ALL: [LensKind; 7] = [
+        Self::Rectilinear,
+        Self::Stereographic,
+        Self::Equidistant,
+        Self::Equisolid,
+        Self::Orthographic,
+        Self::GeneralTan,
+        Self::GeneralSin,
+    ];
+
+    /// The code path of a model.
+    pub fn of(model: LensModel) -> Self {
+        match model {
+            LensModel::Rectilinear => Self::Rectilinear,
+            LensModel::Stereographic => Self::Stereographic,
+            LensModel::Equidistant => Self::Equidistant,
+            LensModel::Equisolid => Self::Equisolid,
+            LensModel::Orthographic => Self::Orthographic,
+            LensModel::General { .. } => match model.general_form().0 {
+                Family::Tan => Self::GeneralTan,
+                Family::Linear => Self::Equidistant,
+                Family::Sin => Self::GeneralSin,
+            },
+        }
+    }
+
+    /// The WGSL constant naming this kind, e.g. `LENS_GENERAL_TAN`.
+    pub fn const_name(&self) -> String {
+        let name = match self {
+            Self::Rectilinear => "RECTILINEAR",
+            Self::Stereographic => "STEREOGRAPHIC",
+            Self::Equidistant => "EQUIDISTANT",
+            Self::Equisolid => "EQUISOLID",
+            Self::Orthographic => "ORTHOGRAPHIC",
+            Self::GeneralTan => "GENERAL_TAN",
+            Self::GeneralSin => "GENERAL_SIN",
+        };
+        format!("LENS_{name}")
+    }
+}
+
+/// Where a kernel that consumes ray directions gets them: the `DIRECTION_SOURCE` override.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[repr(u32)]
+pub enum DirectionSource {
+    /// Evaluate the lens per pixel, every frame.
+    Computed = 0,
+    /// Read the direction table that [`LensRays`] computed once.
+    Table = 1,
+}
+
+impl DirectionSource {
+    /// The WGSL constant naming this source.
+    pub fn const_name(&self) -> String {
+        match self {
+            Self::Computed => "DIRECTIONS_COMPUTED".into(),
+            Self::Table => "DIRECTIONS_TABLE".into(),
+        }
+    }
+
+    /// The name used on the command line and in benchmark tables.
+    pub fn name(&self) -> &'static str {
+        match self {
+            Self::Computed => "computed",
+            Self::Table => "table",
+        }
+    }
+}
+
+/// The lens as WGSL's `LensParams` reads it (32 bytes; `wgsl/lens.wgsl` mirrors it and a test
+/// checks the layouts agree). See the WGSL struct for the fields' meaning.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, PartialEq, Pod, Zeroable)]
+pub struct LensParams {
+    /// Focal length.
+    pub f: f32,
+    /// `k1/f` of the general form.
+    pub k1_over_f: f32,
+    /// Rate `|k2|` of the general form.
+    pub rate: f32,
+    /// Radius of the domain edge, `f32::MAX` when unbounded.
+    pub r_max: f32,
+    /// Largest θ of a ray.
+    pub theta_max: f32,
+    /// Image width in pixels.
+    pub width: u32,
+    /// Image height in pixels.
+    pub height: u32,
+    /// `N_max` of [`LensCamera::mask_limit`].
+    pub mask_limit: u32,
+}
+
+const _: () = assert!(std::mem::size_of::<LensParams>() == 32);
+
+impl LensParams {
+    /// The parameters of a camera, rounded to f32.
+    pub fn new(camera: &LensCamera) -> Self {
+        let lens = camera.lens;
+        let (_, k1, rate) = lens.model().general_form();
+        let f = lens.focal_length();
+        Self {
+            f: f as f32,
+            k1_over_f: (k1 / f) as f32,
+            rate: rate as f32,
+            r_max: lens.r_max().min(f64::from(f32::MAX)) as f32,
+            theta_max: lens.theta_max() as f32,
+            width: camera.size.width,
+            height: camera.size.height,
+            mask_limit: camera.mask_limit(),
+        }
+    }
+}
+
+/// The override constants that specialise a lens kernel to a camera's model and formula.
+pub fn lens_constants(camera: &LensCamera) -> [(&'static str, f64); 2] {
+    [
+        (
+            "LENS_KIND",
+            f64::from(LensKind::of(camera.lens.model()) as u32),
+        ),
+        (
+            "DIRECTION_FORMULA",
+            f64::from(shader::formula_id(camera.formula)),
+        ),
+    ]
+}
+
+/// Creates a compute pipeline for `entry_point` of the WGSL file `file`, with its layout
+/// derived from the shader and the given override constants.
+pub(crate) fn compute_pipeline(
+    device: &wgpu::Device,
+    file: &str,
+    entry_point: &str,
+    constants: &[(&str, f64)],
+) -> wgpu::ComputePipeline {
+    let module = shader::module(device, file);
+    device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+        label: Some(&format!("fisheye.{file}.{entry_point}")),
+        layout: None,
+        module: &module,
+        entry_point: Some(entry_point),
+        compilation_options: wgpu::PipelineCompilationOptions {
+            constants,
+            ..Default::default()
+        },
+        cache: None,
+    })
+}
+
+/// The uniform buffer holding a camera's [`LensParams`].
+pub(crate) fn params_buffer(device: &wgpu::Device, camera: &LensCamera) -> wgpu::Buffer {
+    device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+        label: Some("fisheye.lens.params"),
+        contents: bytemuck::bytes_of(&LensParams::new(camera)),
+        usage: wgpu::BufferUsages::UNIFORM,
+    })
+}
+
+/// A `vec4<f32>` per-element result with `w` (or `z`) as the validity flag, to `Option`.
+fn flagged(v: [f32; 4], flag: f32) -> bool {
+    flag == 1.0 && v.iter().all(|c| c.is_finite())
+}
+
+/// Computes the ray direction of every pixel centre: the direction table, one `vec4<f32>` per
+/// pixel (xyz the direction, w = 1; zeros where masked), made once per lens and image size.
+pub struct LensRays {
+    pipeline: wgpu::ComputePipeline,
+    bind_group: wgpu::BindGroup,
+    /// The table, row-major; usable as a storage binding by later passes.
+    pub directions: wgpu::Buffer,
+    camera: LensCamera,
+}
+
+impl LensRays {
+    /// Creates the pipeline and the table buffer; errors if the table exceeds a storage
+    /// binding of this adapter.
+    pub fn new(ctx: &GpuContext, camera: &LensCamera) -> Result<Self> {
+        let bytes = 16 * camera.size.pixels() as u64;
+        ctx.check_binding("the direction table", bytes)?;
+        ctx.checked("creating the lens-rays pass", || {
+            let device = &ctx.device;
+            let pipeline = compute_pipeline(device, "lens_rays", "main", &lens_constants(camera));
+            let directions = device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("fisheye.lens_rays.directions"),
+                size: bytes,
+                usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
+                mapped_at_creation: false,
+            });
+            let params = params_buffer(device, camera);
+            let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some("fisheye.lens_rays"),
+                layout: &pipeline.get_bind_group_layout(0),
+                entries: &[
+                    wgpu::BindGroupEntry {
+                        binding: 0,
+                        resource: params.as_entire_binding(),
+                    },
+                    wgpu::BindGroupEntry {
+                        binding: 1,
+                        resource: directions.as_entire_binding(),
+                    },
+                ],
+            });
+            Self {
+                pipeline,
+                bind_group,
+                directions,
+                camera: *camera,
+            }
+        })
+    }
+
+    /// Records the pass, optionally timed.
+    pub fn encode(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        timestamp_writes: Option<wgpu::ComputePassTimestampWrites<'_>>,
+    ) {
+        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+            label: Some("fisheye.lens_rays"),
+            timestamp_writes,
+        });
+        pass.set_pipeline(&self.pipeline);
+        pass.set_bind_group(0, &self.bind_group, &[]);
+        pass.dispatch_workgroups(
+            self.camera.size.width.div_ceil(WORKGROUP_2D),
+            self.camera.size.height.div_ceil(WORKGROUP_2D),
+            1,
+        );
+    }
+
+    /// Runs the pass and reads the table back: per pixel, row-major, `None` where masked.
+    pub fn compute(&self, ctx: &GpuContext) -> Result<Vec<Option<Vec3>>> {
+        ctx.checked("computing ray directions", || {
+            let mut encoder = ctx.device.create_command_encoder(&Default::default());
+            self.encode(&mut encoder, None);
+            ctx.queue.submit([encoder.finish()]);
+        })?;
+        let raw: Vec<[f32; 4]> = ctx.read_buffer(&self.directions)?;
+        Ok(raw
+            .into_iter()
+            .map(|v| flagged(v, v[3]).then(|| Vec3::new(v[0], v[1], v[2])))
+            .collect())
+    }
+}
+
+/// Projects or unprojects arbitrary points with the WGSL lens code.
+pub struct LensPoints {
+    unproject: wgpu::ComputePipeline,
+    project: wgpu::ComputePipeline,
+    params: wgpu::Buffer,
+}
+
+impl LensPoints {
+    /// Creates both pipelines for a camera.
+    pub fn new(ctx: &GpuContext, camera: &LensCamera) -> Result<Self> {
+        ctx.checked("creating the lens-points pass", || {
+            let constants = lens_constants(camera);
+            Self {
+                unproject: compute_pipeline(&ctx.device, "lens_points", "unproject", &constants),
+                project: compute_pipeline(&ctx.device, "lens_points", "project", &constants),
+                params: params_buffer(&ctx.device, camera),
+            }
+        })
+    }
+
+    /// The direction through each continuous pixel position (f32), `None` where it has none.
+    pub fn unproject(&self, ctx: &GpuContext, pixels: &[DVec2]) -> Result<Vec<Option<Vec3>>> {
+        let input: Vec<[f32; 4]> = pixels
+            .iter()
+            .map(|p| [p.x as f32, p.y as f32, 0.0, 0.0])
+            .collect();
+        let raw = self.run(ctx, &self.unproject, &input)?;
+        Ok(raw
+            .into_iter()
+            .map(|v| flagged(v, v[3]).then(|| Vec3::new(v[0], v[1], v[2])))
+            .collect())
+    }
+
+    /// The pixel position where each direction lands (f32), `None` where it lands nowhere.
+    pub fn project(&self, ctx: &GpuContext, dirs: &[DVec3]) -> Result<Vec<Option<Vec2>>> {
+        let input: Vec<[f32; 4]> = dirs
+            .iter()
+            .map(|d| [d.x as f32, d.y as f32, d.z as f32, 0.0])
+            .collect();
+        let raw = self.run(ctx, &self.project, &input)?;
+        Ok(raw
+            .into_iter()
+            .map(|v| flagged(v, v[2]).then(|| Vec2::new(v[0], v[1])))
+            .collect())
+    }
+
+    fn run(
+        &self,
+        ctx: &GpuContext,
+        pipeline: &wgpu::ComputePipeline,
+        input: &[[f32; 4]],
+    ) -> Result<Vec<[f32; 4]>> {
+        let limits = ctx.device.limits();
+        // Each chunk fits one storage binding and one dispatch.
+        let chunk = (limits.max_storage_buffer_binding_size as usize / 16)
+            .min(limits.max_compute_workgroups_per_dimension as usize * WORKGROUP_1D as usize);
+        let mut out = Vec::with_capacity(input.len());
+        for part in input.chunks(chunk) {
+            let results = ctx.checked("running the lens-points pass", || {
+                let device = &ctx.device;
+                let points = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                    label: Some("fisheye.lens_points.points"),
+                    contents: bytemuck::cast_slice(part),
+                    usage: wgpu::BufferUsages::STORAGE,
+                });
+                let results = device.create_buffer(&wgpu::BufferDescriptor {
+                    label: Some("fisheye.lens_points.results"),
+                    size: points.size(),
+                    usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
+                    mapped_at_creation: false,
+                });
+                let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+                    label: Some("fisheye.lens_points"),
+                    layout: &pipeline.get_bind_group_layout(0),
+                    entries: &[
+                        wgpu::BindGroupEntry {
+                            binding: 0,
+                            resource: self.params.as_entire_binding(),
+                        },
+                        wgpu::BindGroupEntry {
+                            binding: 1,
+                            resource: points.as_entire_binding(),
+                        },
+                        wgpu::BindGroupEntry {
+                            binding: 2,
+                            resource: results.as_entire_binding(),
+                        },
+                    ],
+                });
+                let mut encoder = device.create_command_encoder(&Default::default());
+                {
+                    let mut pass = encoder.begin_compute_pass(&Default::default());
+                    pass.set_pipeline(pipeline);
+                    pass.set_bind_group(0, &bind_group, &[]);
+                    pass.dispatch_workgroups((part.len() as u32).div_ceil(WORKGROUP_1D), 1, 1);
+                }
+                ctx.queue.submit([encoder.finish()]);
+                results
+            })?;
+            out.extend(ctx.read_buffer::<[f32; 4]>(&results)?);
+        }
+        Ok(out)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// `LensParams` in Rust and WGSL have the same size and field offsets (naga's layout).
+    #[test]
+    fn lens_params_layout_matches_wgsl() {
+        let source = shader::compose("lens");
+        let module = naga::front::wgsl::parse_str(&source).unwrap();
+        let mut layouter = naga::proc::Layouter::default();
+        layouter.update(module.to_ctx()).unwrap();
+        let (handle, ty) = module
+            .types
+            .iter()
+            .find(|(_, t)| t.name.as_deref() == Some("LensParams"))
+            .expect("LensParams in wgsl/lens.wgsl");
+        let naga::TypeInner::Struct { members, span } = &ty.inner else {
+            panic!("LensParams is not a struct");
+        };
+        assert_eq!(*span as usize, std::mem::size_of::<LensParams>());
+        assert_eq!(
+            layouter[handle].size as usize,
+            std::mem::size_of::<LensParams>()
+        );
+        let rust = [
+            ("f", std::mem::offset_of!(LensParams, f)),
+            ("k1_over_f", std::mem::offset_of!(LensParams, k1_over_f)),
+            ("rate", std::mem::offset_of!(LensParams, rate)),
+            ("r_max", std::mem::offset_of!(LensParams, r_max)),
+            ("theta_max", std::mem::offset_of!(LensParams, theta_max)),
+            ("width", std::mem::offset_of!(LensParams, width)),
+            ("height", std::mem::offset_of!(LensParams, height)),
+            ("mask_limit", std::mem::offset_of!(LensParams, mask_limit)),
+        ];
+        assert_eq!(members.len(), rust.len());
+        for (member, (name, offset)) in members.iter().zip(rust) {
+            assert_eq!(member.name.as_deref(), Some(name));
+            assert_eq!(member.offset as usize, offset, "offset of {name}");
+        }
+    }
+}

@@ -1,0 +1,299 @@
+//! `fisheye`: the command-line tool. See `fisheye --help` and the README.
+
+use std::io::{BufRead, Write};
+use std::path::PathBuf;
+use std::time::Instant;
+
+use anyhow::{Context, Result, bail};
+use clap::{Parser, Subcommand, ValueEnum};
+use fisheye_rt::demo::{LensDemo, save_png};
+use fisheye_rt::gpu::{GpuContext, Queries};
+use fisheye_rt::lens::gpu::{DirectionSource, LensPoints};
+use fisheye_rt::lens::{
+    DirectionFormula, ImageSize, LensCamera, LensModel, PRESET_FOV_DEGREES, PRESETS, parse_spec,
+};
+use glam::{DVec2, DVec3};
+
+#[derive(Parser)]
+#[command(
+    name = "fisheye",
+    version,
+    about = "Fisheye lens rendering by ray tracing in wgpu compute shaders"
+)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Show the GPU adapter, its optional features and limits, and measure the precision of
+    /// WGSL's trigonometric builtins against this project's replacements on it.
+    Info,
+    /// Lens models: list them, map pixels and directions, draw what they do.
+    Lens {
+        #[command(subcommand)]
+        command: LensCommand,
+    },
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+enum Formula {
+    Stable,
+    Thesis,
+}
+
+impl From<Formula> for DirectionFormula {
+    fn from(f: Formula) -> Self {
+        match f {
+            Formula::Stable => DirectionFormula::Stable,
+            Formula::Thesis => DirectionFormula::Thesis,
+        }
+    }
+}
+
+#[derive(clap::Args)]
+struct CameraArgs {
+    /// Lens spec: a model with parameters (`equisolid:f=0.93`, `general:f=1,k1=0.5,k2=0.5`,
+    /// `equidistant:f=0.42,fov=180`) or a preset (`samyang-7.5mm`); see `fisheye lens list`.
+    #[arg(long)]
+    lens: String,
+    /// Image size in pixels, WIDTHxHEIGHT.
+    #[arg(long, default_value = "1024x768")]
+    size: ImageSize,
+    /// How directions are built from θ: the stable default, or the thesis's formula.
+    #[arg(long, value_enum, default_value = "stable")]
+    formula: Formula,
+    /// Run the WGSL (f32) lens code on the GPU instead of the f64 reference.
+    #[arg(long)]
+    gpu: bool,
+}
+
+impl CameraArgs {
+    fn camera(&self) -> Result<LensCamera> {
+        let lens = parse_spec(&self.lens)?;
+        Ok(LensCamera::new(lens, self.size).with_formula(self.formula.into()))
+    }
+}
+
+#[derive(Subcommand)]
+enum LensCommand {
+    /// List the lens models and the presets.
+    List,
+    /// Read `px py` lines on stdin (continuous pixel coordinates, origin at the top-left
+    /// corner of the image) and write the unit direction `dx dy dz` (x right, y down, z
+    /// forward) or `none` for each.
+    Unproject(CameraArgs),
+    /// Read `dx dy dz` lines on stdin and write the pixel `px py` each lands on, or `none`.
+    Project(CameraArgs),
+    /// Draw what lenses do to the sphere of directions (10° grid, rings every 30° off the
+    /// axis), one PNG per lens.
+    Demo {
+        /// Lens specs to draw (repeatable); by default one of each model and every preset.
+        #[arg(long)]
+        lens: Vec<String>,
+        /// Image size in pixels, WIDTHxHEIGHT.
+        #[arg(long, default_value = "1024x768")]
+        size: ImageSize,
+        /// Folder to write the PNGs into.
+        #[arg(long, short, default_value = "fisheye-demo")]
+        out: PathBuf,
+    },
+}
+
+fn main() {
+    if let Err(error) = run(Cli::parse()) {
+        eprintln!("error: {error:#}");
+        std::process::exit(1);
+    }
+}
+
+fn run(cli: Cli) -> Result<()> {
+    match cli.command {
+        Command::Info => info(),
+        Command::Lens { command } => match command {
+            LensCommand::List => {
+                list();
+                Ok(())
+            }
+            LensCommand::Unproject(args) => unproject(&args),
+            LensCommand::Project(args) => project(&args),
+            LensCommand::Demo { lens, size, out } => demo(lens, size, out),
+        },
+    }
+}
+
+fn info() -> Result<()> {
+    let ctx = GpuContext::new()?;
+    print!("{}", ctx.report());
+    println!("trigonometry, max |error| against f64 (WGSL builtin / fisheye-rt math.wgsl):");
+    for t in fisheye_rt::precision::measure_trig(&ctx)? {
+        println!(
+            "  {:<5} on {:<7} builtin {:9.2e}   ours {:9.2e}",
+            t.function, t.domain, t.builtin, t.ours
+        );
+    }
+    Ok(())
+}
+
+fn list() {
+    println!("models (spec: NAME:f=F[,fov=DEGREES]; general also takes k1, k2):");
+    let general = LensModel::General { k1: 1.0, k2: 1.0 };
+    for model in [
+        LensModel::Rectilinear,
+        LensModel::Stereographic,
+        LensModel::Equidistant,
+        LensModel::Equisolid,
+        LensModel::Orthographic,
+        general,
+    ] {
+        println!("  {:<14} {}", model.name(), model.formula());
+    }
+    println!("\npresets (limited to {PRESET_FOV_DEGREES}°; spec: NAME[:f=F,fov=DEGREES]):");
+    for p in PRESETS {
+        println!(
+            "  {:<24} {:<13} f={:<6} {}",
+            p.name,
+            p.model.name(),
+            p.f,
+            p.description
+        );
+    }
+}
+
+/// Parses stdin: one point per non-empty line, `N` numbers each; `#` starts a comment.
+fn read_points<const N: usize>() -> Result<Vec<[f64; N]>> {
+    let mut points = Vec::new();
+    for (number, line) in std::io::stdin().lock().lines().enumerate() {
+        let line = line.context("reading stdin")?;
+        let text = line.split('#').next().unwrap_or("").trim();
+        if text.is_empty() {
+            continue;
+        }
+        let values: Vec<f64> = text
+            .split_whitespace()
+            .map(str::parse)
+            .collect::<Result<_, _>>()
+            .with_context(|| format!("stdin line {}: {text:?} is not numbers", number + 1))?;
+        let Ok(point) = <[f64; N]>::try_from(values) else {
+            bail!(
+                "stdin line {}: expected {N} numbers, got {text:?}",
+                number + 1
+            );
+        };
+        points.push(point);
+    }
+    Ok(points)
+}
+
+fn write_lines(lines: impl Iterator<Item = String>) -> Result<()> {
+    let mut out = std::io::BufWriter::new(std::io::stdout().lock());
+    for line in lines {
+        writeln!(out, "{line}")?;
+    }
+    Ok(out.flush()?)
+}
+
+fn unproject(args: &CameraArgs) -> Result<()> {
+    let camera = args.camera()?;
+    let pixels: Vec<DVec2> = read_points::<2>()?.into_iter().map(DVec2::from).collect();
+    let dirs: Vec<Option<DVec3>> = if args.gpu {
+        let ctx = GpuContext::new()?;
+        LensPoints::new(&ctx, &camera)?
+            .unproject(&ctx, &pixels)?
+            .into_iter()
+            .map(|d| d.map(|d| d.as_dvec3()))
+            .collect()
+    } else {
+        pixels.iter().map(|&p| camera.unproject(p)).collect()
+    };
+    write_lines(dirs.into_iter().map(|d| match d {
+        Some(d) => format!("{:.9} {:.9} {:.9}", d.x, d.y, d.z),
+        None => "none".into(),
+    }))
+}
+
+fn project(args: &CameraArgs) -> Result<()> {
+    let camera = args.camera()?;
+    let dirs: Vec<DVec3> = read_points::<3>()?.into_iter().map(DVec3::from).collect();
+    let pixels: Vec<Option<DVec2>> = if args.gpu {
+        let ctx = GpuContext::new()?;
+        LensPoints::new(&ctx, &camera)?
+            .project(&ctx, &dirs)?
+            .into_iter()
+            .map(|p| p.map(|p| p.as_dvec2()))
+            .collect()
+    } else {
+        dirs.iter().map(|&d| camera.project(d)).collect()
+    };
+    write_lines(pixels.into_iter().map(|p| match p {
+        Some(p) => format!("{:.6} {:.6}", p.x, p.y),
+        None => "none".into(),
+    }))
+}
+
+/// One representative lens per model, then every preset.
+fn default_demo_lenses() -> Vec<String> {
+    let mut specs: Vec<String> = [
+        "rectilinear:f=0.5",
+        "stereographic:f=0.35",
+        "equidistant:f=0.3",
+        "equisolid:f=0.45",
+        "orthographic:f=0.66",
+        "general:f=0.4,k1=0.7,k2=0.7",
+    ]
+    .map(String::from)
+    .to_vec();
+    specs.extend(PRESETS.iter().map(|p| p.name.to_string()));
+    specs
+}
+
+fn demo(lenses: Vec<String>, size: ImageSize, out: PathBuf) -> Result<()> {
+    let lenses = if lenses.is_empty() {
+        default_demo_lenses()
+    } else {
+        lenses
+    };
+    // Check every spec before starting the GPU.
+    let cameras = lenses
+        .iter()
+        .map(|spec| Ok((spec, LensCamera::new(parse_spec(spec)?, size))))
+        .collect::<Result<Vec<_>>>()?;
+    let ctx = GpuContext::new()?;
+    println!("adapter: {}", ctx.adapter_name());
+    let queries = Queries::new(&ctx, 1);
+    for (spec, camera) in cameras {
+        let started = Instant::now();
+        let demo = LensDemo::new(&ctx, &camera, DirectionSource::Computed)?;
+        let mut encoder = ctx.device.create_command_encoder(&Default::default());
+        demo.encode(&mut encoder, queries.as_ref().map(|q| q.writes(0)));
+        if let Some(q) = &queries {
+            q.resolve(&mut encoder);
+        }
+        ctx.queue.submit([encoder.finish()]);
+        let gpu_ms = match &queries {
+            Some(q) => format!("{:.2} ms on the GPU", q.read_ns(&ctx)?[0] * 1e-6),
+            None => "no timestamps".into(),
+        };
+        let image = demo.render(&ctx)?;
+        let name: String = spec
+            .chars()
+            .map(|c| {
+                if c.is_ascii_alphanumeric() || "-.@".contains(c) {
+                    c
+                } else {
+                    '_'
+                }
+            })
+            .collect();
+        let path = out.join(format!("{name}.png"));
+        save_png(&image, &path)?;
+        println!(
+            "{:<36} -> {} ({gpu_ms}, {:.0} ms in all)",
+            camera.lens.to_string(),
+            path.display(),
+            started.elapsed().as_secs_f64() * 1e3
+        );
+    }
+    Ok(())
+}

@@ -1,0 +1,140 @@
+//! WGSL assembly: every shader file is embedded, `#import NAME` lines pull in shared files
+//! (each once, dependencies first), and constants defined once in Rust are prepended as WGSL
+//! `const` lines. Pipeline specialisations (lens model, direction formula) are WGSL
+//! `override`s, set per pipeline.
+
+use std::fmt::Write;
+
+use crate::lens::DirectionFormula;
+use crate::lens::gpu::{DirectionSource, LensKind};
+
+/// Every WGSL file of the project, by name (its file stem under `wgsl/`).
+pub const FILES: [(&str, &str); 6] = [
+    ("math", include_str!("../wgsl/math.wgsl")),
+    ("lens", include_str!("../wgsl/lens.wgsl")),
+    ("lens_rays", include_str!("../wgsl/lens_rays.wgsl")),
+    ("lens_points", include_str!("../wgsl/lens_points.wgsl")),
+    ("lens_demo", include_str!("../wgsl/lens_demo.wgsl")),
+    ("trig_probe", include_str!("../wgsl/trig_probe.wgsl")),
+];
+
+/// Side of the square workgroups of per-pixel kernels.
+pub const WORKGROUP_2D: u32 = 8;
+/// Width of the workgroups of per-element kernels.
+pub const WORKGROUP_1D: u32 = 64;
+
+/// The constants every module sees, defined here once.
+pub fn constants() -> Vec<(String, u32)> {
+    let mut out = vec![
+        ("WORKGROUP_2D".to_string(), WORKGROUP_2D),
+        ("WORKGROUP_1D".to_string(), WORKGROUP_1D),
+    ];
+    out.extend(LensKind::ALL.iter().map(|k| (k.const_name(), *k as u32)));
+    for formula in [DirectionFormula::Stable, DirectionFormula::Thesis] {
+        let name = format!("FORMULA_{}", formula.name().to_uppercase());
+        out.push((name, formula_id(formula)));
+    }
+    for source in [DirectionSource::Computed, DirectionSource::Table] {
+        out.push((source.const_name(), source as u32));
+    }
+    out
+}
+
+/// The id WGSL's `DIRECTION_FORMULA` override takes for a formula.
+pub fn formula_id(formula: DirectionFormula) -> u32 {
+    match formula {
+        DirectionFormula::Stable => 0,
+        DirectionFormula::Thesis => 1,
+    }
+}
+
+fn file(name: &str) -> &'static str {
+    FILES
+        .iter()
+        .find(|(n, _)| *n == name)
+        .map(|(_, text)| *text)
+        .unwrap_or_else(|| panic!("#import {name}: no such file in wgsl/ (see shader::FILES)"))
+}
+
+fn append(name: &str, seen: &mut Vec<String>, out: &mut String) {
+    if seen.iter().any(|s| s == name) {
+        return;
+    }
+    seen.push(name.to_string());
+    let text = file(name);
+    for line in text.lines() {
+        if let Some(dep) = line.trim().strip_prefix("#import ") {
+            append(dep.trim(), seen, out);
+        }
+    }
+    writeln!(out, "// ---- wgsl/{name}.wgsl").unwrap();
+    for line in text.lines().filter(|l| !l.trim().starts_with("#import ")) {
+        out.push_str(line);
+        out.push('\n');
+    }
+}
+
+/// The complete WGSL source of the module whose entry file is `entry`.
+pub fn compose(entry: &str) -> String {
+    let mut out = String::from("// ---- constants from fisheye_rt::shader::constants()\n");
+    for (name, value) in constants() {
+        writeln!(out, "const {name}: u32 = {value}u;").unwrap();
+    }
+    append(entry, &mut Vec::new(), &mut out);
+    out
+}
+
+/// Creates the shader module for `entry`, labelled `fisheye.<entry>`.
+pub fn module(device: &wgpu::Device, entry: &str) -> wgpu::ShaderModule {
+    device.create_shader_module(wgpu::ShaderModuleDescriptor {
+        label: Some(&format!("fisheye.{entry}")),
+        source: wgpu::ShaderSource::Wgsl(compose(entry).into()),
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Parses and validates every WGSL file, composed with its imports, with naga: no GPU.
+    #[test]
+    fn every_wgsl_file_validates() {
+        for (name, _) in FILES {
+            let source = compose(name);
+            let module = naga::front::wgsl::parse_str(&source)
+                .unwrap_or_else(|e| panic!("{name}: {}", e.emit_to_string(&source)));
+            naga::valid::Validator::new(
+                naga::valid::ValidationFlags::all(),
+                naga::valid::Capabilities::all(),
+            )
+            .validate(&module)
+            .unwrap_or_else(|e| panic!("{name}: {}", e.emit_to_string(&source)));
+        }
+    }
+
+    #[test]
+    fn every_file_is_listed() {
+        let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/wgsl");
+        let mut on_disk: Vec<String> = std::fs::read_dir(dir)
+            .unwrap()
+            .map(|e| e.unwrap().path())
+            .filter(|p| p.extension().is_some_and(|e| e == "wgsl"))
+            .map(|p| p.file_stem().unwrap().to_string_lossy().into_owned())
+            .collect();
+        on_disk.sort();
+        let mut listed: Vec<String> = FILES.iter().map(|(n, _)| n.to_string()).collect();
+        listed.sort();
+        assert_eq!(on_disk, listed, "wgsl/ and shader::FILES disagree");
+    }
+
+    #[test]
+    fn imports_come_once_and_first() {
+        let source = compose("lens_points");
+        assert_eq!(source.matches("// ---- wgsl/math.wgsl").count(), 1);
+        let math = source.find("wgsl/math.wgsl").unwrap();
+        let lens = source.find("wgsl/lens.wgsl").unwrap();
+        let entry = source.find("wgsl/lens_points.wgsl").unwrap();
+        assert!(math < lens && lens < entry);
+        assert!(!source.contains("#import"));
+    }
+}
