@@ -26,3 +26,8 @@ pub mod precision;
 pub mod shader;
 
 pub use error::{Error, LensError, Result};
+
+/// The README's Rust examples, compiled as doctests so they stay true.
+#[doc = include_str!("../README.md")]
+#[cfg(doctest)]
+pub struct ReadmeDoctests;

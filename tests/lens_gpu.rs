@@ -43,7 +43,10 @@ struct Comparison {
 /// Runs `LensRays` and compares every pixel with the f64 reference; asserts no NaN and the
 /// same mask.
 fn compare(camera: &LensCamera) -> Comparison {
-    let gpu = LensRays::new(ctx(), camera).unwrap().compute(ctx()).unwrap();
+    let gpu = LensRays::new(ctx(), camera)
+        .unwrap()
+        .compute(ctx())
+        .unwrap();
     let cpu = LensCamera::new(camera.lens, camera.size).directions();
     let width = camera.size.width as usize;
     let mut c = Comparison {
@@ -151,10 +154,13 @@ fn domain_edges_180_and_360_degree_fields() {
         "equidistant:f=0.19",
         "stereographic:f=0.25,fov=200",
     ] {
-        let cam = camera(&spec, 1024, 768);
+        let cam = camera(spec, 1024, 768);
         let c = assert_bounded(&cam);
         let masked = cam.size.pixels() - c.valid;
-        assert!(masked > 1000, "{spec}: the domain edge should lie inside the image");
+        assert!(
+            masked > 1000,
+            "{spec}: the domain edge should lie inside the image"
+        );
     }
 }
 
@@ -250,7 +256,11 @@ fn gpu_points_round_trip_at_4096_px() {
     ];
     let points: Vec<DVec2> = (0..4096)
         .step_by(29)
-        .flat_map(|j| (0..4096).step_by(31).map(move |i| DVec2::new(i as f64, j as f64)))
+        .flat_map(|j| {
+            (0..4096)
+                .step_by(31)
+                .map(move |i| DVec2::new(i as f64, j as f64))
+        })
         .map(|p| p + 0.5)
         .chain([DVec2::new(2048.0, 2048.0), DVec2::new(2048.5, 2048.0)])
         .collect();
@@ -262,7 +272,11 @@ fn gpu_points_round_trip_at_4096_px() {
         let mut reference_dirs = Vec::new();
         let mut reference_points = Vec::new();
         let mut worst_dir = 0.0f64;
-        for ((p, g), r) in points.iter().zip(&dirs).zip(points.iter().map(|&p| cam.unproject(p))) {
+        for ((p, g), r) in points
+            .iter()
+            .zip(&dirs)
+            .zip(points.iter().map(|&p| cam.unproject(p)))
+        {
             assert_eq!(g.is_some(), r.is_some(), "{spec} {p}: masks differ");
             let (Some(g), Some(r)) = (g, r) else { continue };
             let kappa = lens.theta_sensitivity(cam.normalized(*p).length());
@@ -328,9 +342,15 @@ fn direction_table_and_computed_directions_agree() {
 /// A table larger than a storage binding is refused with the numbers, not a crash.
 #[test]
 fn oversized_direction_table_is_a_clear_error() {
-    let limit = ctx().device.limits().max_storage_buffer_binding_size as u64;
+    let limit = ctx().device.limits().max_storage_buffer_binding_size;
     let side = ((limit / 16) as f64).sqrt() as u32 + 64;
     let cam = camera("equidistant:f=0.5", side, side);
-    let error = LensRays::new(ctx(), &cam).err().expect("too large").to_string();
-    assert!(error.contains("direction table") && error.contains("MiB"), "{error}");
+    let error = LensRays::new(ctx(), &cam)
+        .err()
+        .expect("too large")
+        .to_string();
+    assert!(
+        error.contains("direction table") && error.contains("MiB"),
+        "{error}"
+    );
 }

@@ -258,7 +258,7 @@ impl GpuContext {
 
     /// Checks that a storage binding of `bytes` fits the device, naming `what` if not.
     pub fn check_binding(&self, what: &str, bytes: u64) -> Result<()> {
-        let limit = u64::from(self.device.limits().max_storage_buffer_binding_size);
+        let limit = self.device.limits().max_storage_buffer_binding_size;
         if bytes > limit {
             return Err(Error::Gpu {
                 during: what.to_string(),

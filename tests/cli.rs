@@ -1,0 +1,202 @@
+//! The `fisheye` binary end to end, as a user runs it.
+
+use std::io::Write;
+use std::process::{Command, Output, Stdio};
+
+use fisheye_rt::lens::{ImageSize, LensCamera, PRESETS, parse_spec};
+use glam::{DVec2, DVec3};
+
+fn fisheye(args: &[&str], stdin: &str) -> Output {
+    let mut child = Command::new(env!("CARGO_BIN_EXE_fisheye"))
+        .args(args)
+        .stdin(Stdio::piped())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("the fisheye binary runs");
+    child
+        .stdin
+        .take()
+        .unwrap()
+        .write_all(stdin.as_bytes())
+        .unwrap();
+    child.wait_with_output().unwrap()
+}
+
+fn stdout(output: &Output) -> String {
+    assert!(
+        output.status.success(),
+        "failed: {}",
+        String::from_utf8_lossy(&output.stderr)
+    );
+    String::from_utf8(output.stdout.clone()).unwrap()
+}
+
+fn numbers(line: &str) -> Vec<f64> {
+    line.split_whitespace()
+        .map(|x| x.parse().unwrap())
+        .collect()
+}
+
+#[test]
+fn lens_list_names_every_model_and_preset() {
+    let text = stdout(&fisheye(&["lens", "list"], ""));
+    for name in fisheye_rt::lens::LensModel::NAMES {
+        assert!(text.contains(name), "{name} missing");
+    }
+    for preset in PRESETS {
+        assert!(text.contains(preset.name), "{} missing", preset.name);
+    }
+}
+
+#[test]
+fn unproject_writes_directions_or_none() {
+    let args = [
+        "lens",
+        "unproject",
+        "--lens",
+        "canon-8-15mm@8mm",
+        "--size",
+        "1024x768",
+    ];
+    let input = "512 384\n# a comment\n\n600.25 300.5\n0 0\n";
+    let text = stdout(&fisheye(&args, input));
+    let lines: Vec<&str> = text.lines().collect();
+    assert_eq!(lines.len(), 3);
+    assert_eq!(numbers(lines[0]), [0.0, 0.0, 1.0]);
+    let camera = LensCamera::new(
+        parse_spec("canon-8-15mm@8mm").unwrap(),
+        ImageSize::new(1024, 768).unwrap(),
+    );
+    let reference = camera.unproject(DVec2::new(600.25, 300.5)).unwrap();
+    let got = DVec3::from_slice(&numbers(lines[1]));
+    assert!(got.distance(reference) < 1e-8, "{got} vs {reference}");
+    // The corner lies outside this lens's 180° circle.
+    assert_eq!(lines[2], "none");
+
+    // The same through the WGSL code.
+    let gpu_args = [&args[..], &["--gpu"]].concat();
+    let gpu = stdout(&fisheye(&gpu_args, input));
+    let gpu_lines: Vec<&str> = gpu.lines().collect();
+    assert_eq!(gpu_lines[2], "none");
+    let got = DVec3::from_slice(&numbers(gpu_lines[1]));
+    assert!(got.distance(reference) < 1e-6, "{got} vs {reference}");
+}
+
+#[test]
+fn project_writes_pixels_or_none() {
+    for gpu in [false, true] {
+        let mut args = vec![
+            "lens",
+            "project",
+            "--lens",
+            "equisolid:f=0.5",
+            "--size",
+            "640x480",
+        ];
+        if gpu {
+            args.push("--gpu");
+        }
+        let text = stdout(&fisheye(&args, "0 0 1\n0 0 -1\n1 0 0\n"));
+        let lines: Vec<&str> = text.lines().collect();
+        assert_eq!(numbers(lines[0]), [320.0, 240.0], "gpu: {gpu}");
+        // Straight back: equisolid maps it to r = 2f = 1, the right edge (azimuth 0).
+        let back = numbers(lines[1]);
+        assert!((back[0] - 640.0).abs() < 1e-3 && (back[1] - 240.0).abs() < 1e-3);
+        // 90° to the right: r = 2f sin 45° = 0.7071 half-widths.
+        let right = numbers(lines[2]);
+        assert!(
+            (right[0] - 320.0 * (1.0 + 0.5f64.sqrt())).abs() < 1e-3,
+            "{right:?}"
+        );
+    }
+}
+
+#[test]
+fn bad_input_is_a_clear_error() {
+    let cases: [(&[&str], &str, &str); 5] = [
+        (
+            &["lens", "unproject", "--lens", "equisolid:f=-2"],
+            "",
+            "f = -2",
+        ),
+        (
+            &["lens", "unproject", "--lens", "nope:f=1"],
+            "",
+            "unknown model or preset",
+        ),
+        (
+            &["lens", "unproject", "--lens", "equisolid:f=1"],
+            "1 2\n3 four\n",
+            "line 2",
+        ),
+        (
+            &["lens", "project", "--lens", "equisolid:f=1"],
+            "1 2\n",
+            "expected 3 numbers",
+        ),
+        (
+            &[
+                "lens",
+                "unproject",
+                "--lens",
+                "equisolid:f=1",
+                "--size",
+                "0x10",
+            ],
+            "",
+            "width must be",
+        ),
+    ];
+    for (args, input, needle) in cases {
+        let output = fisheye(args, input);
+        let stderr = String::from_utf8_lossy(&output.stderr);
+        assert!(!output.status.success(), "{args:?} should fail");
+        assert!(
+            stderr.contains(needle),
+            "{args:?}: {stderr:?} lacks {needle:?}"
+        );
+        assert!(!stderr.contains("panicked"), "{args:?} panicked: {stderr}");
+    }
+}
+
+#[test]
+fn info_reports_adapter_features_and_precision() {
+    let text = stdout(&fisheye(&["info"], ""));
+    for needle in [
+        "adapter:",
+        "timestamp queries",
+        "ray query",
+        "asin",
+        "builtin",
+    ] {
+        assert!(text.contains(needle), "{needle} missing from:\n{text}");
+    }
+}
+
+#[test]
+fn demo_writes_one_png_per_lens() {
+    let dir = std::env::temp_dir().join(format!("fisheye-demo-test-{}", std::process::id()));
+    let out = dir.to_str().unwrap();
+    let args = [
+        "lens",
+        "demo",
+        "--lens",
+        "canon-8-15mm@8mm",
+        "--lens",
+        "rectilinear:f=1",
+        "--size",
+        "96x64",
+        "--out",
+        out,
+    ];
+    stdout(&fisheye(&args, ""));
+    for name in ["canon-8-15mm@8mm.png", "rectilinear_f_1.png"] {
+        let image = image::open(dir.join(name)).unwrap().to_rgba8();
+        assert_eq!(image.dimensions(), (96, 64));
+        // Not blank: more than one colour.
+        let first = image.get_pixel(0, 0);
+        assert!(image.pixels().any(|p| p != first), "{name} is one colour");
+    }
+    std::fs::remove_dir_all(dir).unwrap();
+}
