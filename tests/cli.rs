@@ -7,8 +7,13 @@ use fisheye_rt::lens::{ImageSize, LensCamera, PRESETS, parse_spec};
 use glam::{DVec2, DVec3};
 
 fn fisheye(args: &[&str], stdin: &str) -> Output {
+    fisheye_with_env(args, stdin, &[])
+}
+
+fn fisheye_with_env(args: &[&str], stdin: &str, env: &[(&str, &str)]) -> Output {
     let mut child = Command::new(env!("CARGO_BIN_EXE_fisheye"))
         .args(args)
+        .envs(env.iter().copied())
         .stdin(Stdio::piped())
         .stdout(Stdio::piped())
         .stderr(Stdio::piped())
@@ -199,4 +204,31 @@ fn demo_writes_one_png_per_lens() {
         assert!(image.pixels().any(|p| p != first), "{name} is one colour");
     }
     std::fs::remove_dir_all(dir).unwrap();
+}
+
+/// Adapter selection errors say what exists or what to install, and exit non-zero.
+#[test]
+fn adapter_errors_are_clear() {
+    // A backend this platform lacks has no adapter: the message says what to install.
+    let absent = if cfg!(target_vendor = "apple") {
+        "dx12"
+    } else {
+        "metal"
+    };
+    let cases = [
+        (
+            ("WGPU_ADAPTER_NAME", "no-such-gpu"),
+            "matches no adapter; available:",
+        ),
+        (
+            ("WGPU_BACKEND", absent),
+            "apt-get install mesa-vulkan-drivers",
+        ),
+    ];
+    for (env, needle) in cases {
+        let output = fisheye_with_env(&["info"], "", &[env]);
+        let stderr = String::from_utf8_lossy(&output.stderr);
+        assert!(!output.status.success(), "{env:?} should fail");
+        assert!(stderr.contains(needle), "{env:?}: {stderr:?}");
+    }
 }

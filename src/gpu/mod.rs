@@ -32,15 +32,17 @@ pub struct GpuContext {
     lost: Arc<Mutex<Option<String>>>,
 }
 
-/// Ranks device types: hardware first, software (lavapipe) last.
-fn preference(kind: wgpu::DeviceType) -> u8 {
-    match kind {
+/// Ranks adapters: hardware first, software (lavapipe) last; among equals, GL (which lacks
+/// ray query and multiview) after the native APIs.
+fn preference(info: &wgpu::AdapterInfo) -> (u8, bool) {
+    let kind = match info.device_type {
         wgpu::DeviceType::DiscreteGpu => 0,
         wgpu::DeviceType::IntegratedGpu => 1,
         wgpu::DeviceType::VirtualGpu => 2,
         wgpu::DeviceType::Other => 3,
         wgpu::DeviceType::Cpu => 4,
-    }
+    };
+    (kind, info.backend == wgpu::Backend::Gl)
 }
 
 fn describe(info: &wgpu::AdapterInfo) -> String {
@@ -83,7 +85,7 @@ impl GpuContext {
                 }
             }
             Err(_) => {
-                adapters.sort_by_key(|a| preference(a.get_info().device_type));
+                adapters.sort_by_key(|a| preference(&a.get_info()));
                 adapters.swap_remove(0)
             }
         };
