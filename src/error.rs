@@ -93,6 +93,9 @@ pub enum Error {
     /// The device was lost (driver reset, GPU removed, or an earlier fatal error).
     #[error("the GPU device was lost: {0}")]
     DeviceLost(String),
+    /// A scene that cannot be rendered (with what is wrong).
+    #[error("scene: {0}")]
+    Scene(String),
     /// A bad lens or image size.
     #[error(transparent)]
     Lens(#[from] LensError),

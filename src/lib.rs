@@ -18,12 +18,15 @@
 //! # Ok(()) }
 //! ```
 
+pub mod bvh;
 pub mod demo;
 mod error;
 pub mod gpu;
 pub mod lens;
 pub mod precision;
+pub mod scene;
 pub mod shader;
+pub mod trace;
 
 pub use error::{Error, LensError, Result};
 

@@ -6,12 +6,15 @@ use std::time::Instant;
 
 use anyhow::{Context, Result, bail};
 use clap::{Parser, Subcommand, ValueEnum};
+use fisheye_rt::bvh::BvhQuality;
 use fisheye_rt::demo::{LensDemo, save_png};
 use fisheye_rt::gpu::{GpuContext, Queries};
 use fisheye_rt::lens::gpu::{DirectionSource, LensPoints};
 use fisheye_rt::lens::{
     DirectionFormula, ImageSize, LensCamera, LensModel, PRESET_FOV_DEGREES, PRESETS, parse_spec,
 };
+use fisheye_rt::scene::{Scene, builtin};
+use fisheye_rt::trace::{GpuScene, RenderOptions, TracePass};
 use glam::{DVec2, DVec3};
 
 #[derive(Parser)]
@@ -27,6 +30,33 @@ struct Cli {
 
 #[derive(Subcommand)]
 enum Command {
+    /// Render a scene through a lens by ray tracing; with no arguments, the built-in default
+    /// scene through a 180° fisheye to fisheye.png.
+    Render {
+        /// The scene: `builtin:NAME` (see `fisheye scenes`).
+        #[arg(default_value = "builtin:default")]
+        scene: String,
+        /// Lens spec (see `fisheye lens list`).
+        #[arg(long, default_value = "canon-8-15mm@8mm")]
+        lens: String,
+        /// Image size in pixels, WIDTHxHEIGHT.
+        #[arg(long, default_value = "1024x768")]
+        size: ImageSize,
+        /// Deepest reflection/refraction bounce.
+        #[arg(long, default_value_t = 5)]
+        max_depth: u32,
+        /// BVH build preset.
+        #[arg(long, value_enum, default_value = "fast")]
+        bvh: Quality,
+        /// Primary ray directions: evaluated per pixel, or read from a table made once.
+        #[arg(long, value_enum, default_value = "computed")]
+        directions: Directions,
+        /// The colour image (PNG; alpha is the validity mask).
+        #[arg(long, short, default_value = "fisheye.png")]
+        out: PathBuf,
+    },
+    /// List the built-in scenes.
+    Scenes,
     /// Show the GPU adapter, its optional features and limits, and measure the precision of
     /// WGSL's trigonometric builtins against this project's replacements on it.
     Info,
@@ -108,8 +138,66 @@ fn main() {
     }
 }
 
+#[derive(Clone, Copy, ValueEnum)]
+enum Quality {
+    Fastest,
+    VeryFast,
+    Fast,
+    Medium,
+    Slow,
+}
+
+impl From<Quality> for BvhQuality {
+    fn from(q: Quality) -> Self {
+        match q {
+            Quality::Fastest => BvhQuality::Fastest,
+            Quality::VeryFast => BvhQuality::VeryFast,
+            Quality::Fast => BvhQuality::Fast,
+            Quality::Medium => BvhQuality::Medium,
+            Quality::Slow => BvhQuality::Slow,
+        }
+    }
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+enum Directions {
+    Computed,
+    Table,
+}
+
+impl From<Directions> for DirectionSource {
+    fn from(d: Directions) -> Self {
+        match d {
+            Directions::Computed => DirectionSource::Computed,
+            Directions::Table => DirectionSource::Table,
+        }
+    }
+}
+
 fn run(cli: Cli) -> Result<()> {
     match cli.command {
+        Command::Render {
+            scene,
+            lens,
+            size,
+            max_depth,
+            bvh,
+            directions,
+            out,
+        } => {
+            let options = RenderOptions {
+                max_depth,
+                bvh: bvh.into(),
+                directions: directions.into(),
+            };
+            render(&scene, &lens, size, &options, &out)
+        }
+        Command::Scenes => {
+            for (name, what) in builtin::SCENES {
+                println!("builtin:{name:<14} {what}");
+            }
+            Ok(())
+        }
         Command::Info => info(),
         Command::Lens { command } => match command {
             LensCommand::List => {
@@ -121,6 +209,78 @@ fn run(cli: Cli) -> Result<()> {
             LensCommand::Demo { lens, size, out } => demo(lens, size, out),
         },
     }
+}
+
+fn load_scene(spec: &str) -> Result<Scene> {
+    let Some(name) = spec.strip_prefix("builtin:") else {
+        bail!("scene {spec:?}: only built-in scenes (`builtin:NAME`) are supported yet");
+    };
+    builtin::scene(name).with_context(|| {
+        let names: Vec<&str> = builtin::SCENES.iter().map(|(n, _)| *n).collect();
+        format!("no built-in scene {name:?}; there are {}", names.join(", "))
+    })
+}
+
+fn render(
+    scene_spec: &str,
+    lens_spec: &str,
+    size: ImageSize,
+    options: &RenderOptions,
+    out: &std::path::Path,
+) -> Result<()> {
+    let started = Instant::now();
+    let camera = LensCamera::new(parse_spec(lens_spec)?, size);
+    let scene = load_scene(scene_spec)?;
+    let ctx = GpuContext::new()?;
+    println!("adapter: {}", ctx.adapter_name());
+    let gpu_scene = GpuScene::new(&ctx, &scene, options)?;
+    println!(
+        "scene: {scene_spec}, {} triangles; BVH ({}) {} nodes, depth {}, built in {:.1} ms",
+        scene.len(),
+        options.bvh.name(),
+        gpu_scene.bvh_nodes,
+        gpu_scene.bvh_depth,
+        gpu_scene.bvh_build_time.as_secs_f64() * 1e3
+    );
+    println!(
+        "lens: {} at {size}; compiling the trace kernel...",
+        camera.lens
+    );
+    let pass = TracePass::new(&ctx, &camera, &gpu_scene, options.directions)?;
+    let queries = Queries::new(&ctx, 1);
+    ctx.checked("tracing", || {
+        let mut encoder = ctx.device.create_command_encoder(&Default::default());
+        pass.encode(
+            &mut encoder,
+            &gpu_scene,
+            queries.as_ref().map(|q| q.writes(0)),
+        );
+        if let Some(q) = &queries {
+            q.resolve(&mut encoder);
+        }
+        ctx.queue.submit([encoder.finish()]);
+    })?;
+    let output = pass.read(&ctx)?;
+    let (rays, hits) = output.counts();
+    match &queries {
+        Some(q) => {
+            let ms = q.read_ns(&ctx)?[0] * 1e-6;
+            println!(
+                "trace: {ms:.1} ms on the GPU, {rays} primary rays ({hits} hit), {:.2} M primary rays/s",
+                rays as f64 / ms * 1e-3
+            );
+        }
+        None => {
+            println!("trace: {rays} primary rays ({hits} hit); no GPU timestamps on this adapter")
+        }
+    }
+    save_png(&output.to_image(), out)?;
+    println!(
+        "wrote {} ({:.1} s in all)",
+        out.display(),
+        started.elapsed().as_secs_f64()
+    );
+    Ok(())
 }
 
 fn info() -> Result<()> {

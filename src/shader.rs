@@ -7,10 +7,15 @@ use std::fmt::Write;
 
 use crate::lens::DirectionFormula;
 use crate::lens::gpu::{DirectionSource, LensKind};
+use crate::scene::Surface;
+use crate::trace;
 
 /// Every WGSL file of the project, by name (its file stem under `wgsl/`).
-pub const FILES: [(&str, &str); 6] = [
+pub const FILES: [(&str, &str); 9] = [
     ("math", include_str!("../wgsl/math.wgsl")),
+    ("bvh", include_str!("../wgsl/bvh.wgsl")),
+    ("shade", include_str!("../wgsl/shade.wgsl")),
+    ("trace", include_str!("../wgsl/trace.wgsl")),
     ("lens", include_str!("../wgsl/lens.wgsl")),
     ("lens_rays", include_str!("../wgsl/lens_rays.wgsl")),
     ("lens_points", include_str!("../wgsl/lens_points.wgsl")),
@@ -37,6 +42,15 @@ pub fn constants() -> Vec<(String, u32)> {
     for source in [DirectionSource::Computed, DirectionSource::Table] {
         out.push((source.const_name(), source as u32));
     }
+    out.push(("TRAVERSAL_STACK".into(), crate::bvh::TRAVERSAL_STACK));
+    out.push(("MAX_DEPTH_LIMIT".into(), trace::MAX_DEPTH_LIMIT));
+    out.push(("NO_TEXTURE".into(), trace::NO_TEXTURE));
+    out.push(("NO_HIT".into(), trace::NO_HIT));
+    for surface in [Surface::Diffuse, Surface::Mirror, Surface::Glass] {
+        let name = format!("SURFACE_{:?}", surface).to_uppercase();
+        out.push((name, trace::surface_id(surface)));
+    }
+    out.extend(trace::LIGHT_KINDS.iter().map(|(n, v)| (n.to_string(), *v)));
     out
 }
 
@@ -90,6 +104,31 @@ pub fn module(device: &wgpu::Device, entry: &str) -> wgpu::ShaderModule {
         label: Some(&format!("fisheye.{entry}")),
         source: wgpu::ShaderSource::Wgsl(compose(entry).into()),
     })
+}
+
+/// Checks that the WGSL struct `name` of the module `file` has the given size and, in order,
+/// the given members at the given byte offsets (naga's layout): Rust structs that mirror WGSL
+/// ones call this with their `size_of` and `offset_of!`s.
+#[cfg(test)]
+pub(crate) fn assert_wgsl_layout(file: &str, name: &str, size: usize, fields: &[(&str, usize)]) {
+    let source = compose(file);
+    let module = naga::front::wgsl::parse_str(&source).unwrap();
+    let mut layouter = naga::proc::Layouter::default();
+    layouter.update(module.to_ctx()).unwrap();
+    let (handle, ty) = module
+        .types
+        .iter()
+        .find(|(_, t)| t.name.as_deref() == Some(name))
+        .unwrap_or_else(|| panic!("no struct {name} in {file}"));
+    let naga::TypeInner::Struct { members, .. } = &ty.inner else {
+        panic!("{name} is not a struct");
+    };
+    assert_eq!(layouter[handle].size as usize, size, "size of {name}");
+    let wgsl: Vec<(&str, usize)> = members
+        .iter()
+        .map(|m| (m.name.as_deref().unwrap_or(""), m.offset as usize))
+        .collect();
+    assert_eq!(wgsl, fields, "members of {name}");
 }
 
 #[cfg(test)]

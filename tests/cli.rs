@@ -232,3 +232,33 @@ fn adapter_errors_are_clear() {
         assert!(stderr.contains(needle), "{env:?}: {stderr:?}");
     }
 }
+
+/// `fisheye render` writes the colour image with the mask in alpha, and names what it did.
+#[test]
+fn render_writes_a_masked_png_and_reports() {
+    let path = std::env::temp_dir().join(format!("fisheye-render-{}.png", std::process::id()));
+    let out = path.to_str().unwrap();
+    let args = ["render", "builtin:default", "--size", "96x64", "--out", out];
+    let text = stdout(&fisheye(&args, ""));
+    for needle in ["adapter:", "triangles", "primary rays", "wrote"] {
+        assert!(text.contains(needle), "{needle} missing from:\n{text}");
+    }
+    let image = image::open(&path).unwrap().to_rgba8();
+    assert_eq!(image.dimensions(), (96, 64));
+    // The default lens is a 180° circle of radius 0.66 half-widths: corners masked, centre lit.
+    assert_eq!(image.get_pixel(0, 0)[3], 0);
+    let centre = image.get_pixel(48, 32);
+    assert_eq!(centre[3], 255);
+    assert!(
+        centre[0] > 0 || centre[1] > 0 || centre[2] > 0,
+        "the centre is black"
+    );
+    std::fs::remove_file(path).unwrap();
+
+    let output = fisheye(&["render", "builtin:nope"], "");
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert!(
+        !output.status.success() && stderr.contains("no built-in scene \"nope\""),
+        "{stderr}"
+    );
+}

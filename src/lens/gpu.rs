@@ -387,42 +387,27 @@ impl LensPoints {
 
 #[cfg(test)]
 mod tests {
+    use std::mem::{offset_of, size_of};
+
     use super::*;
 
     /// `LensParams` in Rust and WGSL have the same size and field offsets (naga's layout).
     #[test]
     fn lens_params_layout_matches_wgsl() {
-        let source = shader::compose("lens");
-        let module = naga::front::wgsl::parse_str(&source).unwrap();
-        let mut layouter = naga::proc::Layouter::default();
-        layouter.update(module.to_ctx()).unwrap();
-        let (handle, ty) = module
-            .types
-            .iter()
-            .find(|(_, t)| t.name.as_deref() == Some("LensParams"))
-            .expect("LensParams in wgsl/lens.wgsl");
-        let naga::TypeInner::Struct { members, span } = &ty.inner else {
-            panic!("LensParams is not a struct");
-        };
-        assert_eq!(*span as usize, std::mem::size_of::<LensParams>());
-        assert_eq!(
-            layouter[handle].size as usize,
-            std::mem::size_of::<LensParams>()
+        shader::assert_wgsl_layout(
+            "lens",
+            "LensParams",
+            size_of::<LensParams>(),
+            &[
+                ("f", offset_of!(LensParams, f)),
+                ("k1_over_f", offset_of!(LensParams, k1_over_f)),
+                ("rate", offset_of!(LensParams, rate)),
+                ("r_max", offset_of!(LensParams, r_max)),
+                ("theta_max", offset_of!(LensParams, theta_max)),
+                ("width", offset_of!(LensParams, width)),
+                ("height", offset_of!(LensParams, height)),
+                ("mask_limit", offset_of!(LensParams, mask_limit)),
+            ],
         );
-        let rust = [
-            ("f", std::mem::offset_of!(LensParams, f)),
-            ("k1_over_f", std::mem::offset_of!(LensParams, k1_over_f)),
-            ("rate", std::mem::offset_of!(LensParams, rate)),
-            ("r_max", std::mem::offset_of!(LensParams, r_max)),
-            ("theta_max", std::mem::offset_of!(LensParams, theta_max)),
-            ("width", std::mem::offset_of!(LensParams, width)),
-            ("height", std::mem::offset_of!(LensParams, height)),
-            ("mask_limit", std::mem::offset_of!(LensParams, mask_limit)),
-        ];
-        assert_eq!(members.len(), rust.len());
-        for (member, (name, offset)) in members.iter().zip(rust) {
-            assert_eq!(member.name.as_deref(), Some(name));
-            assert_eq!(member.offset as usize, offset, "offset of {name}");
-        }
     }
 }

@@ -1,0 +1,174 @@
+//! The scene's BVH: obvhs builds a compressed 8-wide BVH (CWBVH, Ylitie, Karras and Laine
+//! 2017) on the CPU; we flatten it and the triangles, camera-relative in f32, into the storage
+//! buffers `wgsl/bvh.wgsl` traverses.
+
+use std::time::{Duration, Instant};
+
+use bytemuck::{Pod, Zeroable};
+use glam::{DVec3, Vec3A};
+use obvhs::BvhBuildParams;
+use obvhs::cwbvh::node::CwBvhNode;
+
+use crate::error::{Error, Result};
+use crate::scene::Scene;
+
+/// The traversal stack of `wgsl/bvh.wgsl` holds this many node groups; a BVH deeper than this
+/// is refused at build time rather than traversed wrongly.
+pub const TRAVERSAL_STACK: u32 = 32;
+
+/// obvhs's build presets, fastest build first.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum BvhQuality {
+    /// PLOC with the smallest search, one primitive per leaf.
+    Fastest,
+    /// PLOC, small search.
+    VeryFast,
+    /// PLOC with a little reinsertion.
+    #[default]
+    Fast,
+    /// More search and reinsertion.
+    Medium,
+    /// Spatial pre-splits and the widest search.
+    Slow,
+}
+
+impl BvhQuality {
+    /// Every preset, for benchmarks.
+    pub const ALL: [BvhQuality; 5] = [
+        Self::Fastest,
+        Self::VeryFast,
+        Self::Fast,
+        Self::Medium,
+        Self::Slow,
+    ];
+
+    /// The name on the command line.
+    pub fn name(&self) -> &'static str {
+        match self {
+            Self::Fastest => "fastest",
+            Self::VeryFast => "very-fast",
+            Self::Fast => "fast",
+            Self::Medium => "medium",
+            Self::Slow => "slow",
+        }
+    }
+
+    fn params(&self) -> BvhBuildParams {
+        match self {
+            Self::Fastest => BvhBuildParams::fastest_build(),
+            Self::VeryFast => BvhBuildParams::very_fast_build(),
+            Self::Fast => BvhBuildParams::fast_build(),
+            Self::Medium => BvhBuildParams::medium_build(),
+            Self::Slow => BvhBuildParams::slow_build(),
+        }
+    }
+}
+
+/// One triangle as `wgsl/bvh.wgsl` reads it: 48 bytes, three `vec4<f32>` whose `w` carry the
+/// scene triangle index and the material index (as bits).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, PartialEq, Pod, Zeroable)]
+pub struct GpuTriangle {
+    /// First corner, camera-relative.
+    pub v0: [f32; 3],
+    /// Index of the triangle in [`Scene::triangles`].
+    pub triangle: u32,
+    /// Second corner.
+    pub v1: [f32; 3],
+    /// Index into [`Scene::materials`].
+    pub material: u32,
+    /// Third corner.
+    pub v2: [f32; 3],
+    /// Padding to 16-byte alignment.
+    pub pad: u32,
+}
+
+const _: () = assert!(std::mem::size_of::<GpuTriangle>() == 48);
+const _: () = assert!(std::mem::size_of::<CwBvhNode>() == 80);
+
+/// A built BVH with its triangles in leaf order, ready to upload.
+pub struct SceneBvh {
+    /// CWBVH nodes (80 bytes each; WGSL reads each as five `vec4<u32>`). Never empty: an empty
+    /// scene gets one node with no children, which every ray misses.
+    pub nodes: Vec<CwBvhNode>,
+    /// Triangles in the order leaves reference them (a pre-split triangle appears more than
+    /// once). Never empty (a zero triangle stands in for none).
+    pub triangles: Vec<GpuTriangle>,
+    /// The world position subtracted from every vertex (the camera position).
+    pub origin: DVec3,
+    /// Deepest node (root = 1).
+    pub depth: u32,
+    /// Time obvhs spent building.
+    pub build_time: Duration,
+}
+
+impl SceneBvh {
+    /// Builds the BVH of `scene` relative to `origin`.
+    pub fn build(scene: &Scene, origin: DVec3, quality: BvhQuality) -> Result<Self> {
+        let rounded: Vec<[Vec3A; 3]> = scene
+            .triangles
+            .iter()
+            .map(|t| t.map(|p| (p - origin).as_vec3().into()))
+            .collect();
+        if rounded.is_empty() {
+            return Ok(Self {
+                nodes: vec![CwBvhNode::default()],
+                triangles: vec![GpuTriangle::zeroed()],
+                origin,
+                depth: 1,
+                build_time: Duration::ZERO,
+            });
+        }
+        let tris: Vec<obvhs::triangle::Triangle> = rounded
+            .iter()
+            .map(|t| obvhs::triangle::Triangle {
+                v0: t[0],
+                v1: t[1],
+                v2: t[2],
+            })
+            .collect();
+        let started = Instant::now();
+        let mut core = Duration::ZERO;
+        let cwbvh =
+            obvhs::cwbvh::builder::build_cwbvh_from_tris(&tris, quality.params(), &mut core);
+        let build_time = started.elapsed();
+        let triangles = cwbvh
+            .primitive_indices
+            .iter()
+            .map(|&i| {
+                let t = &rounded[i as usize];
+                GpuTriangle {
+                    v0: t[0].into(),
+                    triangle: i,
+                    v1: t[1].into(),
+                    material: scene.material_of[i as usize],
+                    v2: t[2].into(),
+                    pad: 0,
+                }
+            })
+            .collect();
+        let depth = node_depth(&cwbvh.nodes, 0);
+        if depth > TRAVERSAL_STACK {
+            return Err(Error::Scene(format!(
+                "the BVH is {depth} levels deep; the GPU traversal stack holds {TRAVERSAL_STACK}"
+            )));
+        }
+        Ok(Self {
+            nodes: cwbvh.nodes,
+            triangles,
+            origin,
+            depth,
+            build_time,
+        })
+    }
+}
+
+fn node_depth(nodes: &[CwBvhNode], index: usize) -> u32 {
+    let node = &nodes[index];
+    (0..8)
+        .filter(|&c| !node.is_leaf(c))
+        .map(|c| node_depth(nodes, node.child_node_index(c) as usize))
+        .max()
+        .unwrap_or(0)
+        + 1
+}

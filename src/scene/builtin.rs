@@ -1,0 +1,324 @@
+//! Built-in procedural scenes that need no files.
+
+use glam::{DVec3, Vec2, Vec3};
+
+use super::mesh::checker;
+use super::{Camera, Light, Material, MeshBuilder, Scene};
+
+/// The names `builtin:NAME` accepts, with what each shows.
+pub const SCENES: [(&str, &str); 4] = [
+    (
+        "default",
+        "a room with checker floor and grid walls, a mirror and a glass sphere, shadows and many small objects",
+    ),
+    (
+        "grid",
+        "a calibration grid on the inside of a cube around the camera, for lens validation",
+    ),
+    (
+        "many-small",
+        "4,000 small boxes on a plane under the sun (ray tracing's good case)",
+    ),
+    (
+        "few-detailed",
+        "three tori of 200,000 triangles each (ray tracing's hard case)",
+    ),
+];
+
+/// The built-in scene called `name`, or `None`.
+pub fn scene(name: &str) -> Option<Scene> {
+    match name {
+        "default" => Some(room()),
+        "grid" => Some(grid()),
+        "many-small" => Some(many_small()),
+        "few-detailed" => Some(few_detailed()),
+        _ => None,
+    }
+}
+
+/// A small deterministic hash (SplitMix64's finaliser) for placing objects.
+fn hash(mut x: u64) -> u64 {
+    x = x.wrapping_add(0x9e37_79b9_7f4a_7c15);
+    x = (x ^ (x >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+    x = (x ^ (x >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+    x ^ (x >> 31)
+}
+
+/// A uniform number in [0, 1) from `(seed, k)`.
+fn unit(seed: u64, k: u64) -> f64 {
+    (hash(seed.wrapping_mul(0x1000_0000_01b3) ^ k) >> 11) as f64 / (1u64 << 53) as f64
+}
+
+fn colour(seed: u64) -> Vec3 {
+    Vec3::new(
+        0.2 + 0.7 * unit(seed, 1) as f32,
+        0.2 + 0.7 * unit(seed, 2) as f32,
+        0.2 + 0.7 * unit(seed, 3) as f32,
+    )
+}
+
+fn room() -> Scene {
+    let mut b = MeshBuilder::new();
+    let floor_tex = b.texture(checker(
+        "checker",
+        256,
+        8,
+        [200, 200, 190],
+        [60, 60, 70],
+        [30, 30, 30],
+    ));
+    let wall_tex = b.texture(checker(
+        "grid",
+        256,
+        4,
+        [225, 215, 190],
+        [215, 205, 180],
+        [80, 80, 90],
+    ));
+    let floor = b.material(Material {
+        diffuse_texture: Some(floor_tex),
+        ..Material::diffuse("floor", Vec3::ONE)
+    });
+    let wall = b.material(Material {
+        diffuse_texture: Some(wall_tex),
+        ..Material::diffuse("wall", Vec3::ONE)
+    });
+    let ceiling = b.material(Material::diffuse("ceiling", Vec3::splat(0.8)));
+    let lamp = b.material(Material {
+        emission: Vec3::new(6.0, 5.6, 5.0),
+        ..Material::diffuse("lamp", Vec3::ZERO)
+    });
+    let mirror = b.material(Material::mirror("mirror", Vec3::splat(0.9)));
+    let glass = b.material(Material::glass("glass", 1.5));
+    let shiny = b.material(Material {
+        specular: Vec3::splat(0.5),
+        shininess: 60.0,
+        ..Material::diffuse("red", Vec3::new(0.75, 0.15, 0.12))
+    });
+
+    let (w, h) = (10.0, 4.0);
+    let lo = DVec3::new(-w / 2.0, 0.0, -w / 2.0);
+    // Inward-facing walls, textured with one cell per metre-ish.
+    let tile = Vec2::splat(w as f32 / 2.5);
+    b.quad(lo, DVec3::Z * w, DVec3::X * w, tile, floor);
+    b.quad(
+        lo + DVec3::Y * h,
+        DVec3::X * w,
+        DVec3::Z * w,
+        Vec2::ONE,
+        ceiling,
+    );
+    let wall_uv = Vec2::new(w as f32 / 2.5, h as f32 / 2.5);
+    b.quad(lo, DVec3::X * w, DVec3::Y * h, wall_uv, wall); // back (-z)
+    b.quad(
+        lo + DVec3::new(w, 0.0, w),
+        -DVec3::X * w,
+        DVec3::Y * h,
+        wall_uv,
+        wall,
+    ); // front
+    b.quad(
+        lo + DVec3::Z * w,
+        -DVec3::Z * w,
+        DVec3::Y * h,
+        wall_uv,
+        wall,
+    ); // left
+    b.quad(lo + DVec3::X * w, DVec3::Z * w, DVec3::Y * h, wall_uv, wall); // right
+    // A glowing panel under the ceiling.
+    b.quad(
+        DVec3::new(-1.0, h - 0.01, -1.0),
+        DVec3::X * 2.0,
+        DVec3::Z * 2.0,
+        Vec2::ONE,
+        lamp,
+    );
+
+    b.sphere(DVec3::new(-1.6, 1.0, -2.2), 1.0, 64, 32, false, mirror);
+    b.sphere(DVec3::new(1.5, 0.8, -1.4), 0.8, 64, 32, false, glass);
+    b.cuboid(
+        DVec3::new(2.6, 0.0, -3.8),
+        DVec3::new(3.6, 1.4, -2.8),
+        shiny,
+    );
+
+    // Many small objects: a ring of little boxes and spheres around the room.
+    let small: Vec<u32> = (0..8)
+        .map(|k| b.material(Material::diffuse("small", colour(k))))
+        .collect();
+    for k in 0..240u64 {
+        let angle = std::f64::consts::TAU * unit(k, 10);
+        let radius = 2.6 + 1.8 * unit(k, 11);
+        let centre = DVec3::new(radius * angle.cos(), 0.0, radius * angle.sin());
+        let size = 0.06 + 0.12 * unit(k, 12);
+        let material = small[(k % 8) as usize];
+        if k % 3 == 0 {
+            b.sphere(centre + DVec3::Y * size, size, 12, 6, false, material);
+        } else {
+            let half = DVec3::new(size, 0.0, size);
+            b.cuboid(
+                centre - half,
+                centre + half + DVec3::Y * 2.0 * size,
+                material,
+            );
+        }
+    }
+
+    let lights = vec![
+        Light::Point {
+            position: DVec3::new(0.0, 3.2, 0.5),
+            intensity: Vec3::new(7.0, 6.6, 6.0),
+        },
+        Light::Point {
+            position: DVec3::new(-3.5, 2.5, 3.5),
+            intensity: Vec3::new(2.0, 2.2, 3.0),
+        },
+    ];
+    let camera = Camera {
+        position: DVec3::new(0.0, 1.5, 2.5),
+        look_at: DVec3::new(0.0, 1.2, -3.0),
+        up: DVec3::Y,
+    };
+    b.finish(lights, Vec3::new(0.6, 0.7, 0.9), Vec3::splat(0.06), camera)
+}
+
+fn grid() -> Scene {
+    let mut b = MeshBuilder::new();
+    let tex = b.texture(checker(
+        "calibration",
+        512,
+        16,
+        [245, 245, 245],
+        [235, 235, 235],
+        [10, 10, 10],
+    ));
+    let wall = b.material(Material {
+        diffuse_texture: Some(tex),
+        ..Material::diffuse("grid", Vec3::ONE)
+    });
+    let s = 5.0;
+    let lo = DVec3::splat(-s);
+    let e = 2.0 * s;
+    let one = Vec2::ONE;
+    // The six inner faces of a cube centred on the camera.
+    b.quad(lo, DVec3::X * e, DVec3::Y * e, one, wall);
+    b.quad(
+        lo + DVec3::new(e, 0.0, e),
+        -DVec3::X * e,
+        DVec3::Y * e,
+        one,
+        wall,
+    );
+    b.quad(lo + DVec3::Z * e, -DVec3::Z * e, DVec3::Y * e, one, wall);
+    b.quad(lo + DVec3::X * e, DVec3::Z * e, DVec3::Y * e, one, wall);
+    b.quad(lo, DVec3::Z * e, DVec3::X * e, one, wall);
+    b.quad(lo + DVec3::Y * e, DVec3::X * e, DVec3::Z * e, one, wall);
+    let camera = Camera {
+        position: DVec3::ZERO,
+        look_at: -DVec3::Z,
+        up: DVec3::Y,
+    };
+    // Lit evenly by ambient light alone: the grid's contrast is all in its texture.
+    b.finish(Vec::new(), Vec3::ZERO, Vec3::ONE, camera)
+}
+
+fn outdoor_lights() -> Vec<Light> {
+    vec![Light::Directional {
+        direction: DVec3::new(-0.4, -1.0, -0.3).normalize(),
+        irradiance: Vec3::new(2.6, 2.4, 2.1),
+    }]
+}
+
+fn many_small() -> Scene {
+    let mut b = MeshBuilder::new();
+    let ground = b.material(Material::diffuse("ground", Vec3::new(0.45, 0.5, 0.4)));
+    b.quad(
+        DVec3::new(-30.0, 0.0, -30.0),
+        DVec3::Z * 60.0,
+        DVec3::X * 60.0,
+        Vec2::ONE,
+        ground,
+    );
+    let palette: Vec<u32> = (0..16)
+        .map(|k| b.material(Material::diffuse("box", colour(100 + k))))
+        .collect();
+    for k in 0..4000u64 {
+        let centre = DVec3::new(50.0 * unit(k, 1) - 25.0, 0.0, 50.0 * unit(k, 2) - 25.0);
+        let half = DVec3::new(0.1 + 0.2 * unit(k, 3), 0.0, 0.1 + 0.2 * unit(k, 4));
+        let height = 0.2 + 1.2 * unit(k, 5);
+        b.cuboid(
+            centre - half,
+            centre + half + DVec3::Y * height,
+            palette[(k % 16) as usize],
+        );
+    }
+    let camera = Camera {
+        position: DVec3::new(0.0, 1.7, 0.0),
+        look_at: DVec3::new(0.0, 1.2, -10.0),
+        up: DVec3::Y,
+    };
+    b.finish(
+        outdoor_lights(),
+        Vec3::new(0.55, 0.7, 0.95),
+        Vec3::splat(0.15),
+        camera,
+    )
+}
+
+fn few_detailed() -> Scene {
+    let mut b = MeshBuilder::new();
+    let ground = b.material(Material::diffuse("ground", Vec3::new(0.5, 0.5, 0.45)));
+    b.quad(
+        DVec3::new(-20.0, 0.0, -20.0),
+        DVec3::Z * 40.0,
+        DVec3::X * 40.0,
+        Vec2::ONE,
+        ground,
+    );
+    for (k, x) in [-3.2, 0.0, 3.2].into_iter().enumerate() {
+        let m = b.material(Material {
+            specular: Vec3::splat(0.4),
+            shininess: 40.0,
+            ..Material::diffuse("torus", colour(200 + k as u64))
+        });
+        // 500 × 200 × 2 = 200,000 triangles each.
+        b.torus(DVec3::new(x, 1.0, -4.0), 1.1, 0.45, 500, 200, m);
+    }
+    let camera = Camera {
+        position: DVec3::new(0.0, 1.6, 1.0),
+        look_at: DVec3::new(0.0, 1.0, -4.0),
+        up: DVec3::Y,
+    };
+    b.finish(
+        outdoor_lights(),
+        Vec3::new(0.55, 0.7, 0.95),
+        Vec3::splat(0.15),
+        camera,
+    )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn every_builtin_scene_builds_and_is_sized_as_documented() {
+        for (name, _) in SCENES {
+            let s = scene(name).unwrap();
+            assert!(!s.is_empty(), "{name}");
+            assert_eq!(s.material_of.len(), s.len());
+            assert!(
+                s.material_of
+                    .iter()
+                    .all(|&m| (m as usize) < s.materials.len())
+            );
+            let (lo, hi) = s.bounds().unwrap();
+            assert!(lo.is_finite() && hi.is_finite());
+        }
+        assert!(scene("many-small").unwrap().len() >= 4000 * 12);
+        assert!(scene("few-detailed").unwrap().len() >= 3 * 200_000);
+        let room = scene("default").unwrap().features();
+        assert!(room.mirrors && room.glass && room.textures && room.smooth_normals);
+        assert!(scene("no-such").is_none());
+    }
+}

@@ -1,0 +1,236 @@
+//! Assembles scenes from triangles and simple shapes (quads, boxes, spheres, tori).
+
+use std::f64::consts::{PI, TAU};
+
+use glam::{DVec3, Vec2, Vec3};
+
+use super::{Camera, Light, Material, Scene, Texture, face_normal};
+
+/// Collects triangles with their materials, normals and UVs, then makes a [`Scene`].
+#[derive(Default)]
+pub struct MeshBuilder {
+    triangles: Vec<[DVec3; 3]>,
+    normals: Vec<Option<[Vec3; 3]>>,
+    uvs: Vec<Option<[Vec2; 3]>>,
+    material_of: Vec<u32>,
+    materials: Vec<Material>,
+    textures: Vec<Texture>,
+}
+
+impl MeshBuilder {
+    /// An empty builder.
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    /// Adds a material and returns its index.
+    pub fn material(&mut self, material: Material) -> u32 {
+        self.materials.push(material);
+        self.materials.len() as u32 - 1
+    }
+
+    /// Adds a texture and returns its index.
+    pub fn texture(&mut self, texture: Texture) -> u32 {
+        self.textures.push(texture);
+        self.textures.len() as u32 - 1
+    }
+
+    /// Number of triangles so far.
+    pub fn len(&self) -> usize {
+        self.triangles.len()
+    }
+
+    /// Whether no triangle was added yet.
+    pub fn is_empty(&self) -> bool {
+        self.triangles.is_empty()
+    }
+
+    /// Adds one triangle.
+    pub fn triangle(
+        &mut self,
+        corners: [DVec3; 3],
+        normals: Option<[Vec3; 3]>,
+        uvs: Option<[Vec2; 3]>,
+        material: u32,
+    ) {
+        self.triangles.push(corners);
+        self.normals.push(normals);
+        self.uvs.push(uvs);
+        self.material_of.push(material);
+    }
+
+    /// A parallelogram `corner + s·u + t·v`, s, t ∈ [0, 1], facing `u × v`, with UVs running
+    /// from 0 to `uv_scale`.
+    pub fn quad(&mut self, corner: DVec3, u: DVec3, v: DVec3, uv_scale: Vec2, material: u32) {
+        let p = [corner, corner + u, corner + u + v, corner + v];
+        let t = [
+            Vec2::ZERO,
+            Vec2::new(uv_scale.x, 0.0),
+            uv_scale,
+            Vec2::new(0.0, uv_scale.y),
+        ];
+        self.triangle([p[0], p[1], p[2]], None, Some([t[0], t[1], t[2]]), material);
+        self.triangle([p[0], p[2], p[3]], None, Some([t[0], t[2], t[3]]), material);
+    }
+
+    /// An axis-aligned box with outward faces.
+    pub fn cuboid(&mut self, lo: DVec3, hi: DVec3, material: u32) {
+        let d = hi - lo;
+        let (x, y, z) = (DVec3::X * d.x, DVec3::Y * d.y, DVec3::Z * d.z);
+        let one = Vec2::ONE;
+        self.quad(lo, y, x, one, material); // -z
+        self.quad(lo + z, x, y, one, material); // +z
+        self.quad(lo, z, y, one, material); // -x
+        self.quad(lo + x, y, z, one, material); // +x
+        self.quad(lo, x, z, one, material); // -y
+        self.quad(lo + y, z, x, one, material); // +y
+    }
+
+    /// A closed UV sphere with smooth normals (`inward` flips them, for a camera inside).
+    pub fn sphere(
+        &mut self,
+        centre: DVec3,
+        radius: f64,
+        segments: u32,
+        rings: u32,
+        inward: bool,
+        material: u32,
+    ) {
+        let point = |i: u32, j: u32| {
+            let (phi, theta) = (
+                TAU * f64::from(i) / f64::from(segments),
+                PI * f64::from(j) / f64::from(rings),
+            );
+            // Poles are exact so that the fans there close.
+            let n = match j {
+                0 => DVec3::Y,
+                _ if j == rings => -DVec3::Y,
+                _ => DVec3::new(
+                    theta.sin() * phi.cos(),
+                    theta.cos(),
+                    -theta.sin() * phi.sin(),
+                ),
+            };
+            (centre + n * radius, if inward { -n } else { n })
+        };
+        self.grid(segments, rings, inward, material, point);
+    }
+
+    /// A closed torus around the y axis with smooth normals.
+    pub fn torus(
+        &mut self,
+        centre: DVec3,
+        major: f64,
+        minor: f64,
+        segments: u32,
+        sides: u32,
+        material: u32,
+    ) {
+        let point = |i: u32, j: u32| {
+            let (phi, psi) = (
+                TAU * f64::from(i) / f64::from(segments),
+                TAU * f64::from(j) / f64::from(sides),
+            );
+            let ring = DVec3::new(phi.cos(), 0.0, -phi.sin());
+            let n = ring * psi.cos() + DVec3::Y * psi.sin();
+            (centre + ring * major + n * minor, n)
+        };
+        self.grid(segments, sides, false, material, point);
+    }
+
+    /// Triangulates a (segments × rows) parametric grid closed in its first parameter.
+    /// Vertices are shared by index arithmetic, so neighbouring triangles meet exactly.
+    fn grid(
+        &mut self,
+        segments: u32,
+        rows: u32,
+        flip: bool,
+        material: u32,
+        point: impl Fn(u32, u32) -> (DVec3, DVec3),
+    ) {
+        let vertex = |i: u32, j: u32| point(i % segments, j);
+        for j in 0..rows {
+            for i in 0..segments {
+                let a = vertex(i, j);
+                let b = vertex(i + 1, j);
+                let c = vertex(i + 1, j + 1);
+                let d = vertex(i, j + 1);
+                for tri in [[a, d, c], [a, c, b]] {
+                    let mut tri = tri;
+                    if flip {
+                        tri.swap(1, 2);
+                    }
+                    let corners = tri.map(|(p, _)| p);
+                    // Skip the zero-area triangles a grid makes at poles.
+                    if face_normal(&corners) == DVec3::ZERO {
+                        continue;
+                    }
+                    let normals = tri.map(|(_, n)| n.as_vec3());
+                    self.triangle(corners, Some(normals), None, material);
+                }
+            }
+        }
+    }
+
+    /// The finished scene.
+    pub fn finish(self, lights: Vec<Light>, sky: Vec3, ambient: Vec3, camera: Camera) -> Scene {
+        let normals = self.normals.iter().any(Option::is_some).then(|| {
+            self.normals
+                .iter()
+                .zip(&self.triangles)
+                .map(|(n, t)| n.unwrap_or_else(|| [face_normal(t).as_vec3(); 3]))
+                .collect()
+        });
+        let uvs = self.uvs.iter().any(Option::is_some).then(|| {
+            self.uvs
+                .iter()
+                .map(|t| t.unwrap_or([Vec2::ZERO; 3]))
+                .collect()
+        });
+        Scene {
+            triangles: self.triangles,
+            normals,
+            uvs,
+            material_of: self.material_of,
+            materials: self.materials,
+            textures: self.textures,
+            lights,
+            sky,
+            ambient,
+            camera,
+        }
+    }
+}
+
+/// A procedural checker texture: `cells` × `cells` squares of two sRGB colours, with thin grid
+/// lines of a third, `size` texels square.
+pub fn checker(
+    name: &str,
+    size: u32,
+    cells: u32,
+    a: [u8; 3],
+    b: [u8; 3],
+    line: [u8; 3],
+) -> Texture {
+    let cell = size / cells;
+    let mut rgba = Vec::with_capacity((size * size * 4) as usize);
+    for y in 0..size {
+        for x in 0..size {
+            let on_line = x % cell == 0 || y % cell == 0;
+            let c = if on_line {
+                line
+            } else if (x / cell + y / cell).is_multiple_of(2) {
+                a
+            } else {
+                b
+            };
+            rgba.extend_from_slice(&[c[0], c[1], c[2], 255]);
+        }
+    }
+    Texture {
+        name: name.to_string(),
+        width: size,
+        height: size,
+        rgba,
+    }
+}

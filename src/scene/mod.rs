@@ -1,0 +1,225 @@
+//! Scenes: triangles in f64 world space, Whitted materials, lights, a sky and a camera pose.
+//!
+//! Positions stay in f64 until upload, where they are made relative to the camera and rounded
+//! to f32 once, so a scene far from the origin renders as it does at the origin.
+
+pub mod builtin;
+mod mesh;
+
+use glam::{DMat3, DVec3, Vec2, Vec3};
+
+pub use mesh::{MeshBuilder, checker};
+
+/// How a surface scatters light in the Whitted model.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Surface {
+    /// Lambert diffuse plus Phong highlights, lit by the lights with shadow rays.
+    Diffuse,
+    /// A perfect mirror tinted by `Ks` (MTL `illum` 3 and 5).
+    Mirror,
+    /// A dielectric with index `Ni`: Fresnel-weighted reflection and refraction, total internal
+    /// reflection, transmission tinted by `Tf` (MTL `illum` 4, 6 and 7).
+    Glass,
+}
+
+/// A material with the MTL fields a Whitted tracer uses.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Material {
+    /// The MTL name (for messages).
+    pub name: String,
+    /// How the surface scatters.
+    pub surface: Surface,
+    /// `Kd`, linear RGB.
+    pub diffuse: Vec3,
+    /// Index into [`Scene::textures`] of `map_Kd`, multiplied with `diffuse`.
+    pub diffuse_texture: Option<u32>,
+    /// `Ks`: Phong highlight colour, and the mirror's tint.
+    pub specular: Vec3,
+    /// `Ns`: Phong exponent.
+    pub shininess: f32,
+    /// `Ke`: emitted radiance.
+    pub emission: Vec3,
+    /// `Ni`: index of refraction.
+    pub ior: f32,
+    /// `Tf`: transmission filter of glass.
+    pub transmission: Vec3,
+}
+
+impl Material {
+    /// A grey diffuse material.
+    pub fn diffuse(name: &str, colour: Vec3) -> Self {
+        Self {
+            name: name.to_string(),
+            surface: Surface::Diffuse,
+            diffuse: colour,
+            diffuse_texture: None,
+            specular: Vec3::ZERO,
+            shininess: 1.0,
+            emission: Vec3::ZERO,
+            ior: 1.0,
+            transmission: Vec3::ONE,
+        }
+    }
+
+    /// A mirror tinted by `tint`.
+    pub fn mirror(name: &str, tint: Vec3) -> Self {
+        Self {
+            surface: Surface::Mirror,
+            diffuse: Vec3::ZERO,
+            specular: tint,
+            ..Self::diffuse(name, Vec3::ZERO)
+        }
+    }
+
+    /// Clear glass of index `ior`.
+    pub fn glass(name: &str, ior: f32) -> Self {
+        Self {
+            surface: Surface::Glass,
+            diffuse: Vec3::ZERO,
+            ior,
+            ..Self::diffuse(name, Vec3::ZERO)
+        }
+    }
+}
+
+/// An RGBA8 texture, sRGB-encoded as image files are.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Texture {
+    /// Where it came from (a path, or the name of a procedural texture).
+    pub name: String,
+    /// Width in texels.
+    pub width: u32,
+    /// Height in texels.
+    pub height: u32,
+    /// Row-major RGBA8, top row first.
+    pub rgba: Vec<u8>,
+}
+
+/// A light source. Emissive materials also light what they are seen from, but cast no shadow
+/// rays (Whitted's model has no area lights).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Light {
+    /// A point light: radiance falls off with the squared distance.
+    Point {
+        /// Position, world space.
+        position: DVec3,
+        /// Intensity (RGB, W/sr-like units: irradiance at distance 1).
+        intensity: Vec3,
+    },
+    /// A light at infinity (the sun).
+    Directional {
+        /// Direction the light travels, world space.
+        direction: DVec3,
+        /// Irradiance on a surface facing it.
+        irradiance: Vec3,
+    },
+}
+
+/// Where the camera is and where it looks. World space is y up.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Camera {
+    /// Eye position.
+    pub position: DVec3,
+    /// A point the optical axis passes through.
+    pub look_at: DVec3,
+    /// The world's up direction, used to level the camera.
+    pub up: DVec3,
+}
+
+impl Camera {
+    /// Camera-to-world rotation: its columns are the camera's x (right), y (down) and z
+    /// (forward) axes in world space, as the lens module's directions use them.
+    pub fn rotation(&self) -> DMat3 {
+        let forward = (self.look_at - self.position).normalize();
+        let mut right = forward.cross(self.up);
+        if right.length_squared() < 1e-24 {
+            // Looking along `up`: any level is as good as another.
+            right = forward.any_orthonormal_vector();
+        }
+        let right = right.normalize();
+        DMat3::from_cols(right, forward.cross(right), forward)
+    }
+}
+
+/// Everything the tracer renders.
+#[derive(Clone, Debug)]
+pub struct Scene {
+    /// The corners of every triangle, world space.
+    pub triangles: Vec<[DVec3; 3]>,
+    /// Per-triangle vertex normals, if any mesh had them (others get their face normal).
+    pub normals: Option<Vec<[Vec3; 3]>>,
+    /// Per-triangle texture coordinates, if any mesh had them (others get zeros).
+    pub uvs: Option<Vec<[Vec2; 3]>>,
+    /// Index into `materials` of each triangle.
+    pub material_of: Vec<u32>,
+    /// The materials.
+    pub materials: Vec<Material>,
+    /// Diffuse textures.
+    pub textures: Vec<Texture>,
+    /// The lights.
+    pub lights: Vec<Light>,
+    /// Radiance of rays that escape.
+    pub sky: Vec3,
+    /// Ambient light reaching every diffuse surface (Whitted's ambient term).
+    pub ambient: Vec3,
+    /// The camera pose.
+    pub camera: Camera,
+}
+
+impl Scene {
+    /// Number of triangles.
+    pub fn len(&self) -> usize {
+        self.triangles.len()
+    }
+
+    /// Whether the scene has no triangles.
+    pub fn is_empty(&self) -> bool {
+        self.triangles.is_empty()
+    }
+
+    /// The axis-aligned bounds of all triangles (`None` when empty).
+    pub fn bounds(&self) -> Option<(DVec3, DVec3)> {
+        let mut corners = self.triangles.iter().flatten();
+        let first = *corners.next()?;
+        Some(corners.fold((first, first), |(lo, hi), p| (lo.min(*p), hi.max(*p))))
+    }
+
+    /// Which features the scene uses, for specialising kernels.
+    pub fn features(&self) -> Features {
+        let used: Vec<&Material> = {
+            let mut seen = vec![false; self.materials.len()];
+            for &m in &self.material_of {
+                seen[m as usize] = true;
+            }
+            self.materials
+                .iter()
+                .zip(seen)
+                .filter_map(|(m, s)| s.then_some(m))
+                .collect()
+        };
+        Features {
+            mirrors: used.iter().any(|m| m.surface == Surface::Mirror),
+            glass: used.iter().any(|m| m.surface == Surface::Glass),
+            textures: self.uvs.is_some() && used.iter().any(|m| m.diffuse_texture.is_some()),
+            smooth_normals: self.normals.is_some(),
+        }
+    }
+}
+
+/// The optional shading features a scene uses; kernels compile only these.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Features {
+    /// Some surface is a mirror.
+    pub mirrors: bool,
+    /// Some surface is glass.
+    pub glass: bool,
+    /// Some surface has a diffuse texture (and the scene has UVs).
+    pub textures: bool,
+    /// Vertex normals are interpolated.
+    pub smooth_normals: bool,
+}
+
+/// The vertex normal of a triangle's face (not normalized when degenerate).
+pub fn face_normal(t: &[DVec3; 3]) -> DVec3 {
+    (t[1] - t[0]).cross(t[2] - t[0]).normalize_or_zero()
+}

@@ -1,0 +1,462 @@
+//! The f64 reference tracer, the ground truth for the GPU's.
+//!
+//! It sees exactly the data the GPU sees (camera-relative vertices, lights and camera axes
+//! rounded to f32 once, then promoted), shades with the same Whitted model, but computes in
+//! f64 and finds hits with its own binary BVH (median splits; independent of obvhs), itself
+//! tested against brute force. Rays come from the f64 lens reference.
+
+use glam::{DMat3, DVec2, DVec3, Vec3};
+
+use super::{MAX_DEPTH_LIMIT, NO_HIT, RenderOutput};
+use crate::lens::LensCamera;
+use crate::scene::{Features, Light, Scene, Surface, Texture};
+
+/// Rays whose weight falls below this are not traced (as in `wgsl/shade.wgsl`).
+const MIN_WEIGHT: f64 = 1e-3;
+
+/// A hit: distance, barycentric weights of corners 1 and 2, scene triangle.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Hit {
+    /// Distance along the (unit) ray.
+    pub t: f64,
+    /// Weight of corner 1.
+    pub u: f64,
+    /// Weight of corner 2.
+    pub v: f64,
+    /// Scene triangle index.
+    pub triangle: u32,
+}
+
+enum Node {
+    Leaf {
+        lo: DVec3,
+        hi: DVec3,
+        first: u32,
+        count: u32,
+    },
+    Inner {
+        lo: DVec3,
+        hi: DVec3,
+        left: u32,
+        right: u32,
+    },
+}
+
+/// The reference tracer for one scene.
+pub struct Reference<'a> {
+    scene: &'a Scene,
+    features: Features,
+    /// Camera-relative corners, f32-rounded then promoted.
+    corners: Vec<[DVec3; 3]>,
+    nodes: Vec<Node>,
+    order: Vec<u32>,
+    rotation: DMat3,
+    lights: Vec<(bool, DVec3, DVec3)>,
+    max_depth: u32,
+}
+
+fn round32(v: DVec3) -> DVec3 {
+    v.as_vec3().as_dvec3()
+}
+
+fn v3(v: Vec3) -> DVec3 {
+    v.as_dvec3()
+}
+
+impl<'a> Reference<'a> {
+    /// Prepares the reference for `scene`, relative to its camera as the GPU upload is.
+    pub fn new(scene: &'a Scene, max_depth: u32) -> Self {
+        assert!(max_depth <= MAX_DEPTH_LIMIT);
+        let origin = scene.camera.position;
+        let corners: Vec<[DVec3; 3]> = scene
+            .triangles
+            .iter()
+            .map(|t| t.map(|p| round32(p - origin)))
+            .collect();
+        let rotation = scene.camera.rotation();
+        let rotation = DMat3::from_cols(
+            round32(rotation.x_axis),
+            round32(rotation.y_axis),
+            round32(rotation.z_axis),
+        );
+        let lights = scene
+            .lights
+            .iter()
+            .map(|l| match *l {
+                Light::Point {
+                    position,
+                    intensity,
+                } => (true, round32(position - origin), v3(intensity)),
+                Light::Directional {
+                    direction,
+                    irradiance,
+                } => (false, round32(direction.normalize()), v3(irradiance)),
+            })
+            .collect();
+        let mut reference = Self {
+            scene,
+            features: scene.features(),
+            corners,
+            nodes: Vec::new(),
+            order: (0..scene.len() as u32).collect(),
+            rotation,
+            lights,
+            max_depth,
+        };
+        if !reference.order.is_empty() {
+            reference.build(0, scene.len());
+        }
+        reference
+    }
+
+    fn bounds(&self, range: &[u32]) -> (DVec3, DVec3) {
+        range
+            .iter()
+            .flat_map(|&i| self.corners[i as usize])
+            .fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), p| {
+                (lo.min(p), hi.max(p))
+            })
+    }
+
+    /// Builds the subtree over `order[first..first + count]`, returns its node index.
+    fn build(&mut self, first: usize, count: usize) -> u32 {
+        let (lo, hi) = self.bounds(&self.order[first..first + count]);
+        let index = self.nodes.len() as u32;
+        if count <= 4 {
+            self.nodes.push(Node::Leaf {
+                lo,
+                hi,
+                first: first as u32,
+                count: count as u32,
+            });
+            return index;
+        }
+        let axis = (hi - lo).max_position();
+        let centroid = |i: &u32| {
+            let c = self.corners[*i as usize];
+            (c[0] + c[1] + c[2])[axis]
+        };
+        let mut slice = std::mem::take(&mut self.order);
+        slice[first..first + count].sort_by(|a, b| centroid(a).total_cmp(&centroid(b)));
+        self.order = slice;
+        self.nodes.push(Node::Leaf {
+            lo,
+            hi,
+            first: 0,
+            count: 0,
+        });
+        let half = count / 2;
+        let left = self.build(first, half);
+        let right = self.build(first + half, count - half);
+        self.nodes[index as usize] = Node::Inner {
+            lo,
+            hi,
+            left,
+            right,
+        };
+        index
+    }
+
+    /// Watertight ray/triangle test (Woop, Benthin and Wald 2013) in f64, edges inclusive.
+    fn triangle_hit(
+        &self,
+        triangle: u32,
+        origin: DVec3,
+        dir: DVec3,
+        tmin: f64,
+        tmax: f64,
+    ) -> Option<Hit> {
+        let kz = dir.abs().max_position();
+        let mut kx = (kz + 1) % 3;
+        let mut ky = (kx + 1) % 3;
+        if dir[kz] < 0.0 {
+            std::mem::swap(&mut kx, &mut ky);
+        }
+        let (sx, sy, sz) = (dir[kx] / dir[kz], dir[ky] / dir[kz], 1.0 / dir[kz]);
+        let [a, b, c] = self.corners[triangle as usize].map(|p| p - origin);
+        let (ax, ay) = (a[kx] - sx * a[kz], a[ky] - sy * a[kz]);
+        let (bx, by) = (b[kx] - sx * b[kz], b[ky] - sy * b[kz]);
+        let (cx, cy) = (c[kx] - sx * c[kz], c[ky] - sy * c[kz]);
+        let u = cx * by - cy * bx;
+        let v = ax * cy - ay * cx;
+        let w = bx * ay - by * ax;
+        if (u < 0.0 || v < 0.0 || w < 0.0) && (u > 0.0 || v > 0.0 || w > 0.0) {
+            return None;
+        }
+        let det = u + v + w;
+        if det == 0.0 {
+            return None;
+        }
+        let t = (u * a[kz] + v * b[kz] + w * c[kz]) * sz / det;
+        (t > tmin && t < tmax).then_some(Hit {
+            t,
+            u: v / det,
+            v: w / det,
+            triangle,
+        })
+    }
+
+    fn box_hit(lo: DVec3, hi: DVec3, origin: DVec3, inv: DVec3, tmin: f64, tmax: f64) -> bool {
+        let a = (lo - origin) * inv;
+        let b = (hi - origin) * inv;
+        let near = a.min(b).max_element().max(tmin);
+        let far = a.max(b).min_element().min(tmax);
+        // f64 rounding is ~1e-16 relative: a relative pad of 1e-12 is conservative.
+        near <= far * (1.0 + 1e-12) + 1e-300
+    }
+
+    /// The closest hit in (tmin, tmax), or with `any` the first one found.
+    pub fn trace(&self, origin: DVec3, dir: DVec3, tmin: f64, tmax: f64, any: bool) -> Option<Hit> {
+        if self.nodes.is_empty() {
+            return None;
+        }
+        let inv = DVec3::ONE / dir;
+        let mut best: Option<Hit> = None;
+        let mut stack = vec![0u32];
+        while let Some(index) = stack.pop() {
+            let limit = best.map_or(tmax, |h| h.t);
+            match self.nodes[index as usize] {
+                Node::Leaf {
+                    lo,
+                    hi,
+                    first,
+                    count,
+                } => {
+                    if !Self::box_hit(lo, hi, origin, inv, tmin, limit) {
+                        continue;
+                    }
+                    for &tri in &self.order[first as usize..(first + count) as usize] {
+                        let limit = best.map_or(tmax, |h| h.t);
+                        if let Some(hit) = self.triangle_hit(tri, origin, dir, tmin, limit) {
+                            best = Some(hit);
+                            if any {
+                                return best;
+                            }
+                        }
+                    }
+                }
+                Node::Inner {
+                    lo,
+                    hi,
+                    left,
+                    right,
+                } => {
+                    if Self::box_hit(lo, hi, origin, inv, tmin, limit) {
+                        stack.extend([left, right]);
+                    }
+                }
+            }
+        }
+        best
+    }
+
+    /// Brute force over every triangle (to test [`Reference::trace`]).
+    pub fn trace_brute_force(&self, origin: DVec3, dir: DVec3) -> Option<Hit> {
+        let mut best: Option<Hit> = None;
+        for tri in 0..self.corners.len() as u32 {
+            let limit = best.map_or(f64::INFINITY, |h| h.t);
+            if let Some(hit) = self.triangle_hit(tri, origin, dir, 0.0, limit) {
+                best = Some(hit);
+            }
+        }
+        best
+    }
+
+    /// Renders every pixel of `camera` (rows split over the machine's threads).
+    pub fn render(&self, camera: &LensCamera) -> RenderOutput {
+        let size = camera.size;
+        let directions = camera.directions();
+        let threads = std::thread::available_parallelism().map_or(1, |n| n.get());
+        let chunk = directions.len().div_ceil(threads).max(1);
+        let mut pixels = vec![([0.0f32; 4], [0.0f32; 4], NO_HIT); directions.len()];
+        std::thread::scope(|s| {
+            for (out, dirs) in pixels.chunks_mut(chunk).zip(directions.chunks(chunk)) {
+                s.spawn(move || {
+                    for (o, d) in out.iter_mut().zip(dirs) {
+                        *o = match d {
+                            Some(d) => self.pixel(self.rotation * *d),
+                            None => ([0.0; 4], [0.0; 4], NO_HIT),
+                        };
+                    }
+                });
+            }
+        });
+        RenderOutput {
+            size,
+            colour: pixels.iter().map(|p| p.0).collect(),
+            geometry: pixels.iter().map(|p| p.1).collect(),
+            ids: pixels.iter().map(|p| p.2).collect(),
+        }
+    }
+
+    /// One primary ray (world direction from the camera): colour with w = 1, geometry, id.
+    fn pixel(&self, dir: DVec3) -> ([f32; 4], [f32; 4], u32) {
+        let mut colour = DVec3::ZERO;
+        let mut first = ([0.0f32; 4], NO_HIT);
+        let mut stack = vec![(DVec3::ZERO, dir, DVec3::ONE, 0u32)];
+        while let Some((origin, dir, weight, depth)) = stack.pop() {
+            let Some(hit) = self.trace(origin, dir, 0.0, f64::INFINITY, false) else {
+                colour += weight * v3(self.scene.sky);
+                continue;
+            };
+            let s = self.surface(dir, &hit);
+            if depth == 0 {
+                let n = s.normal.as_vec3();
+                first = ([n.x, n.y, n.z, hit.t as f32], hit.triangle);
+            }
+            let m = &self.scene.materials[self.scene.material_of[hit.triangle as usize] as usize];
+            colour += weight * v3(m.emission);
+            let children = depth < self.max_depth;
+            let push = |stack: &mut Vec<_>, origin, dir, w: DVec3| {
+                if children && w.max_element() >= MIN_WEIGHT {
+                    stack.push((origin, dir, w, depth + 1));
+                }
+            };
+            let above = s.position + s.geometric * 1e-9 * (1.0 + s.position.length());
+            let below = s.position - s.geometric * 1e-9 * (1.0 + s.position.length());
+            match m.surface {
+                Surface::Mirror if self.features.mirrors => {
+                    push(
+                        &mut stack,
+                        above,
+                        reflect(dir, s.normal),
+                        weight * v3(m.specular),
+                    );
+                }
+                Surface::Glass if self.features.glass => {
+                    let eta = if s.front {
+                        1.0 / f64::from(m.ior)
+                    } else {
+                        f64::from(m.ior)
+                    };
+                    let cos_i = -dir.dot(s.normal);
+                    let sin2_t = eta * eta * (1.0 - cos_i * cos_i).max(0.0);
+                    let mut reflectance = 1.0;
+                    if sin2_t < 1.0 {
+                        let cos_t = (1.0 - sin2_t).sqrt();
+                        reflectance = fresnel(cos_i, cos_t, 1.0 / eta);
+                        let refracted = (eta * dir + (eta * cos_i - cos_t) * s.normal).normalize();
+                        let w = weight * (1.0 - reflectance) * v3(m.transmission);
+                        push(&mut stack, below, refracted, w);
+                    }
+                    push(
+                        &mut stack,
+                        above,
+                        reflect(dir, s.normal),
+                        weight * reflectance,
+                    );
+                }
+                _ => colour += weight * self.direct_light(&s, dir, above),
+            }
+        }
+        let c = colour.as_vec3();
+        ([c.x, c.y, c.z, 1.0], first.0, first.1)
+    }
+
+    fn surface(&self, dir: DVec3, hit: &Hit) -> SurfacePoint {
+        let i = hit.triangle as usize;
+        let [a, b, c] = self.corners[i];
+        let w = 1.0 - hit.u - hit.v;
+        let position = w * a + hit.u * b + hit.v * c;
+        let mut geometric = (b - a).cross(c - a).normalize();
+        let front = geometric.dot(dir) < 0.0;
+        if !front {
+            geometric = -geometric;
+        }
+        let mut normal = geometric;
+        if self.features.smooth_normals {
+            let n = self.scene.normals.as_ref().unwrap()[i];
+            let n = (w * v3(n[0]) + hit.u * v3(n[1]) + hit.v * v3(n[2])).normalize();
+            normal = if n.dot(geometric) >= 0.0 { n } else { -n };
+        }
+        let m = &self.scene.materials[self.scene.material_of[i] as usize];
+        let mut diffuse = v3(m.diffuse);
+        if let (true, Some(t)) = (self.features.textures, m.diffuse_texture) {
+            let uv = self.scene.uvs.as_ref().unwrap()[i];
+            let uv = w * uv[0].as_dvec2() + hit.u * uv[1].as_dvec2() + hit.v * uv[2].as_dvec2();
+            diffuse *= sample(&self.scene.textures[t as usize], uv);
+        }
+        SurfacePoint {
+            position,
+            geometric,
+            normal,
+            front,
+            diffuse,
+            specular: v3(m.specular),
+            shininess: f64::from(m.shininess),
+        }
+    }
+
+    fn direct_light(&self, s: &SurfacePoint, view: DVec3, origin: DVec3) -> DVec3 {
+        let mut colour = s.diffuse * v3(self.scene.ambient);
+        for &(point, vector, light) in &self.lights {
+            let (to_light, distance, irradiance) = if point {
+                let d = vector - origin;
+                let distance = d.length();
+                (d / distance, distance, light / (distance * distance))
+            } else {
+                (-vector, f64::INFINITY, light)
+            };
+            let cos_light = s.normal.dot(to_light);
+            if cos_light <= 0.0 || s.geometric.dot(to_light) <= 0.0 {
+                continue;
+            }
+            if self.trace(origin, to_light, 0.0, distance, true).is_some() {
+                continue;
+            }
+            let half = (to_light - view).normalize();
+            let highlight = s.specular * s.normal.dot(half).max(0.0).powf(s.shininess);
+            colour += irradiance * (s.diffuse * cos_light + highlight);
+        }
+        colour
+    }
+}
+
+struct SurfacePoint {
+    position: DVec3,
+    geometric: DVec3,
+    normal: DVec3,
+    front: bool,
+    diffuse: DVec3,
+    specular: DVec3,
+    shininess: f64,
+}
+
+fn reflect(d: DVec3, n: DVec3) -> DVec3 {
+    d - 2.0 * d.dot(n) * n
+}
+
+fn fresnel(cos_i: f64, cos_t: f64, eta: f64) -> f64 {
+    let rs = (eta * cos_i - cos_t) / (eta * cos_i + cos_t);
+    let rp = (cos_i - eta * cos_t) / (cos_i + eta * cos_t);
+    0.5 * (rs * rs + rp * rp)
+}
+
+fn srgb_to_linear(c: f64) -> f64 {
+    if c <= 0.04045 {
+        c / 12.92
+    } else {
+        ((c + 0.055) / 1.055).powf(2.4)
+    }
+}
+
+/// Bilinear, repeat-wrapped, in linear space; v = 0 at the bottom (as `wgsl/shade.wgsl`).
+fn sample(t: &Texture, uv: DVec2) -> DVec3 {
+    let (w, h) = (i64::from(t.width), i64::from(t.height));
+    let texel = |x: i64, y: i64| {
+        let (x, y) = (x.rem_euclid(w) as usize, y.rem_euclid(h) as usize);
+        let i = 4 * (y * t.width as usize + x);
+        DVec3::new(
+            srgb_to_linear(f64::from(t.rgba[i]) / 255.0),
+            srgb_to_linear(f64::from(t.rgba[i + 1]) / 255.0),
+            srgb_to_linear(f64::from(t.rgba[i + 2]) / 255.0),
+        )
+    };
+    let st = DVec2::new(uv.x * w as f64 - 0.5, (1.0 - uv.y) * h as f64 - 0.5);
+    let base = st.floor();
+    let f = st - base;
+    let (x, y) = (base.x as i64, base.y as i64);
+    let top = texel(x, y).lerp(texel(x + 1, y), f.x);
+    let bottom = texel(x, y + 1).lerp(texel(x + 1, y + 1), f.x);
+    top.lerp(bottom, f.y)
+}

@@ -1,0 +1,610 @@
+//! The ray tracer: a scene on the GPU ([`GpuScene`], built and uploaded once), the trace pass
+//! for a lens and image size ([`TracePass`]), and [`render`], which does both in one call.
+//! `cpu` holds the f64 reference the GPU output is tested against.
+
+pub mod cpu;
+mod output;
+
+use bytemuck::{Pod, Zeroable};
+use glam::DVec3;
+use wgpu::util::DeviceExt;
+
+pub use output::RenderOutput;
+
+use crate::bvh::{BvhQuality, SceneBvh};
+use crate::error::{Error, Result};
+use crate::gpu::GpuContext;
+use crate::lens::LensCamera;
+use crate::lens::gpu::{DirectionSource, LensRays, lens_constants, params_buffer};
+use crate::scene::{Features, Light, Scene, Surface};
+use crate::shader::{self, WORKGROUP_2D};
+
+/// The deepest Whitted recursion a kernel can run (its ray stack has one more entry).
+pub const MAX_DEPTH_LIMIT: u32 = 8;
+/// `Material::texture` of an untextured material.
+pub const NO_TEXTURE: u32 = u32::MAX;
+/// The id of a miss or a masked pixel in [`RenderOutput::ids`].
+pub const NO_HIT: u32 = u32::MAX;
+
+/// The WGSL id of a surface kind.
+pub fn surface_id(surface: Surface) -> u32 {
+    match surface {
+        Surface::Diffuse => 0,
+        Surface::Mirror => 1,
+        Surface::Glass => 2,
+    }
+}
+
+/// The WGSL id of a light kind: `LIGHT_POINT`, `LIGHT_DIRECTIONAL`.
+pub const LIGHT_KINDS: [(&str, u32); 2] = [("LIGHT_POINT", 0), ("LIGHT_DIRECTIONAL", 1)];
+
+/// A material as `wgsl/shade.wgsl` reads it (64 bytes).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, PartialEq, Pod, Zeroable)]
+pub struct GpuMaterial {
+    /// `Kd`.
+    pub diffuse: [f32; 3],
+    /// [`surface_id`].
+    pub surface: u32,
+    /// `Ks`.
+    pub specular: [f32; 3],
+    /// `Ns`.
+    pub shininess: f32,
+    /// `Ke`.
+    pub emission: [f32; 3],
+    /// `Ni`.
+    pub ior: f32,
+    /// `Tf`.
+    pub transmission: [f32; 3],
+    /// Texture index or [`NO_TEXTURE`].
+    pub texture: u32,
+}
+
+/// A light as `wgsl/shade.wgsl` reads it (32 bytes).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, PartialEq, Pod, Zeroable)]
+pub struct GpuLight {
+    /// Camera-relative position (point) or travel direction (directional).
+    pub vector: [f32; 3],
+    /// A `LIGHT_KINDS` id.
+    pub kind: u32,
+    /// Intensity or irradiance.
+    pub colour: [f32; 3],
+    /// Padding.
+    pub pad: u32,
+}
+
+/// Per-scene shading constants (32 bytes).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, PartialEq, Pod, Zeroable)]
+pub struct Shading {
+    /// Radiance of escaping rays.
+    pub sky: [f32; 3],
+    /// Number of lights.
+    pub light_count: u32,
+    /// Ambient term.
+    pub ambient: [f32; 3],
+    /// Deepest secondary ray.
+    pub max_depth: u32,
+}
+
+/// The camera-to-world rotation (48 bytes): camera x, y, z axes in world space.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, PartialEq, Pod, Zeroable)]
+pub struct Frame {
+    /// Camera x (right).
+    pub right: [f32; 4],
+    /// Camera y (down).
+    pub down: [f32; 4],
+    /// Camera z (forward).
+    pub forward: [f32; 4],
+}
+
+/// How to render.
+#[derive(Clone, Copy, Debug)]
+pub struct RenderOptions {
+    /// Deepest reflection/refraction (0: primary rays and shadows only).
+    pub max_depth: u32,
+    /// BVH build preset.
+    pub bvh: BvhQuality,
+    /// Where primary ray directions come from.
+    pub directions: DirectionSource,
+}
+
+impl Default for RenderOptions {
+    fn default() -> Self {
+        Self {
+            max_depth: 5,
+            bvh: BvhQuality::default(),
+            directions: DirectionSource::Computed,
+        }
+    }
+}
+
+fn to3(v: glam::Vec3) -> [f32; 3] {
+    v.to_array()
+}
+
+/// Per scene triangle: vertex normals when smooth, UVs when textured, as `vec4<f32>`s.
+pub fn shading_vertices(scene: &Scene, features: Features) -> Vec<[f32; 4]> {
+    let mut out = Vec::new();
+    for i in 0..scene.len() {
+        if features.smooth_normals {
+            let n = scene.normals.as_ref().expect("smooth normals")[i];
+            out.extend(n.map(|n| [n.x, n.y, n.z, 0.0]));
+        }
+        if features.textures {
+            let t = scene.uvs.as_ref().expect("textures need UVs")[i];
+            out.push([t[0].x, t[0].y, t[1].x, t[1].y]);
+            out.push([t[2].x, t[2].y, 0.0, 0.0]);
+        }
+    }
+    out
+}
+
+fn storage_entry(binding: u32, read_only: bool) -> wgpu::BindGroupLayoutEntry {
+    wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility: wgpu::ShaderStages::COMPUTE,
+        ty: wgpu::BindingType::Buffer {
+            ty: wgpu::BufferBindingType::Storage { read_only },
+            has_dynamic_offset: false,
+            min_binding_size: None,
+        },
+        count: None,
+    }
+}
+
+fn uniform_entry(binding: u32) -> wgpu::BindGroupLayoutEntry {
+    wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility: wgpu::ShaderStages::COMPUTE,
+        ty: wgpu::BindingType::Buffer {
+            ty: wgpu::BufferBindingType::Uniform,
+            has_dynamic_offset: false,
+            min_binding_size: None,
+        },
+        count: None,
+    }
+}
+
+/// A storage buffer holding `data`, or one zero element where `data` is empty (bindings may
+/// not be empty), checked against the binding limit.
+fn storage<T: Pod>(ctx: &GpuContext, label: &str, data: &[T]) -> Result<wgpu::Buffer> {
+    let zero = [T::zeroed()];
+    let data = if data.is_empty() { &zero[..] } else { data };
+    let bytes: &[u8] = bytemuck::cast_slice(data);
+    ctx.check_binding(label, bytes.len() as u64)?;
+    Ok(ctx
+        .device
+        .create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some(label),
+            contents: bytes,
+            usage: wgpu::BufferUsages::STORAGE,
+        }))
+}
+
+/// A scene on the GPU: its BVH, triangles, materials, lights, shading data and textures, in
+/// bind group 1 of the trace kernel. Built once; every frame reuses it.
+pub struct GpuScene {
+    layout: wgpu::BindGroupLayout,
+    bind_group: wgpu::BindGroup,
+    /// What the scene uses; the trace kernel is specialised to it.
+    pub features: Features,
+    /// The world position the scene was made relative to (the camera's).
+    pub origin: DVec3,
+    /// The BVH's statistics.
+    pub bvh_nodes: usize,
+    /// Deepest BVH node.
+    pub bvh_depth: u32,
+    /// obvhs's build time.
+    pub bvh_build_time: std::time::Duration,
+    /// The camera-to-world rotation.
+    frame: Frame,
+}
+
+impl GpuScene {
+    /// Builds the BVH and uploads everything, relative to the scene camera's position.
+    pub fn new(ctx: &GpuContext, scene: &Scene, options: &RenderOptions) -> Result<Self> {
+        if options.max_depth > MAX_DEPTH_LIMIT {
+            return Err(Error::Scene(format!(
+                "max depth {} is above the limit of {MAX_DEPTH_LIMIT}",
+                options.max_depth
+            )));
+        }
+        let origin = scene.camera.position;
+        let bvh = SceneBvh::build(scene, origin, options.bvh)?;
+        let features = scene.features();
+        let materials: Vec<GpuMaterial> = scene
+            .materials
+            .iter()
+            .map(|m| GpuMaterial {
+                diffuse: to3(m.diffuse),
+                surface: surface_id(m.surface),
+                specular: to3(m.specular),
+                shininess: m.shininess,
+                emission: to3(m.emission),
+                ior: m.ior,
+                transmission: to3(m.transmission),
+                texture: m.diffuse_texture.unwrap_or(NO_TEXTURE),
+            })
+            .collect();
+        let lights: Vec<GpuLight> = scene
+            .lights
+            .iter()
+            .map(|l| match *l {
+                Light::Point {
+                    position,
+                    intensity,
+                } => GpuLight {
+                    vector: (position - origin).as_vec3().to_array(),
+                    kind: LIGHT_KINDS[0].1,
+                    colour: to3(intensity),
+                    pad: 0,
+                },
+                Light::Directional {
+                    direction,
+                    irradiance,
+                } => GpuLight {
+                    vector: direction.normalize().as_vec3().to_array(),
+                    kind: LIGHT_KINDS[1].1,
+                    colour: to3(irradiance),
+                    pad: 0,
+                },
+            })
+            .collect();
+        let mut texture_info = Vec::new();
+        let mut texels: Vec<u32> = Vec::new();
+        if features.textures {
+            for t in &scene.textures {
+                texture_info.push([texels.len() as u32, t.width, t.height, 0]);
+                texels.extend(bytemuck::cast_slice::<u8, u32>(&t.rgba));
+            }
+        }
+        let shading = Shading {
+            sky: to3(scene.sky),
+            light_count: lights.len() as u32,
+            ambient: to3(scene.ambient),
+            max_depth: options.max_depth,
+        };
+        let rotation = scene.camera.rotation();
+        let col = |v: DVec3| {
+            let v = v.as_vec3();
+            [v.x, v.y, v.z, 0.0]
+        };
+        let frame = Frame {
+            right: col(rotation.x_axis),
+            down: col(rotation.y_axis),
+            forward: col(rotation.z_axis),
+        };
+
+        let buffers = [
+            storage(ctx, "fisheye.scene.bvh_nodes", &bvh.nodes)?,
+            storage(ctx, "fisheye.scene.triangles", &bvh.triangles)?,
+            storage(ctx, "fisheye.scene.materials", &materials)?,
+            storage(ctx, "fisheye.scene.lights", &lights)?,
+            storage(
+                ctx,
+                "fisheye.scene.vertex_data",
+                &shading_vertices(scene, features),
+            )?,
+            storage(ctx, "fisheye.scene.texture_info", &texture_info)?,
+            storage(ctx, "fisheye.scene.texels", &texels)?,
+        ];
+        ctx.checked("uploading the scene", || {
+            let device = &ctx.device;
+            let uniform = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some("fisheye.scene.shading"),
+                contents: bytemuck::bytes_of(&shading),
+                usage: wgpu::BufferUsages::UNIFORM,
+            });
+            // Binding order = @binding(n) order in wgsl/bvh.wgsl and wgsl/shade.wgsl.
+            let mut entries: Vec<_> = (0..7).map(|b| storage_entry(b, true)).collect();
+            entries.push(uniform_entry(7));
+            let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+                label: Some("fisheye.scene"),
+                entries: &entries,
+            });
+            let mut resources: Vec<wgpu::BindGroupEntry> = buffers
+                .iter()
+                .enumerate()
+                .map(|(b, buffer)| wgpu::BindGroupEntry {
+                    binding: b as u32,
+                    resource: buffer.as_entire_binding(),
+                })
+                .collect();
+            resources.push(wgpu::BindGroupEntry {
+                binding: 7,
+                resource: uniform.as_entire_binding(),
+            });
+            let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some("fisheye.scene"),
+                layout: &layout,
+                entries: &resources,
+            });
+            Self {
+                layout,
+                bind_group,
+                features,
+                origin,
+                bvh_nodes: bvh.nodes.len(),
+                bvh_depth: bvh.depth,
+                bvh_build_time: bvh.build_time,
+                frame,
+            }
+        })
+    }
+}
+
+/// The trace kernel for one lens, image size and scene: owns its pipeline, its frame bind
+/// group (group 0) and its outputs; records one frame per [`TracePass::encode`].
+pub struct TracePass {
+    pipeline: wgpu::ComputePipeline,
+    bind_group: wgpu::BindGroup,
+    colour: wgpu::Buffer,
+    geometry: wgpu::Buffer,
+    ids: wgpu::Buffer,
+    camera: LensCamera,
+}
+
+impl TracePass {
+    /// Creates the pipeline (specialised to the lens, direction source and the scene's
+    /// features) and the output buffers; with [`DirectionSource::Table`] also computes the
+    /// direction table once.
+    pub fn new(
+        ctx: &GpuContext,
+        camera: &LensCamera,
+        scene: &GpuScene,
+        source: DirectionSource,
+    ) -> Result<Self> {
+        let pixels = camera.size.pixels() as u64;
+        for (what, bytes) in [
+            ("the colour output", 16 * pixels),
+            ("the geometry output", 16 * pixels),
+        ] {
+            ctx.check_binding(what, bytes)?;
+        }
+        let table = match source {
+            DirectionSource::Table => {
+                let rays = LensRays::new(ctx, camera)?;
+                let mut encoder = ctx.device.create_command_encoder(&Default::default());
+                rays.encode(&mut encoder, None);
+                ctx.queue.submit([encoder.finish()]);
+                Some(rays)
+            }
+            DirectionSource::Computed => None,
+        };
+        ctx.checked("creating the trace pass", || {
+            let device = &ctx.device;
+            let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+                label: Some("fisheye.trace.frame"),
+                entries: &[
+                    uniform_entry(0),
+                    uniform_entry(1),
+                    storage_entry(2, true),
+                    storage_entry(3, false),
+                    storage_entry(4, false),
+                    storage_entry(5, false),
+                ],
+            });
+            let f = scene.features;
+            let flag = |b: bool| if b { 1.0 } else { 0.0 };
+            let mut constants = lens_constants(camera).to_vec();
+            constants.extend([
+                ("DIRECTION_SOURCE", f64::from(source as u32)),
+                ("HAS_MIRRORS", flag(f.mirrors)),
+                ("HAS_GLASS", flag(f.glass)),
+                ("HAS_TEXTURES", flag(f.textures)),
+                ("SMOOTH_NORMALS", flag(f.smooth_normals)),
+            ]);
+            let module = shader::module(device, "trace");
+            let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+                label: Some("fisheye.trace"),
+                layout: Some(
+                    &device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+                        label: Some("fisheye.trace"),
+                        bind_group_layouts: &[Some(&layout), Some(&scene.layout)],
+                        immediate_size: 0,
+                    }),
+                ),
+                module: &module,
+                entry_point: Some("main"),
+                compilation_options: wgpu::PipelineCompilationOptions {
+                    constants: &constants,
+                    ..Default::default()
+                },
+                cache: None,
+            });
+            let output = |label: &str, bytes: u64| {
+                device.create_buffer(&wgpu::BufferDescriptor {
+                    label: Some(label),
+                    size: bytes,
+                    usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
+                    mapped_at_creation: false,
+                })
+            };
+            let colour = output("fisheye.trace.colour", 16 * pixels);
+            let geometry = output("fisheye.trace.geometry", 16 * pixels);
+            let ids = output("fisheye.trace.ids", 4 * pixels);
+            let frame = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some("fisheye.trace.frame"),
+                contents: bytemuck::bytes_of(&scene.frame),
+                usage: wgpu::BufferUsages::UNIFORM,
+            });
+            let placeholder = output("fisheye.trace.no_table", 16);
+            let table = table.as_ref().map_or(&placeholder, |t| &t.directions);
+            let lens = params_buffer(device, camera);
+            let resources = [&lens, &frame, table, &colour, &geometry, &ids];
+            let entries: Vec<_> = resources
+                .iter()
+                .enumerate()
+                .map(|(b, buffer)| wgpu::BindGroupEntry {
+                    binding: b as u32,
+                    resource: buffer.as_entire_binding(),
+                })
+                .collect();
+            let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some("fisheye.trace.frame"),
+                layout: &layout,
+                entries: &entries,
+            });
+            Self {
+                pipeline,
+                bind_group,
+                colour,
+                geometry,
+                ids,
+                camera: *camera,
+            }
+        })
+    }
+
+    /// Records one frame, optionally timed.
+    pub fn encode(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        scene: &GpuScene,
+        timestamp_writes: Option<wgpu::ComputePassTimestampWrites<'_>>,
+    ) {
+        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+            label: Some("fisheye.trace"),
+            timestamp_writes,
+        });
+        pass.set_pipeline(&self.pipeline);
+        pass.set_bind_group(0, &self.bind_group, &[]);
+        pass.set_bind_group(1, &scene.bind_group, &[]);
+        pass.dispatch_workgroups(
+            self.camera.size.width.div_ceil(WORKGROUP_2D),
+            self.camera.size.height.div_ceil(WORKGROUP_2D),
+            1,
+        );
+    }
+
+    /// Reads the last frame's outputs back.
+    pub fn read(&self, ctx: &GpuContext) -> Result<RenderOutput> {
+        Ok(RenderOutput {
+            size: self.camera.size,
+            colour: ctx.read_buffer(&self.colour)?,
+            geometry: ctx.read_buffer(&self.geometry)?,
+            ids: ctx.read_buffer(&self.ids)?,
+        })
+    }
+}
+
+/// Renders `scene` through `camera` in one call: builds and uploads the scene, traces one
+/// frame and reads it back.
+pub fn render(
+    ctx: &GpuContext,
+    scene: &Scene,
+    camera: &LensCamera,
+    options: &RenderOptions,
+) -> Result<RenderOutput> {
+    let gpu_scene = GpuScene::new(ctx, scene, options)?;
+    let pass = TracePass::new(ctx, camera, &gpu_scene, options.directions)?;
+    ctx.checked("tracing", || {
+        let mut encoder = ctx.device.create_command_encoder(&Default::default());
+        pass.encode(&mut encoder, &gpu_scene, None);
+        ctx.queue.submit([encoder.finish()]);
+    })?;
+    pass.read(ctx)
+}
+
+#[cfg(test)]
+mod tests {
+    use std::mem::{offset_of, size_of};
+
+    use super::*;
+    use crate::bvh::GpuTriangle;
+    use crate::shader::assert_wgsl_layout;
+
+    #[test]
+    fn gpu_structs_match_their_wgsl_twins() {
+        assert_wgsl_layout(
+            "bvh",
+            "BvhTriangle",
+            size_of::<GpuTriangle>(),
+            &[
+                ("v0", offset_of!(GpuTriangle, v0)),
+                ("triangle", offset_of!(GpuTriangle, triangle)),
+                ("v1", offset_of!(GpuTriangle, v1)),
+                ("material", offset_of!(GpuTriangle, material)),
+                ("v2", offset_of!(GpuTriangle, v2)),
+                ("pad", offset_of!(GpuTriangle, pad)),
+            ],
+        );
+        assert_wgsl_layout(
+            "shade",
+            "Material",
+            size_of::<GpuMaterial>(),
+            &[
+                ("diffuse", offset_of!(GpuMaterial, diffuse)),
+                ("surface", offset_of!(GpuMaterial, surface)),
+                ("specular", offset_of!(GpuMaterial, specular)),
+                ("shininess", offset_of!(GpuMaterial, shininess)),
+                ("emission", offset_of!(GpuMaterial, emission)),
+                ("ior", offset_of!(GpuMaterial, ior)),
+                ("transmission", offset_of!(GpuMaterial, transmission)),
+                ("texture", offset_of!(GpuMaterial, texture)),
+            ],
+        );
+        assert_wgsl_layout(
+            "shade",
+            "Light",
+            size_of::<GpuLight>(),
+            &[
+                ("vector", offset_of!(GpuLight, vector)),
+                ("kind", offset_of!(GpuLight, kind)),
+                ("colour", offset_of!(GpuLight, colour)),
+                ("pad", offset_of!(GpuLight, pad)),
+            ],
+        );
+        assert_wgsl_layout(
+            "shade",
+            "Shading",
+            size_of::<Shading>(),
+            &[
+                ("sky", offset_of!(Shading, sky)),
+                ("light_count", offset_of!(Shading, light_count)),
+                ("ambient", offset_of!(Shading, ambient)),
+                ("max_depth", offset_of!(Shading, max_depth)),
+            ],
+        );
+        assert_wgsl_layout(
+            "trace",
+            "Frame",
+            size_of::<Frame>(),
+            &[
+                ("right", offset_of!(Frame, right)),
+                ("down", offset_of!(Frame, down)),
+                ("forward", offset_of!(Frame, forward)),
+            ],
+        );
+    }
+
+    /// `wgsl/bvh.wgsl` reads obvhs's 80-byte node as five `vec4<u32>`, words as documented
+    /// there: these offsets pin that reading to obvhs's struct.
+    #[test]
+    fn cwbvh_node_words_match_the_wgsl_reading() {
+        use obvhs::cwbvh::node::CwBvhNode as N;
+        assert_eq!(size_of::<N>(), 80);
+        let words = [
+            (offset_of!(N, p), 0),
+            (offset_of!(N, e), 3),
+            (offset_of!(N, imask), 3),
+            (offset_of!(N, child_base_idx), 4),
+            (offset_of!(N, primitive_base_idx), 5),
+            (offset_of!(N, child_meta), 6),
+            (offset_of!(N, child_min_x), 8),
+            (offset_of!(N, child_max_x), 10),
+            (offset_of!(N, child_min_y), 12),
+            (offset_of!(N, child_max_y), 14),
+            (offset_of!(N, child_min_z), 16),
+            (offset_of!(N, child_max_z), 18),
+        ];
+        for (offset, word) in words {
+            assert_eq!(offset / 4, word);
+        }
+        // e's three bytes, then imask as the word's top byte.
+        assert_eq!(offset_of!(N, imask), 15);
+    }
+}

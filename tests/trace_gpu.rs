@@ -1,0 +1,438 @@
+//! The GPU tracer against the f64 reference tracer, and its hard cases, by readback.
+//!
+//! Tolerances. The GPU traces f32 rays whose directions differ from the reference's by about
+//! 1e-7 rad, over the same f32 geometry, so:
+//! - primary ids agree except where a ray passes within that angle of a triangle edge: a
+//!   differing pixel must lie on an edge of the reference's id image, and there are few;
+//! - distances agree to a few f32 ulp, more at grazing angles: the 99.9th percentile of the
+//!   relative difference must be ≤ 1e-5, the maximum ≤ 1e-3;
+//! - colours agree to f32 rounding where every ray of the pixel's tree hits the same
+//!   triangles; reflections and shadows have silhouettes of their own, so we bound the mean
+//!   difference (≤ 2e-3) and the share of pixels off by more than 0.02 (≤ 1%).
+
+use std::sync::OnceLock;
+
+use fisheye_rt::gpu::GpuContext;
+use fisheye_rt::lens::{ImageSize, LensCamera, parse_spec};
+use fisheye_rt::scene::{Camera, Light, Material, MeshBuilder, Scene, builtin};
+use fisheye_rt::trace::{NO_HIT, RenderOptions, RenderOutput, cpu::Reference, render};
+use glam::{DVec3, Vec2, Vec3};
+
+fn ctx() -> &'static GpuContext {
+    static CTX: OnceLock<GpuContext> = OnceLock::new();
+    CTX.get_or_init(|| GpuContext::new().expect("these tests need a GPU adapter (or lavapipe)"))
+}
+
+fn camera(spec: &str, w: u32, h: u32) -> LensCamera {
+    LensCamera::new(parse_spec(spec).unwrap(), ImageSize::new(w, h).unwrap())
+}
+
+/// Whether pixel `i` of the reference's id image borders a different id.
+fn on_id_edge(ids: &[u32], size: ImageSize, i: usize) -> bool {
+    let (w, h) = (size.width as usize, size.height as usize);
+    let (x, y) = (i % w, i / w);
+    let neighbours = [
+        (x > 0).then(|| i - 1),
+        (x + 1 < w).then(|| i + 1),
+        (y > 0).then(|| i - w),
+        (y + 1 < h).then(|| i + w),
+    ];
+    neighbours.into_iter().flatten().any(|j| ids[j] != ids[i])
+}
+
+struct Agreement {
+    id_mismatches: usize,
+    mean_colour_error: f64,
+    colour_outliers: usize,
+}
+
+/// Compares a GPU render with the reference under the module's tolerances.
+fn assert_agrees(name: &str, gpu: &RenderOutput, cpu: &RenderOutput) -> Agreement {
+    let n = gpu.ids.len();
+    let mut mismatches = 0;
+    let mut distance_errors = Vec::new();
+    let mut colour_sum = 0.0;
+    let mut outliers = 0;
+    let mut compared = 0;
+    for i in 0..n {
+        assert_eq!(gpu.valid(i), cpu.valid(i), "{name}: masks differ at {i}");
+        assert!(
+            gpu.colour[i].iter().all(|c| c.is_finite()),
+            "{name}: non-finite colour at {i}"
+        );
+        if gpu.ids[i] != cpu.ids[i] {
+            assert!(
+                on_id_edge(&cpu.ids, cpu.size, i) || on_id_edge(&gpu.ids, gpu.size, i),
+                "{name}: ids differ inside a surface at pixel {i}: gpu {} cpu {}",
+                gpu.ids[i],
+                cpu.ids[i]
+            );
+            mismatches += 1;
+            continue;
+        }
+        if !gpu.valid(i) {
+            continue;
+        }
+        if gpu.ids[i] != NO_HIT {
+            let (a, b) = (f64::from(gpu.geometry[i][3]), f64::from(cpu.geometry[i][3]));
+            distance_errors.push((a - b).abs() / b);
+        }
+        let e = (0..3)
+            .map(|k| f64::from((gpu.colour[i][k] - cpu.colour[i][k]).abs()))
+            .fold(0.0, f64::max);
+        colour_sum += e;
+        compared += 1;
+        if e > 0.02 {
+            outliers += 1;
+        }
+    }
+    distance_errors.sort_by(f64::total_cmp);
+    let p999 = distance_errors
+        .get(distance_errors.len() * 999 / 1000)
+        .copied()
+        .unwrap_or(0.0);
+    let max = distance_errors.last().copied().unwrap_or(0.0);
+    let mean = colour_sum / compared.max(1) as f64;
+    eprintln!(
+        "{name}: {mismatches}/{n} ids differ (on edges), distance p99.9 {p999:.1e} max {max:.1e}, \
+         colour mean {mean:.1e}, {outliers} outliers"
+    );
+    assert!(mismatches * 100 <= n, "{name}: {mismatches} ids differ");
+    assert!(
+        p999 <= 1e-5 && max <= 1e-3,
+        "{name}: distances {p999:e} / {max:e}"
+    );
+    assert!(mean <= 2e-3, "{name}: mean colour error {mean}");
+    assert!(
+        outliers * 100 <= compared,
+        "{name}: {outliers} colour outliers"
+    );
+    Agreement {
+        id_mismatches: mismatches,
+        mean_colour_error: mean,
+        colour_outliers: outliers,
+    }
+}
+
+fn both(scene: &Scene, cam: &LensCamera) -> (RenderOutput, RenderOutput) {
+    let options = RenderOptions::default();
+    let gpu = render(ctx(), scene, cam, &options).unwrap();
+    let cpu = Reference::new(scene, options.max_depth).render(cam);
+    (gpu, cpu)
+}
+
+#[test]
+fn builtin_scenes_match_the_reference() {
+    for (name, spec) in [
+        ("default", "equidistant:f=0.42,fov=180"),
+        ("default", "rectilinear:f=0.8"),
+        ("grid", "samyang-7.5mm"),
+        ("many-small", "equidistant:f=0.3"),
+    ] {
+        let scene = builtin::scene(name).unwrap();
+        let (gpu, cpu) = both(&scene, &camera(spec, 128, 96));
+        let (valid, hits) = gpu.counts();
+        assert!(hits > valid / 3, "{name}: only {hits} hits of {valid}");
+        assert_agrees(&format!("{name} through {spec}"), &gpu, &cpu);
+    }
+}
+
+#[test]
+fn reference_bvh_matches_brute_force() {
+    let scene = builtin::scene("default").unwrap();
+    let reference = Reference::new(&scene, 0);
+    let cam = camera("equidistant:f=0.25", 48, 48);
+    let rotation = scene.camera.rotation();
+    let mut hits = 0;
+    for dir in cam.directions().into_iter().flatten() {
+        let d = rotation * dir;
+        let a = reference.trace(DVec3::ZERO, d, 0.0, f64::INFINITY, false);
+        let b = reference.trace_brute_force(DVec3::ZERO, d);
+        assert_eq!(a.map(|h| h.triangle), b.map(|h| h.triangle));
+        hits += usize::from(a.is_some());
+    }
+    assert!(hits > 1000);
+}
+
+/// A camera inside a closed tessellated sphere hits on every pixel inside the image circle:
+/// no ray leaks through a shared edge or vertex. At the centre, rays pass exactly through the
+/// pole vertices where 64 triangles meet (the camera looks straight up).
+#[test]
+fn closed_sphere_does_not_leak() {
+    for (centre, look) in [
+        (DVec3::ZERO, DVec3::Y),
+        (DVec3::new(0.13, -0.21, 0.07), -DVec3::Z),
+    ] {
+        let mut b = MeshBuilder::new();
+        let m = b.material(Material::diffuse("inside", Vec3::splat(0.5)));
+        b.sphere(DVec3::ZERO, 1.0, 64, 32, true, m);
+        let scene = b.finish(
+            Vec::new(),
+            Vec3::new(1.0, 0.0, 0.0),
+            Vec3::ONE,
+            Camera {
+                position: centre,
+                look_at: centre + look,
+                up: DVec3::X,
+            },
+        );
+        // 360°: every direction; odd size: the centre ray is the optical axis itself.
+        let cam = camera("equidistant:f=0.2", 161, 161);
+        let out = render(ctx(), &scene, &cam, &RenderOptions::default()).unwrap();
+        let (valid, hits) = out.counts();
+        assert!(valid > 15_000);
+        assert_eq!(hits, valid, "{} rays leaked from {centre}", valid - hits);
+    }
+}
+
+/// A ray through the shared vertex of a flat fan hits it (odd image: the centre pixel's ray is
+/// the axis, through the vertex).
+#[test]
+fn ray_through_shared_fan_vertex_hits() {
+    let mut b = MeshBuilder::new();
+    let m = b.material(Material::diffuse("fan", Vec3::ONE));
+    let centre = DVec3::new(0.0, 0.0, -2.0);
+    let n = 7;
+    for k in 0..n {
+        let angle = |k: u32| std::f64::consts::TAU * f64::from(k) / f64::from(n) + 0.3;
+        let p = |k: u32| centre + DVec3::new(angle(k).cos(), angle(k).sin(), 0.0);
+        b.triangle([centre, p(k), p(k + 1)], None, None, m);
+    }
+    let scene = b.finish(
+        Vec::new(),
+        Vec3::ZERO,
+        Vec3::ONE,
+        Camera {
+            position: DVec3::ZERO,
+            look_at: centre,
+            up: DVec3::Y,
+        },
+    );
+    let cam = camera("rectilinear:f=4", 33, 33);
+    let out = render(ctx(), &scene, &cam, &RenderOptions::default()).unwrap();
+    let centre_pixel = 16 * 33 + 16;
+    assert_ne!(
+        out.ids[centre_pixel], NO_HIT,
+        "the ray through the fan's vertex missed"
+    );
+    assert!((out.geometry[centre_pixel][3] - 2.0).abs() < 1e-6);
+}
+
+/// A mirror sphere against the sky: every pixel on the mirror shows Ks × sky exactly; a
+/// reflected ray that re-hit its own surface (acne) would show something else.
+#[test]
+fn mirror_has_no_acne() {
+    for offset in [DVec3::ZERO, DVec3::splat(1e5)] {
+        let mut b = MeshBuilder::new();
+        let m = b.material(Material::mirror("mirror", Vec3::new(0.9, 0.8, 0.7)));
+        b.sphere(offset + DVec3::new(0.0, 0.0, -3.0), 1.0, 96, 48, false, m);
+        let sky = Vec3::new(0.2, 0.4, 0.8);
+        let scene = b.finish(
+            Vec::new(),
+            sky,
+            Vec3::ZERO,
+            Camera {
+                position: offset,
+                look_at: offset - DVec3::Z,
+                up: DVec3::Y,
+            },
+        );
+        let out = render(
+            ctx(),
+            &scene,
+            &camera("rectilinear:f=2", 96, 96),
+            &RenderOptions::default(),
+        )
+        .unwrap();
+        let expected = Vec3::new(0.9, 0.8, 0.7) * sky;
+        let mut on_mirror = 0;
+        for (i, id) in out.ids.iter().enumerate() {
+            if *id == NO_HIT {
+                continue;
+            }
+            on_mirror += 1;
+            let c = Vec3::from_slice(&out.colour[i][..3]);
+            assert!(
+                (c - expected).abs().max_element() < 1e-5,
+                "pixel {i}: {c} (offset {offset})"
+            );
+        }
+        assert!(on_mirror > 2000);
+    }
+}
+
+/// A lit plane with nothing above it: every hit shows Kd·(ambient + E·cos θ) exactly, also at
+/// grazing angles and 1e5 units from the origin; a shadow ray that re-hit the plane would
+/// darken it (shadow acne).
+#[test]
+fn diffuse_plane_has_no_shadow_acne_even_grazing() {
+    for offset in [DVec3::ZERO, DVec3::new(1e5, -3e4, 2e5)] {
+        let mut b = MeshBuilder::new();
+        let kd = Vec3::new(0.7, 0.6, 0.5);
+        let m = b.material(Material::diffuse("plane", kd));
+        b.quad(
+            offset + DVec3::new(-500.0, 0.0, -500.0),
+            DVec3::Z * 1000.0,
+            DVec3::X * 1000.0,
+            Vec2::ONE,
+            m,
+        );
+        let light = DVec3::new(0.3, -0.8, -0.5).normalize();
+        let e = Vec3::new(1.5, 1.4, 1.3);
+        let ambient = Vec3::splat(0.1);
+        let scene = b.finish(
+            vec![Light::Directional {
+                direction: light,
+                irradiance: e,
+            }],
+            Vec3::ZERO,
+            ambient,
+            Camera {
+                position: offset + DVec3::new(0.0, 0.05, 0.0),
+                look_at: offset + DVec3::new(0.0, 0.05, -1.0),
+                up: DVec3::Y,
+            },
+        );
+        // 180° fisheye, level camera 5 cm above the plane: rays down to grazing at the horizon.
+        let out = render(
+            ctx(),
+            &scene,
+            &camera("equidistant:f=0.6,fov=180", 128, 96),
+            &RenderOptions::default(),
+        )
+        .unwrap();
+        let expected = kd * (ambient + e * (-light.y as f32));
+        let mut hits = 0;
+        for (i, id) in out.ids.iter().enumerate() {
+            if *id == NO_HIT {
+                continue;
+            }
+            hits += 1;
+            let c = Vec3::from_slice(&out.colour[i][..3]);
+            assert!(
+                (c - expected).abs().max_element() < 1e-5,
+                "pixel {i}: {c} vs {expected} (offset {offset})"
+            );
+        }
+        assert!(hits > 2000);
+    }
+}
+
+/// Translating the whole scene (camera and lights too) by 1e5 units renders the same image.
+#[test]
+fn far_from_origin_renders_the_same() {
+    let scene = builtin::scene("default").unwrap();
+    let mut moved = scene.clone();
+    let shift = DVec3::new(1e5, -2e5, 1.5e5);
+    for t in &mut moved.triangles {
+        *t = t.map(|p| p + shift);
+    }
+    for l in &mut moved.lights {
+        if let Light::Point { position, .. } = l {
+            *position += shift;
+        }
+    }
+    moved.camera.position += shift;
+    moved.camera.look_at += shift;
+    let cam = camera("equidistant:f=0.42,fov=180", 96, 72);
+    let a = render(ctx(), &scene, &cam, &RenderOptions::default()).unwrap();
+    let b = render(ctx(), &moved, &cam, &RenderOptions::default()).unwrap();
+    let same_ids = a.ids.iter().zip(&b.ids).filter(|(x, y)| x == y).count();
+    assert!(
+        same_ids * 1000 >= a.ids.len() * 999,
+        "{same_ids} of {}",
+        a.ids.len()
+    );
+    let worst = a
+        .colour
+        .iter()
+        .zip(&b.colour)
+        .zip(a.ids.iter().zip(&b.ids))
+        .filter(|(_, (x, y))| x == y)
+        .map(|((p, q), _)| (0..3).map(|k| (p[k] - q[k]).abs()).fold(0.0, f32::max))
+        .fold(0.0, f32::max);
+    assert!(worst < 0.02, "colour differs by {worst}");
+}
+
+#[test]
+fn empty_one_triangle_and_degenerate_scenes() {
+    let camera_pose = Camera {
+        position: DVec3::ZERO,
+        look_at: -DVec3::Z,
+        up: DVec3::Y,
+    };
+    let sky = Vec3::new(0.3, 0.5, 0.7);
+    let cam = camera("stereographic:f=0.4", 64, 48);
+
+    // Empty: every ray sees the sky, no id, nothing masked wrongly.
+    let empty = MeshBuilder::new().finish(Vec::new(), sky, Vec3::ONE, camera_pose);
+    let out = render(ctx(), &empty, &cam, &RenderOptions::default()).unwrap();
+    assert!(out.ids.iter().all(|&id| id == NO_HIT));
+    for (i, c) in out.colour.iter().enumerate() {
+        assert!(out.valid(i));
+        assert_eq!(Vec3::from_slice(&c[..3]), sky);
+    }
+
+    // One triangle, and zero-area ones (repeated and collinear corners) that must never hit.
+    let mut b = MeshBuilder::new();
+    let m = b.material(Material::diffuse("tri", Vec3::ONE));
+    b.triangle(
+        [
+            DVec3::new(-1.0, -1.0, -2.0),
+            DVec3::new(1.0, -1.0, -2.0),
+            DVec3::new(0.0, 1.0, -2.0),
+        ],
+        None,
+        None,
+        m,
+    );
+    let p = DVec3::new(0.0, 0.0, -1.5);
+    b.triangle([p, p, p], None, None, m);
+    b.triangle([p, p + DVec3::X, p + 2.0 * DVec3::X], None, None, m);
+    b.triangle([p - DVec3::Y, p, p + DVec3::Y], None, None, m);
+    let scene = b.finish(Vec::new(), sky, Vec3::ONE, camera_pose);
+    let (gpu, cpu) = both(&scene, &camera("rectilinear:f=1", 64, 48));
+    assert!(
+        gpu.ids.iter().all(|&id| id == 0 || id == NO_HIT),
+        "a degenerate triangle was hit"
+    );
+    assert!(gpu.ids.iter().filter(|&&id| id == 0).count() > 200);
+    let agreement = assert_agrees("one triangle", &gpu, &cpu);
+    assert!(agreement.id_mismatches <= 20 && agreement.colour_outliers == 0);
+    assert!(agreement.mean_colour_error < 1e-6);
+}
+
+/// Glass: Fresnel splits, total internal reflection and the transmission filter agree with
+/// the reference through up to 5 bounces.
+#[test]
+fn glass_matches_the_reference() {
+    let mut b = MeshBuilder::new();
+    let glass = b.material(Material {
+        transmission: Vec3::new(0.9, 1.0, 0.9),
+        ..Material::glass("glass", 1.5)
+    });
+    let floor = b.material(Material::diffuse("floor", Vec3::splat(0.6)));
+    b.sphere(DVec3::new(0.0, 1.0, -3.0), 1.0, 96, 48, false, glass);
+    b.quad(
+        DVec3::new(-10.0, 0.0, -10.0),
+        DVec3::Z * 20.0,
+        DVec3::X * 20.0,
+        Vec2::ONE,
+        floor,
+    );
+    let scene = b.finish(
+        vec![Light::Point {
+            position: DVec3::new(2.0, 4.0, 0.0),
+            intensity: Vec3::splat(12.0),
+        }],
+        Vec3::new(0.5, 0.6, 0.8),
+        Vec3::splat(0.05),
+        Camera {
+            position: DVec3::new(0.0, 1.2, 0.0),
+            look_at: DVec3::new(0.0, 1.0, -3.0),
+            up: DVec3::Y,
+        },
+    );
+    let (gpu, cpu) = both(&scene, &camera("rectilinear:f=1.5", 96, 96));
+    assert_agrees("glass sphere", &gpu, &cpu);
+}

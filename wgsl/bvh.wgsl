@@ -1,0 +1,214 @@
+// CWBVH traversal with closest-hit and any-hit queries, written for this project after the
+// algorithm of Ylitie, Karras and Laine 2017 ("Efficient Incoherent Ray Traversal on GPUs
+// Through Compressed Wide BVHs") and obvhs's node encoding. Robust by construction: child
+// boxes are tested conservatively (padded by a bound on every rounding, after Ize 2013,
+// "Robust BVH Ray Traversal"), and triangles watertightly (Woop, Benthin and Wald 2013).
+
+// Mirrors `obvhs::cwbvh::node::CwBvhNode` (80 bytes) as five vec4<u32> per node:
+// [0] p.xyz (f32 bits), e.x | e.y << 8 | e.z << 16 | imask << 24
+// [1] child_base_idx, primitive_base_idx, child_meta[0..4], child_meta[4..8]
+// [2] child_min_x[0..8], child_max_x[0..8]   (two words each)
+// [3] child_min_y, child_max_y
+// [4] child_min_z, child_max_z
+@group(1) @binding(0) var<storage, read> bvh_nodes: array<vec4<u32>>;
+// Mirrors `fisheye_rt::bvh::GpuTriangle` (48 bytes): camera-relative corners, the scene
+// triangle it came from and its material.
+struct BvhTriangle {
+    v0: vec3<f32>,
+    triangle: u32,
+    v1: vec3<f32>,
+    material: u32,
+    v2: vec3<f32>,
+    pad: u32,
+}
+
+@group(1) @binding(1) var<storage, read> bvh_triangles: array<BvhTriangle>;
+
+// 4 ulp: covers the roundings of the slab test and of obvhs's quantization.
+const BOX_PAD: f32 = 4.0 * 1.1920929e-7;
+// Edge functions this close to zero (relative to their products) count as zero, so a point
+// on a shared edge is inside both triangles even where the driver fuses multiply-adds.
+const EDGE_BAND: f32 = 2.0 * 1.1920929e-7;
+
+struct Ray {
+    origin: vec3<f32>,
+    dir: vec3<f32>,
+    tmin: f32,
+    tmax: f32,
+}
+
+struct Hit {
+    t: f32,
+    // Barycentric weights of v1 and v2 (v0's is 1 - u - v).
+    u: f32,
+    v: f32,
+    // Index into bvh_triangles, NO_HIT if none.
+    slot: u32,
+}
+
+// Woop et al.'s per-ray shear: kz is the dominant axis, (kx, ky) keep the winding.
+struct Shear {
+    k: vec3<u32>,
+    s: vec3<f32>,
+}
+
+fn ray_shear(dir: vec3<f32>) -> Shear {
+    let a = abs(dir);
+    var kz = 2u;
+    if a.x > a.y && a.x > a.z {
+        kz = 0u;
+    } else if a.y > a.z {
+        kz = 1u;
+    }
+    var kx = (kz + 1u) % 3u;
+    var ky = (kx + 1u) % 3u;
+    if dir[kz] < 0.0 {
+        let swap = kx;
+        kx = ky;
+        ky = swap;
+    }
+    return Shear(vec3<u32>(kx, ky, kz), vec3<f32>(dir[kx] / dir[kz], dir[ky] / dir[kz], 1.0 / dir[kz]));
+}
+
+// a·d - b·c with results within EDGE_BAND of zero snapped to zero.
+fn edge(a: f32, d: f32, b: f32, c: f32) -> f32 {
+    let p = a * d;
+    let q = b * c;
+    let e = p - q;
+    return select(e, 0.0, abs(e) <= EDGE_BAND * (abs(p) + abs(q)));
+}
+
+// Watertight ray/triangle test; returns (t, u, v, 1) on a hit within (tmin, tmax), else 0.
+fn triangle_hit(slot: u32, ray: Ray, sh: Shear) -> vec4<f32> {
+    let tri = bvh_triangles[slot];
+    let a = tri.v0 - ray.origin;
+    let b = tri.v1 - ray.origin;
+    let c = tri.v2 - ray.origin;
+    let ax = a[sh.k.x] - sh.s.x * a[sh.k.z];
+    let ay = a[sh.k.y] - sh.s.y * a[sh.k.z];
+    let bx = b[sh.k.x] - sh.s.x * b[sh.k.z];
+    let by = b[sh.k.y] - sh.s.y * b[sh.k.z];
+    let cx = c[sh.k.x] - sh.s.x * c[sh.k.z];
+    let cy = c[sh.k.y] - sh.s.y * c[sh.k.z];
+    let u = edge(cx, by, cy, bx);
+    let v = edge(ax, cy, ay, cx);
+    let w = edge(bx, ay, by, ax);
+    if (u < 0.0 || v < 0.0 || w < 0.0) && (u > 0.0 || v > 0.0 || w > 0.0) {
+        return vec4<f32>(0.0);
+    }
+    let det = u + v + w;
+    if det == 0.0 {
+        return vec4<f32>(0.0);
+    }
+    let t_scaled = (u * a[sh.k.z] + v * b[sh.k.z] + w * c[sh.k.z]) * sh.s.z;
+    let sign_det = sign(det);
+    let abs_det = abs(det);
+    let t_signed = t_scaled * sign_det;
+    if t_signed <= ray.tmin * abs_det || t_signed >= ray.tmax * abs_det {
+        return vec4<f32>(0.0);
+    }
+    let inv = 1.0 / det;
+    return vec4<f32>(t_scaled * inv, v * inv, w * inv, 1.0);
+}
+
+fn byte_of(pair: vec2<u32>, i: u32) -> u32 {
+    return (pair[i >> 2u] >> ((i & 3u) * 8u)) & 0xffu;
+}
+
+// Tests a node's eight children; returns obvhs's hit mask: internal children in the top byte
+// (ordered by octant), leaf primitives in the low 24 bits.
+fn node_hits(index: u32, ray: Ray, inv_dir: vec3<f32>, oct_inv: u32, tmax: f32) -> u32 {
+    let n0 = bvh_nodes[5u * index];
+    let n1 = bvh_nodes[5u * index + 1u];
+    let n2 = bvh_nodes[5u * index + 2u];
+    let n3 = bvh_nodes[5u * index + 3u];
+    let n4 = bvh_nodes[5u * index + 4u];
+    let p = bitcast<vec3<f32>>(n0.xyz);
+    let e = vec3<f32>(
+        bitcast<f32>((n0.w & 0xffu) << 23u),
+        bitcast<f32>(((n0.w >> 8u) & 0xffu) << 23u),
+        bitcast<f32>(((n0.w >> 16u) & 0xffu) << 23u),
+    );
+    let scale = e * inv_dir;
+    let offset = (p - ray.origin) * inv_dir;
+    // A bound on the absolute rounding error of every slab distance of this node.
+    let pad = BOX_PAD * (abs(p - ray.origin) + 256.0 * e) * abs(inv_dir);
+    let negative = inv_dir < vec3<f32>(0.0);
+    var mask = 0u;
+    for (var i = 0u; i < 8u; i++) {
+        let child_meta = byte_of(n1.zw, i);
+        if child_meta == 0u {
+            continue;
+        }
+        let lo = vec3<f32>(f32(byte_of(n2.xy, i)), f32(byte_of(n3.xy, i)), f32(byte_of(n4.xy, i)));
+        let hi = vec3<f32>(f32(byte_of(n2.zw, i)), f32(byte_of(n3.zw, i)), f32(byte_of(n4.zw, i)));
+        let near = select(lo, hi, negative) * scale + offset - pad;
+        let far = select(hi, lo, negative) * scale + offset + pad;
+        let t0 = max(max(near.x, near.y), max(near.z, ray.tmin));
+        let t1 = min(min(far.x, far.y), min(far.z, tmax));
+        if t0 <= t1 {
+            let inner = (child_meta & (child_meta << 1u) & 0x10u) != 0u;
+            let bit = select(child_meta & 0x1fu, (child_meta ^ oct_inv) & 0x1fu, inner);
+            mask |= (child_meta >> 5u) << bit;
+        }
+    }
+    return mask;
+}
+
+// 1/d with zero components replaced by a tiny value of the same sign, so slab distances stay
+// finite (a ray parallel to a slab is inside it iff its origin is).
+fn safe_inverse(d: vec3<f32>) -> vec3<f32> {
+    let tiny = vec3<f32>(1e-30);
+    return 1.0 / select(d, select(tiny, -tiny, d < vec3<f32>(0.0)), abs(d) < tiny);
+}
+
+// The closest hit (any_hit = false), or any hit (true, for shadow rays), in (tmin, tmax).
+fn bvh_trace(ray: Ray, any_hit: bool) -> Hit {
+    var hit = Hit(ray.tmax, 0.0, 0.0, NO_HIT);
+    let inv_dir = safe_inverse(ray.dir);
+    let sh = ray_shear(ray.dir);
+    // obvhs's octant code: 7 minus the octant, the traversal order's key.
+    let oct_inv = select(4u, 0u, ray.dir.x < 0.0) | select(2u, 0u, ray.dir.y < 0.0)
+        | select(1u, 0u, ray.dir.z < 0.0);
+    var stack: array<vec2<u32>, TRAVERSAL_STACK>;
+    var depth = 0u;
+    var nodes = vec2<u32>(0u, 0x80000000u);
+    var triangles = vec2<u32>(0u, 0u);
+    loop {
+        if (nodes.y & 0xff000000u) != 0u {
+            let hits_imask = nodes.y;
+            let bit = firstLeadingBit(hits_imask);
+            nodes.y &= ~(1u << bit);
+            if (nodes.y & 0xff000000u) != 0u {
+                stack[depth] = nodes;
+                depth += 1u;
+            }
+            let slot = (bit - 24u) ^ oct_inv;
+            let index = nodes.x + countOneBits(hits_imask & ~(0xffffffffu << slot));
+            let mask = node_hits(index, ray, inv_dir, oct_inv, hit.t);
+            let header = bvh_nodes[5u * index + 1u];
+            nodes = vec2<u32>(header.x, (mask & 0xff000000u) | (bvh_nodes[5u * index].w >> 24u));
+            triangles = vec2<u32>(header.y, mask & 0x00ffffffu);
+        }
+        while triangles.y != 0u {
+            let bit = firstTrailingBit(triangles.y);
+            triangles.y &= triangles.y - 1u;
+            let slot = triangles.x + bit;
+            let h = triangle_hit(slot, Ray(ray.origin, ray.dir, ray.tmin, hit.t), sh);
+            if h.w != 0.0 {
+                hit = Hit(h.x, h.y, h.z, slot);
+                if any_hit {
+                    return hit;
+                }
+            }
+        }
+        if (nodes.y & 0xff000000u) == 0u {
+            if depth == 0u {
+                break;
+            }
+            depth -= 1u;
+            nodes = stack[depth];
+        }
+    }
+    return hit;
+}

@@ -1,0 +1,55 @@
+// Traces the primary ray of every pixel through the lens and shades it Whitted-style; one
+// invocation per pixel, dispatched over the image in WORKGROUP_2D × WORKGROUP_2D tiles.
+// The same kernel serves every lens, pinhole included: only ray generation differs.
+#import lens
+#import shade
+
+override DIRECTION_SOURCE: u32;
+
+// Mirrors `fisheye_rt::trace::Frame`: the camera-to-world rotation's columns (camera x right,
+// y down, z forward). The scene is uploaded camera-relative, so rays start at the origin.
+struct Frame {
+    right: vec4<f32>,
+    down: vec4<f32>,
+    forward: vec4<f32>,
+}
+
+@group(0) @binding(0) var<uniform> lens: LensParams;
+@group(0) @binding(1) var<uniform> frame: Frame;
+// The direction table (read only when DIRECTION_SOURCE is DIRECTIONS_TABLE).
+@group(0) @binding(2) var<storage, read> table: array<vec4<f32>>;
+// Linear RGB radiance; w = 1 where the pixel has a ray, all zero where masked.
+@group(0) @binding(3) var<storage, read_write> colour_out: array<vec4<f32>>;
+// World-space shading normal and distance of the primary hit; zero on a miss or mask.
+@group(0) @binding(4) var<storage, read_write> geometry_out: array<vec4<f32>>;
+// Scene triangle of the primary hit; NO_HIT on a miss or mask.
+@group(0) @binding(5) var<storage, read_write> ids_out: array<u32>;
+
+@compute @workgroup_size(WORKGROUP_2D, WORKGROUP_2D)
+fn main(@builtin(global_invocation_id) id: vec3<u32>) {
+    if id.x >= lens.width || id.y >= lens.height {
+        return;
+    }
+    let index = id.y * lens.width + id.x;
+    var ray: vec4<f32>;
+    if DIRECTION_SOURCE == DIRECTIONS_TABLE {
+        ray = table[index];
+    } else {
+        ray = lens_pixel_ray(lens, id.xy);
+    }
+    if ray.w == 0.0 {
+        colour_out[index] = vec4<f32>(0.0);
+        geometry_out[index] = vec4<f32>(0.0);
+        ids_out[index] = NO_HIT;
+        return;
+    }
+    let dir = frame.right.xyz * ray.x + frame.down.xyz * ray.y + frame.forward.xyz * ray.z;
+    let traced = shade(Ray(vec3<f32>(0.0), dir, 0.0, 3.0e38));
+    colour_out[index] = vec4<f32>(traced.colour, 1.0);
+    if traced.triangle == NO_HIT {
+        geometry_out[index] = vec4<f32>(0.0);
+    } else {
+        geometry_out[index] = vec4<f32>(traced.normal, traced.hit.t);
+    }
+    ids_out[index] = traced.triangle;
+}
