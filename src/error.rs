@@ -93,6 +93,14 @@ pub enum Error {
     /// The device was lost (driver reset, GPU removed, or an earlier fatal error).
     #[error("the GPU device was lost: {0}")]
     DeviceLost(String),
+    /// An OBJ file that could not be loaded.
+    #[error("{path}: {message}")]
+    Obj {
+        /// The file.
+        path: std::path::PathBuf,
+        /// What went wrong.
+        message: String,
+    },
     /// A scene that cannot be rendered (with what is wrong).
     #[error("scene: {0}")]
     Scene(String),

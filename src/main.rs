@@ -33,7 +33,8 @@ enum Command {
     /// Render a scene through a lens by ray tracing; with no arguments, the built-in default
     /// scene through a 180° fisheye to fisheye.png.
     Render {
-        /// The scene: `builtin:NAME` (see `fisheye scenes`).
+        /// The scene: `builtin:NAME` (see `fisheye scenes`) or an OBJ file, framed from the
+        /// front with a headlight and a sun.
         #[arg(default_value = "builtin:default")]
         scene: String,
         /// Lens spec (see `fisheye lens list`).
@@ -211,14 +212,26 @@ fn run(cli: Cli) -> Result<()> {
     }
 }
 
+/// A scene from `builtin:NAME` or an OBJ file; warnings go to stderr.
 fn load_scene(spec: &str) -> Result<Scene> {
-    let Some(name) = spec.strip_prefix("builtin:") else {
-        bail!("scene {spec:?}: only built-in scenes (`builtin:NAME`) are supported yet");
-    };
-    builtin::scene(name).with_context(|| {
-        let names: Vec<&str> = builtin::SCENES.iter().map(|(n, _)| *n).collect();
-        format!("no built-in scene {name:?}; there are {}", names.join(", "))
-    })
+    if let Some(name) = spec.strip_prefix("builtin:") {
+        return builtin::scene(name).with_context(|| {
+            let names: Vec<&str> = builtin::SCENES.iter().map(|(n, _)| *n).collect();
+            format!("no built-in scene {name:?}; there are {}", names.join(", "))
+        });
+    }
+    let path = std::path::Path::new(spec);
+    if !path
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("obj"))
+    {
+        bail!("scene {spec:?}: expected `builtin:NAME` or an .obj file");
+    }
+    let loaded = fisheye_rt::scene::obj::load_obj(path)?;
+    for warning in &loaded.warnings {
+        eprintln!("warning: {warning}");
+    }
+    Ok(loaded.scene)
 }
 
 fn render(

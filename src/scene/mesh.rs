@@ -35,6 +35,21 @@ impl MeshBuilder {
         self.textures.len() as u32 - 1
     }
 
+    /// Number of materials so far.
+    pub fn material_count(&self) -> u32 {
+        self.materials.len() as u32
+    }
+
+    /// Number of textures so far.
+    pub fn texture_count(&self) -> u32 {
+        self.textures.len() as u32
+    }
+
+    /// The bounds of the triangles so far (`None` if there are none).
+    pub fn bounds(&self) -> Option<(DVec3, DVec3)> {
+        super::bounds(&self.triangles)
+    }
+
     /// Number of triangles so far.
     pub fn len(&self) -> usize {
         self.triangles.len()

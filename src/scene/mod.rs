@@ -5,6 +5,7 @@
 
 pub mod builtin;
 mod mesh;
+pub mod obj;
 
 use glam::{DMat3, DVec3, Vec2, Vec3};
 
@@ -179,9 +180,7 @@ impl Scene {
 
     /// The axis-aligned bounds of all triangles (`None` when empty).
     pub fn bounds(&self) -> Option<(DVec3, DVec3)> {
-        let mut corners = self.triangles.iter().flatten();
-        let first = *corners.next()?;
-        Some(corners.fold((first, first), |(lo, hi), p| (lo.min(*p), hi.max(*p))))
+        bounds(&self.triangles)
     }
 
     /// Which features the scene uses, for specialising kernels.
@@ -217,6 +216,13 @@ pub struct Features {
     pub textures: bool,
     /// Vertex normals are interpolated.
     pub smooth_normals: bool,
+}
+
+/// The axis-aligned bounds of some triangles (`None` when there are none).
+pub fn bounds(triangles: &[[DVec3; 3]]) -> Option<(DVec3, DVec3)> {
+    let mut corners = triangles.iter().flatten();
+    let first = *corners.next()?;
+    Some(corners.fold((first, first), |(lo, hi), p| (lo.min(*p), hi.max(*p))))
 }
 
 /// The vertex normal of a triangle's face (not normalized when degenerate).

@@ -1,0 +1,162 @@
+//! OBJ/MTL scenes: the shared real scenes (read from `../shared/scenes/`, never copied), their
+//! materials, the framing of bare OBJs, and bad files.
+
+mod common;
+
+use std::path::{Path, PathBuf};
+
+use common::{assert_agrees, both, camera, ctx};
+use fisheye_rt::scene::Surface;
+use fisheye_rt::scene::obj::load_obj;
+use fisheye_rt::trace::{RenderOptions, render};
+use glam::Vec3;
+
+fn shared(path: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../shared/scenes")
+        .join(path)
+}
+
+fn material<'a>(
+    scene: &'a fisheye_rt::scene::Scene,
+    name: &str,
+) -> &'a fisheye_rt::scene::Material {
+    scene.materials.iter().find(|m| m.name == name).unwrap()
+}
+
+#[test]
+fn cornell_box_materials_come_from_the_mtl() {
+    let original = load_obj(&shared("cornell_box/CornellBox-Original.obj")).unwrap();
+    assert!(original.warnings.is_empty(), "{:?}", original.warnings);
+    assert_eq!(original.scene.len(), 36);
+    assert_eq!(
+        material(&original.scene, "light").emission,
+        Vec3::new(17.0, 12.0, 4.0)
+    );
+    assert_eq!(
+        material(&original.scene, "leftWall").diffuse,
+        Vec3::new(0.63, 0.065, 0.05)
+    );
+
+    let spheres = load_obj(&shared("cornell_box/CornellBox-Sphere.obj"))
+        .unwrap()
+        .scene;
+    let mirror = material(&spheres, "leftSphere");
+    assert_eq!(
+        (mirror.surface, mirror.specular),
+        (Surface::Mirror, Vec3::splat(0.95))
+    );
+    let glass = material(&spheres, "rightSphere");
+    assert_eq!(glass.surface, Surface::Glass);
+    assert_eq!((glass.ior, glass.transmission), (2.5, Vec3::splat(0.1)));
+    assert!(
+        spheres.normals.is_some(),
+        "the sphere box has vertex normals"
+    );
+}
+
+/// The Cornell box with a mirror and a glass sphere, GPU against the reference.
+#[test]
+fn cornell_spheres_match_the_reference() {
+    let scene = load_obj(&shared("cornell_box/CornellBox-Sphere.obj"))
+        .unwrap()
+        .scene;
+    let (gpu, cpu) = both(&scene, &camera("equisolid:f=0.6", 128, 96));
+    // Measured: 2,099 of 12,288 pixels see the box.
+    assert!(gpu.counts().1 > 1500);
+    assert_agrees("Cornell spheres", &gpu, &cpu);
+}
+
+/// A bare OBJ in its own units (the bunny is 0.15 m tall, 0.1 m off the origin) is framed:
+/// every corner of its bounding box is in front of the camera and inside a 180° image.
+#[test]
+fn bare_obj_is_framed_whatever_its_units() {
+    let loaded = load_obj(&shared("scanned/stanford-bunny.obj")).unwrap();
+    let scene = loaded.scene;
+    assert_eq!(scene.len(), 69_451);
+    let (lo, hi) = scene.bounds().unwrap();
+    let to_camera = scene.camera.rotation().transpose();
+    let cam = camera("canon-8-15mm@8mm", 256, 192);
+    for k in 0..8 {
+        let corner = glam::DVec3::new(
+            if k & 1 == 0 { lo.x } else { hi.x },
+            if k & 2 == 0 { lo.y } else { hi.y },
+            if k & 4 == 0 { lo.z } else { hi.z },
+        );
+        let dir = to_camera * (corner - scene.camera.position);
+        assert!(dir.z > 0.0, "corner {corner} is behind the camera");
+        assert!(
+            cam.project(dir).is_some(),
+            "corner {corner} is outside the image"
+        );
+    }
+    let out = render(ctx(), &scene, &cam, &RenderOptions::default()).unwrap();
+    // Measured: about 1,700 of 49,152 pixels.
+    assert!(
+        out.counts().1 > 1000,
+        "the bunny covers too little of the image"
+    );
+}
+
+fn write(dir: &Path, name: &str, text: &str) -> PathBuf {
+    std::fs::create_dir_all(dir).unwrap();
+    let path = dir.join(name);
+    std::fs::write(&path, text).unwrap();
+    path
+}
+
+#[test]
+fn bad_obj_files_are_errors_or_warnings_naming_the_problem() {
+    let dir = std::env::temp_dir().join(format!("fisheye-obj-test-{}", std::process::id()));
+    // A missing file names itself.
+    let missing = dir.join("missing.obj");
+    let message = load_obj(&missing).err().unwrap().to_string();
+    assert!(
+        message.contains("missing.obj") && message.contains("cannot open"),
+        "{message}"
+    );
+
+    // A face that indexes a vertex that does not exist.
+    let bad = write(&dir, "bad.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 9\n");
+    let message = load_obj(&bad).err().unwrap().to_string();
+    assert!(message.contains("bad.obj"), "{message}");
+
+    // A missing MTL and a missing texture warn and fall back; non-finite vertices are dropped
+    // with a warning naming the mesh.
+    write(
+        &dir,
+        "tex.mtl",
+        "newmtl t\nKd 0.5 0.5 0.5\nmap_Kd nowhere.png\n",
+    );
+    let obj = write(
+        &dir,
+        "warn.obj",
+        "mtllib tex.mtl\no good\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl t\nf 1 2 3\n\
+         o broken\nv nan 0 0\nv 1 1 0\nv 0 1 1\nf 4 5 6\n",
+    );
+    let loaded = load_obj(&obj).unwrap();
+    assert_eq!(loaded.scene.len(), 1);
+    let text = loaded.warnings.join("\n");
+    assert!(
+        text.contains("nowhere.png") && text.contains("using Kd"),
+        "{text}"
+    );
+    assert!(
+        text.contains("\"broken\"") && text.contains("non-finite"),
+        "{text}"
+    );
+    assert_eq!(material(&loaded.scene, "t").diffuse_texture, None);
+
+    let no_mtl = write(
+        &dir,
+        "nomtl.obj",
+        "mtllib gone.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n",
+    );
+    let loaded = load_obj(&no_mtl).unwrap();
+    assert!(
+        loaded.warnings.join("\n").contains("MTL"),
+        "{:?}",
+        loaded.warnings
+    );
+    std::fs::remove_dir_all(dir).unwrap();
+}
