@@ -5,10 +5,10 @@
 use std::path::Path;
 
 use crate::error::{Error, Result};
-use crate::gpu::GpuContext;
+use crate::gpu::{GpuContext, dispatch_over_image, storage_entry, uniform_entry};
 use crate::lens::LensCamera;
 use crate::lens::gpu::{DirectionSource, LensRays, lens_constants, params_buffer};
-use crate::shader::{self, WORKGROUP_2D};
+use crate::shader;
 
 /// The demo pass for one camera: owns its pipeline, layout, output and (for the table
 /// source) the direction table, computed once at creation.
@@ -19,35 +19,13 @@ pub struct LensDemo {
     camera: LensCamera,
 }
 
-fn storage_entry(binding: u32, read_only: bool) -> wgpu::BindGroupLayoutEntry {
-    wgpu::BindGroupLayoutEntry {
-        binding,
-        visibility: wgpu::ShaderStages::COMPUTE,
-        ty: wgpu::BindingType::Buffer {
-            ty: wgpu::BufferBindingType::Storage { read_only },
-            has_dynamic_offset: false,
-            min_binding_size: None,
-        },
-        count: None,
-    }
-}
-
 impl LensDemo {
     /// Creates the pass; with [`DirectionSource::Table`] also computes the table (one
     /// [`LensRays`] dispatch, submitted here, not per frame).
     pub fn new(ctx: &GpuContext, camera: &LensCamera, source: DirectionSource) -> Result<Self> {
         let bytes = 4 * camera.size.pixels() as u64;
         ctx.check_binding("the demo image", bytes)?;
-        let table = match source {
-            DirectionSource::Table => {
-                let rays = LensRays::new(ctx, camera)?;
-                let mut encoder = ctx.device.create_command_encoder(&Default::default());
-                rays.encode(&mut encoder, None);
-                ctx.queue.submit([encoder.finish()]);
-                Some(rays)
-            }
-            DirectionSource::Computed => None,
-        };
+        let table = LensRays::for_source(ctx, camera, source)?;
         ctx.checked("creating the lens demo", || {
             let device = &ctx.device;
             // Declared in binding order, matching wgsl/lens_demo.wgsl. Explicit, because the
@@ -55,16 +33,7 @@ impl LensDemo {
             let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
                 label: Some("fisheye.lens_demo"),
                 entries: &[
-                    wgpu::BindGroupLayoutEntry {
-                        binding: 0,
-                        visibility: wgpu::ShaderStages::COMPUTE,
-                        ty: wgpu::BindingType::Buffer {
-                            ty: wgpu::BufferBindingType::Uniform,
-                            has_dynamic_offset: false,
-                            min_binding_size: None,
-                        },
-                        count: None,
-                    },
+                    uniform_entry(0),
                     storage_entry(1, true),
                     storage_entry(2, false),
                 ],
@@ -143,16 +112,13 @@ impl LensDemo {
         encoder: &mut wgpu::CommandEncoder,
         timestamp_writes: Option<wgpu::ComputePassTimestampWrites<'_>>,
     ) {
-        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
-            label: Some("fisheye.lens_demo"),
+        dispatch_over_image(
+            encoder,
+            "fisheye.lens_demo",
+            &self.pipeline,
+            &[&self.bind_group],
+            self.camera.size,
             timestamp_writes,
-        });
-        pass.set_pipeline(&self.pipeline);
-        pass.set_bind_group(0, &self.bind_group, &[]);
-        pass.dispatch_workgroups(
-            self.camera.size.width.div_ceil(WORKGROUP_2D),
-            self.camera.size.height.div_ceil(WORKGROUP_2D),
-            1,
         );
     }
 

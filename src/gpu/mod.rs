@@ -9,6 +9,51 @@ pub use timing::Queries;
 
 use crate::error::{Error, Result};
 
+/// A compute-visible storage buffer entry of a bind group layout.
+pub fn storage_entry(binding: u32, read_only: bool) -> wgpu::BindGroupLayoutEntry {
+    buffer_entry(binding, wgpu::BufferBindingType::Storage { read_only })
+}
+
+/// A compute-visible uniform buffer entry of a bind group layout.
+pub fn uniform_entry(binding: u32) -> wgpu::BindGroupLayoutEntry {
+    buffer_entry(binding, wgpu::BufferBindingType::Uniform)
+}
+
+fn buffer_entry(binding: u32, ty: wgpu::BufferBindingType) -> wgpu::BindGroupLayoutEntry {
+    wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility: wgpu::ShaderStages::COMPUTE,
+        ty: wgpu::BindingType::Buffer {
+            ty,
+            has_dynamic_offset: false,
+            min_binding_size: None,
+        },
+        count: None,
+    }
+}
+
+/// Records one compute pass that runs `pipeline` once per pixel of `size`, in
+/// `WORKGROUP_2D`-square tiles, with `bind_groups` at groups 0, 1, ...
+pub fn dispatch_over_image(
+    encoder: &mut wgpu::CommandEncoder,
+    label: &str,
+    pipeline: &wgpu::ComputePipeline,
+    bind_groups: &[&wgpu::BindGroup],
+    size: crate::lens::ImageSize,
+    timestamp_writes: Option<wgpu::ComputePassTimestampWrites<'_>>,
+) {
+    let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+        label: Some(label),
+        timestamp_writes,
+    });
+    pass.set_pipeline(pipeline);
+    for (index, group) in bind_groups.iter().enumerate() {
+        pass.set_bind_group(index as u32, *group, &[]);
+    }
+    let tile = crate::shader::WORKGROUP_2D;
+    pass.dispatch_workgroups(size.width.div_ceil(tile), size.height.div_ceil(tile), 1);
+}
+
 /// Optional device features the project uses when the adapter has them.
 pub const OPTIONAL_FEATURES: [(wgpu::Features, &str); 5] = [
     (wgpu::Features::TIMESTAMP_QUERY, "timestamp queries"),

@@ -8,8 +8,8 @@ use wgpu::util::DeviceExt;
 
 use super::{Family, LensCamera, LensModel};
 use crate::error::Result;
-use crate::gpu::GpuContext;
-use crate::shader::{self, WORKGROUP_1D, WORKGROUP_2D};
+use crate::gpu::{GpuContext, dispatch_over_image};
+use crate::shader::{self, WORKGROUP_1D};
 
 /// Which WGSL code path a lens runs: the `LENS_KIND` override. The classic models keep their
 /// own closed forms; `General*` are the trigonometric paths of the general form.
@@ -246,22 +246,37 @@ impl LensRays {
         })
     }
 
+    /// The table a kernel reading directions from `source` needs: for
+    /// [`DirectionSource::Table`] it is computed here, once (the pass is submitted); for
+    /// [`DirectionSource::Computed`] there is none.
+    pub fn for_source(
+        ctx: &GpuContext,
+        camera: &LensCamera,
+        source: DirectionSource,
+    ) -> Result<Option<Self>> {
+        if source == DirectionSource::Computed {
+            return Ok(None);
+        }
+        let rays = Self::new(ctx, camera)?;
+        let mut encoder = ctx.device.create_command_encoder(&Default::default());
+        rays.encode(&mut encoder, None);
+        ctx.queue.submit([encoder.finish()]);
+        Ok(Some(rays))
+    }
+
     /// Records the pass, optionally timed.
     pub fn encode(
         &self,
         encoder: &mut wgpu::CommandEncoder,
         timestamp_writes: Option<wgpu::ComputePassTimestampWrites<'_>>,
     ) {
-        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
-            label: Some("fisheye.lens_rays"),
+        dispatch_over_image(
+            encoder,
+            "fisheye.lens_rays",
+            &self.pipeline,
+            &[&self.bind_group],
+            self.camera.size,
             timestamp_writes,
-        });
-        pass.set_pipeline(&self.pipeline);
-        pass.set_bind_group(0, &self.bind_group, &[]);
-        pass.dispatch_workgroups(
-            self.camera.size.width.div_ceil(WORKGROUP_2D),
-            self.camera.size.height.div_ceil(WORKGROUP_2D),
-            1,
         );
     }
 

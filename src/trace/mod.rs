@@ -13,11 +13,11 @@ pub use output::RenderOutput;
 
 use crate::bvh::{BvhQuality, SceneBvh};
 use crate::error::{Error, Result};
-use crate::gpu::GpuContext;
+use crate::gpu::{GpuContext, dispatch_over_image, storage_entry, uniform_entry};
 use crate::lens::LensCamera;
 use crate::lens::gpu::{DirectionSource, LensRays, lens_constants, params_buffer};
 use crate::scene::{Features, Light, Scene, Surface};
-use crate::shader::{self, WORKGROUP_2D};
+use crate::shader;
 
 /// The deepest Whitted recursion a kernel can run (its ray stack has one more entry).
 pub const MAX_DEPTH_LIMIT: u32 = 8;
@@ -140,32 +140,6 @@ pub fn shading_vertices(scene: &Scene, features: Features) -> Vec<[f32; 4]> {
         }
     }
     out
-}
-
-fn storage_entry(binding: u32, read_only: bool) -> wgpu::BindGroupLayoutEntry {
-    wgpu::BindGroupLayoutEntry {
-        binding,
-        visibility: wgpu::ShaderStages::COMPUTE,
-        ty: wgpu::BindingType::Buffer {
-            ty: wgpu::BufferBindingType::Storage { read_only },
-            has_dynamic_offset: false,
-            min_binding_size: None,
-        },
-        count: None,
-    }
-}
-
-fn uniform_entry(binding: u32) -> wgpu::BindGroupLayoutEntry {
-    wgpu::BindGroupLayoutEntry {
-        binding,
-        visibility: wgpu::ShaderStages::COMPUTE,
-        ty: wgpu::BindingType::Buffer {
-            ty: wgpu::BufferBindingType::Uniform,
-            has_dynamic_offset: false,
-            min_binding_size: None,
-        },
-        count: None,
-    }
 }
 
 /// A storage buffer holding `data`, or one zero element where `data` is empty (bindings may
@@ -364,16 +338,7 @@ impl TracePass {
         ] {
             ctx.check_binding(what, bytes)?;
         }
-        let table = match source {
-            DirectionSource::Table => {
-                let rays = LensRays::new(ctx, camera)?;
-                let mut encoder = ctx.device.create_command_encoder(&Default::default());
-                rays.encode(&mut encoder, None);
-                ctx.queue.submit([encoder.finish()]);
-                Some(rays)
-            }
-            DirectionSource::Computed => None,
-        };
+        let table = LensRays::for_source(ctx, camera, source)?;
         ctx.checked("creating the trace pass", || {
             let device = &ctx.device;
             let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
@@ -466,17 +431,13 @@ impl TracePass {
         scene: &GpuScene,
         timestamp_writes: Option<wgpu::ComputePassTimestampWrites<'_>>,
     ) {
-        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
-            label: Some("fisheye.trace"),
+        dispatch_over_image(
+            encoder,
+            "fisheye.trace",
+            &self.pipeline,
+            &[&self.bind_group, &scene.bind_group],
+            self.camera.size,
             timestamp_writes,
-        });
-        pass.set_pipeline(&self.pipeline);
-        pass.set_bind_group(0, &self.bind_group, &[]);
-        pass.set_bind_group(1, &scene.bind_group, &[]);
-        pass.dispatch_workgroups(
-            self.camera.size.width.div_ceil(WORKGROUP_2D),
-            self.camera.size.height.div_ceil(WORKGROUP_2D),
-            1,
         );
     }
 
