@@ -40,24 +40,8 @@ impl LensDemo {
             });
             let mut constants = lens_constants(camera).to_vec();
             constants.push(("DIRECTION_SOURCE", f64::from(source as u32)));
-            let module = shader::module(device, "lens_demo");
-            let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-                label: Some("fisheye.lens_demo"),
-                layout: Some(
-                    &device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-                        label: Some("fisheye.lens_demo"),
-                        bind_group_layouts: &[Some(&layout)],
-                        immediate_size: 0,
-                    }),
-                ),
-                module: &module,
-                entry_point: Some("main"),
-                compilation_options: wgpu::PipelineCompilationOptions {
-                    constants: &constants,
-                    ..Default::default()
-                },
-                cache: None,
-            });
+            let pipeline =
+                shader::compute_pipeline(device, "lens_demo", "main", &constants, &[&layout]);
             let pixels = device.create_buffer(&wgpu::BufferDescriptor {
                 label: Some("fisheye.lens_demo.pixels"),
                 size: bytes,

@@ -7,8 +7,7 @@ use wgpu::util::DeviceExt;
 
 use crate::error::Result;
 use crate::gpu::GpuContext;
-use crate::lens::gpu::compute_pipeline;
-use crate::shader::WORKGROUP_1D;
+use crate::shader::{WORKGROUP_1D, compute_pipeline};
 
 /// The largest absolute error of one function over its probed domain.
 #[derive(Clone, Debug)]
@@ -40,7 +39,7 @@ pub fn measure_trig(ctx: &GpuContext) -> Result<Vec<TrigError>> {
     let args = arguments();
     let values = ctx.checked("probing trigonometry", || {
         let device = &ctx.device;
-        let pipeline = compute_pipeline(device, "trig_probe", "main", &[]);
+        let pipeline = compute_pipeline(device, "trig_probe", "main", &[], &[]);
         let input = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("fisheye.trig_probe.args"),
             contents: bytemuck::cast_slice(&args),

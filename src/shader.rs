@@ -109,6 +109,40 @@ pub fn module(device: &wgpu::Device, entry: &str) -> wgpu::ShaderModule {
 /// Checks that the WGSL struct `name` of the module `file` has the given size and, in order,
 /// the given members at the given byte offsets (naga's layout): Rust structs that mirror WGSL
 /// ones call this with their `size_of` and `offset_of!`s.
+/// Creates the compute pipeline for `entry_point` of the WGSL file `file`, specialised by the
+/// override `constants`. With no `layouts` the layout is derived from the shader; passes whose
+/// kernels leave a binding unused in some specialisation give theirs explicitly, in group
+/// order.
+pub fn compute_pipeline(
+    device: &wgpu::Device,
+    file: &str,
+    entry_point: &str,
+    constants: &[(&str, f64)],
+    layouts: &[&wgpu::BindGroupLayout],
+) -> wgpu::ComputePipeline {
+    let label = format!("fisheye.{file}.{entry_point}");
+    let layout = (!layouts.is_empty()).then(|| {
+        let groups: Vec<Option<&wgpu::BindGroupLayout>> =
+            layouts.iter().map(|l| Some(*l)).collect();
+        device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some(&label),
+            bind_group_layouts: &groups,
+            immediate_size: 0,
+        })
+    });
+    device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+        label: Some(&label),
+        layout: layout.as_ref(),
+        module: &module(device, file),
+        entry_point: Some(entry_point),
+        compilation_options: wgpu::PipelineCompilationOptions {
+            constants,
+            ..Default::default()
+        },
+        cache: None,
+    })
+}
+
 #[cfg(test)]
 pub(crate) fn assert_wgsl_layout(file: &str, name: &str, size: usize, fields: &[(&str, usize)]) {
     let source = compose(file);

@@ -161,28 +161,6 @@ pub fn lens_constants(camera: &LensCamera) -> [(&'static str, f64); 2] {
     ]
 }
 
-/// Creates a compute pipeline for `entry_point` of the WGSL file `file`, with its layout
-/// derived from the shader and the given override constants.
-pub(crate) fn compute_pipeline(
-    device: &wgpu::Device,
-    file: &str,
-    entry_point: &str,
-    constants: &[(&str, f64)],
-) -> wgpu::ComputePipeline {
-    let module = shader::module(device, file);
-    device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-        label: Some(&format!("fisheye.{file}.{entry_point}")),
-        layout: None,
-        module: &module,
-        entry_point: Some(entry_point),
-        compilation_options: wgpu::PipelineCompilationOptions {
-            constants,
-            ..Default::default()
-        },
-        cache: None,
-    })
-}
-
 /// The uniform buffer holding a camera's [`LensParams`].
 pub(crate) fn params_buffer(device: &wgpu::Device, camera: &LensCamera) -> wgpu::Buffer {
     device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
@@ -215,7 +193,8 @@ impl LensRays {
         ctx.check_binding("the direction table", bytes)?;
         ctx.checked("creating the lens-rays pass", || {
             let device = &ctx.device;
-            let pipeline = compute_pipeline(device, "lens_rays", "main", &lens_constants(camera));
+            let pipeline =
+                shader::compute_pipeline(device, "lens_rays", "main", &lens_constants(camera), &[]);
             let directions = device.create_buffer(&wgpu::BufferDescriptor {
                 label: Some("fisheye.lens_rays.directions"),
                 size: bytes,
@@ -308,8 +287,20 @@ impl LensPoints {
         ctx.checked("creating the lens-points pass", || {
             let constants = lens_constants(camera);
             Self {
-                unproject: compute_pipeline(&ctx.device, "lens_points", "unproject", &constants),
-                project: compute_pipeline(&ctx.device, "lens_points", "project", &constants),
+                unproject: shader::compute_pipeline(
+                    &ctx.device,
+                    "lens_points",
+                    "unproject",
+                    &constants,
+                    &[],
+                ),
+                project: shader::compute_pipeline(
+                    &ctx.device,
+                    "lens_points",
+                    "project",
+                    &constants,
+                    &[],
+                ),
                 params: params_buffer(&ctx.device, camera),
             }
         })

@@ -116,6 +116,23 @@ pub enum Light {
     },
 }
 
+impl Light {
+    /// The light as the tracers see it, relative to `origin` and rounded to f32 once:
+    /// `(is_point, position or unit travel direction, intensity or irradiance)`.
+    pub fn relative_to(&self, origin: DVec3) -> (bool, Vec3, Vec3) {
+        match *self {
+            Light::Point {
+                position,
+                intensity,
+            } => (true, (position - origin).as_vec3(), intensity),
+            Light::Directional {
+                direction,
+                irradiance,
+            } => (false, direction.normalize().as_vec3(), irradiance),
+        }
+    }
+}
+
 /// Where the camera is and where it looks. World space is y up.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Camera {

@@ -9,7 +9,7 @@ use glam::{DMat3, DVec2, DVec3, Vec3};
 
 use super::{MAX_DEPTH_LIMIT, NO_HIT, RenderOutput};
 use crate::lens::LensCamera;
-use crate::scene::{Features, Light, Scene, Surface, Texture};
+use crate::scene::{Features, Scene, Surface, Texture};
 
 /// Rays whose weight falls below this are not traced (as in `wgsl/shade.wgsl`).
 const MIN_WEIGHT: f64 = 1e-3;
@@ -82,15 +82,9 @@ impl<'a> Reference<'a> {
         let lights = scene
             .lights
             .iter()
-            .map(|l| match *l {
-                Light::Point {
-                    position,
-                    intensity,
-                } => (true, round32(position - origin), v3(intensity)),
-                Light::Directional {
-                    direction,
-                    irradiance,
-                } => (false, round32(direction.normalize()), v3(irradiance)),
+            .map(|l| {
+                let (point, vector, colour) = l.relative_to(origin);
+                (point, vector.as_dvec3(), colour.as_dvec3())
             })
             .collect();
         let mut reference = Self {

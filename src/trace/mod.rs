@@ -16,7 +16,7 @@ use crate::error::{Error, Result};
 use crate::gpu::{GpuContext, dispatch_over_image, storage_entry, uniform_entry};
 use crate::lens::LensCamera;
 use crate::lens::gpu::{DirectionSource, LensRays, lens_constants, params_buffer};
-use crate::scene::{Features, Light, Scene, Surface};
+use crate::scene::{Features, Scene, Surface};
 use crate::shader;
 
 /// The deepest Whitted recursion a kernel can run (its ray stack has one more entry).
@@ -206,25 +206,18 @@ impl GpuScene {
         let lights: Vec<GpuLight> = scene
             .lights
             .iter()
-            .map(|l| match *l {
-                Light::Point {
-                    position,
-                    intensity,
-                } => GpuLight {
-                    vector: (position - origin).as_vec3().to_array(),
-                    kind: LIGHT_KINDS[0].1,
-                    colour: to3(intensity),
+            .map(|l| {
+                let (point, vector, colour) = l.relative_to(origin);
+                GpuLight {
+                    vector: vector.to_array(),
+                    kind: if point {
+                        LIGHT_KINDS[0].1
+                    } else {
+                        LIGHT_KINDS[1].1
+                    },
+                    colour: to3(colour),
                     pad: 0,
-                },
-                Light::Directional {
-                    direction,
-                    irradiance,
-                } => GpuLight {
-                    vector: direction.normalize().as_vec3().to_array(),
-                    kind: LIGHT_KINDS[1].1,
-                    colour: to3(irradiance),
-                    pad: 0,
-                },
+                }
             })
             .collect();
         let mut texture_info = Vec::new();
@@ -362,24 +355,13 @@ impl TracePass {
                 ("HAS_TEXTURES", flag(f.textures)),
                 ("SMOOTH_NORMALS", flag(f.smooth_normals)),
             ]);
-            let module = shader::module(device, "trace");
-            let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-                label: Some("fisheye.trace"),
-                layout: Some(
-                    &device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-                        label: Some("fisheye.trace"),
-                        bind_group_layouts: &[Some(&layout), Some(&scene.layout)],
-                        immediate_size: 0,
-                    }),
-                ),
-                module: &module,
-                entry_point: Some("main"),
-                compilation_options: wgpu::PipelineCompilationOptions {
-                    constants: &constants,
-                    ..Default::default()
-                },
-                cache: None,
-            });
+            let pipeline = shader::compute_pipeline(
+                device,
+                "trace",
+                "main",
+                &constants,
+                &[&layout, &scene.layout],
+            );
             let output = |label: &str, bytes: u64| {
                 device.create_buffer(&wgpu::BufferDescriptor {
                     label: Some(label),
