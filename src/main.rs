@@ -14,7 +14,7 @@ use fisheye_rt::lens::{
     DirectionFormula, ImageSize, LensCamera, LensModel, PRESET_FOV_DEGREES, PRESETS, parse_spec,
 };
 use fisheye_rt::scene::{Scene, builtin};
-use fisheye_rt::trace::{GpuScene, RenderOptions, TracePass};
+use fisheye_rt::trace::{Channel, GpuScene, RenderOptions, TracePass, world_directions};
 use glam::{DVec2, DVec3};
 
 #[derive(Parser)]
@@ -55,6 +55,10 @@ enum Command {
         /// The colour image (PNG; alpha is the validity mask).
         #[arg(long, short, default_value = "fisheye.png")]
         out: PathBuf,
+        /// Ground-truth arrays to write beside the image as OUT_STEM.NAME.npy: range (distance
+        /// to the primary hit), normal, id (triangle), direction (world-space ray), mask.
+        #[arg(long, value_enum, value_delimiter = ',')]
+        outputs: Vec<Output>,
     },
     /// List the built-in scenes.
     Scenes,
@@ -161,6 +165,27 @@ impl From<Quality> for BvhQuality {
 }
 
 #[derive(Clone, Copy, ValueEnum)]
+enum Output {
+    Range,
+    Normal,
+    Id,
+    Direction,
+    Mask,
+}
+
+impl From<Output> for Channel {
+    fn from(o: Output) -> Self {
+        match o {
+            Output::Range => Channel::Range,
+            Output::Normal => Channel::Normal,
+            Output::Id => Channel::Id,
+            Output::Direction => Channel::Direction,
+            Output::Mask => Channel::Mask,
+        }
+    }
+}
+
+#[derive(Clone, Copy, ValueEnum)]
 enum Directions {
     Computed,
     Table,
@@ -185,13 +210,15 @@ fn run(cli: Cli) -> Result<()> {
             bvh,
             directions,
             out,
+            outputs,
         } => {
             let options = RenderOptions {
                 max_depth,
                 bvh: bvh.into(),
                 directions: directions.into(),
             };
-            render(&scene, &lens, size, &options, &out)
+            let channels: Vec<Channel> = outputs.into_iter().map(Channel::from).collect();
+            render(&scene, &lens, size, &options, &out, &channels)
         }
         Command::Scenes => {
             for (name, what) in builtin::SCENES {
@@ -240,6 +267,7 @@ fn render(
     size: ImageSize,
     options: &RenderOptions,
     out: &std::path::Path,
+    channels: &[Channel],
 ) -> Result<()> {
     let started = Instant::now();
     let camera = LensCamera::new(parse_spec(lens_spec)?, size);
@@ -288,6 +316,14 @@ fn render(
         }
     }
     save_png(&output.to_image(), out)?;
+    if !channels.is_empty() {
+        let directions = world_directions(&camera, &scene.camera);
+        for channel in channels {
+            let path = out.with_extension(format!("{}.npy", channel.name()));
+            output.write_npy(*channel, &directions, &path)?;
+            println!("wrote {}", path.display());
+        }
+    }
     println!(
         "wrote {} ({:.1} s in all)",
         out.display(),

@@ -262,3 +262,60 @@ fn render_writes_a_masked_png_and_reports() {
         "{stderr}"
     );
 }
+
+fn npy<T: npyz::Deserialize>(path: &std::path::Path) -> (Vec<u64>, Vec<T>) {
+    let bytes = std::fs::read(path).unwrap();
+    let file = npyz::NpyFile::new(&bytes[..]).unwrap();
+    let shape = file.shape().to_vec();
+    (shape, file.into_vec().unwrap())
+}
+
+/// `--outputs` writes ground truth through the lens as NPY, consistent across channels and
+/// with the PNG's mask.
+#[test]
+fn render_writes_ground_truth_arrays() {
+    let dir = std::env::temp_dir().join(format!("fisheye-npy-{}", std::process::id()));
+    let png = dir.join("view.png");
+    let args = [
+        "render",
+        "--size",
+        "64x48",
+        "--out",
+        png.to_str().unwrap(),
+        "--outputs",
+        "range,normal,id,direction,mask",
+    ];
+    stdout(&fisheye(&args, ""));
+    let (shape, range) = npy::<f32>(&dir.join("view.range.npy"));
+    assert_eq!(shape, [48, 64]);
+    let (shape, normal) = npy::<f32>(&dir.join("view.normal.npy"));
+    assert_eq!(shape, [48, 64, 3]);
+    let (_, ids) = npy::<u32>(&dir.join("view.id.npy"));
+    let (shape, direction) = npy::<f32>(&dir.join("view.direction.npy"));
+    assert_eq!(shape, [48, 64, 3]);
+    let (_, mask) = npy::<u8>(&dir.join("view.mask.npy"));
+    let image = image::open(&png).unwrap().to_rgba8();
+    for (i, alpha) in image.pixels().map(|p| p[3]).enumerate() {
+        assert_eq!(mask[i], u8::from(alpha == 255), "mask at {i}");
+        let d = &direction[3 * i..3 * i + 3];
+        let n = &normal[3 * i..3 * i + 3];
+        let length = |v: &[f32]| v.iter().map(|x| x * x).sum::<f32>().sqrt();
+        if mask[i] == 1 {
+            assert!((length(d) - 1.0).abs() < 1e-6, "direction at {i}");
+        } else {
+            assert_eq!(length(d), 0.0);
+            assert_eq!(ids[i], u32::MAX);
+        }
+        // The default room is closed: every ray hits, at a positive range, with a unit normal.
+        if ids[i] != u32::MAX {
+            assert!(
+                range[i] > 0.0 && (length(n) - 1.0).abs() < 1e-5,
+                "hit at {i}"
+            );
+        } else {
+            assert_eq!(range[i], 0.0);
+        }
+    }
+    assert!(mask.iter().filter(|&&m| m == 1).count() > 500);
+    std::fs::remove_dir_all(dir).unwrap();
+}

@@ -9,7 +9,7 @@ use bytemuck::{Pod, Zeroable};
 use glam::DVec3;
 use wgpu::util::DeviceExt;
 
-pub use output::RenderOutput;
+pub use output::{Channel, RenderOutput};
 
 use crate::bvh::{BvhQuality, SceneBvh};
 use crate::error::{Error, Result};
@@ -432,6 +432,17 @@ impl TracePass {
             ids: ctx.read_buffer(&self.ids)?,
         })
     }
+}
+
+/// The world-space direction of every pixel's ray (f64 lens model, rotated by the pose),
+/// row-major, `None` where the lens masks the pixel.
+pub fn world_directions(camera: &LensCamera, pose: &crate::scene::Camera) -> Vec<Option<DVec3>> {
+    let rotation = pose.rotation();
+    camera
+        .directions()
+        .into_iter()
+        .map(|d| d.map(|d| rotation * d))
+        .collect()
 }
 
 /// Renders `scene` through `camera` in one call: builds and uploads the scene, traces one

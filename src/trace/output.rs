@@ -1,5 +1,10 @@
 //! What a render produces: radiance, the primary hit's geometry and ids, per pixel.
 
+use std::path::Path;
+
+use glam::DVec3;
+
+use crate::error::{Error, Result};
 use crate::lens::ImageSize;
 
 use super::NO_HIT;
@@ -61,5 +66,98 @@ impl RenderOutput {
         let valid = (0..self.colour.len()).filter(|&i| self.valid(i)).count();
         let hits = self.ids.iter().filter(|&&id| id != NO_HIT).count();
         (valid, hits)
+    }
+}
+
+/// A per-pixel array `fisheye render --outputs` can write beside the image, as NPY (row-major,
+/// image rows first; float32 unless noted).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Channel {
+    /// Euclidean distance from the camera to the primary hit, H×W; 0 on a miss or mask.
+    Range,
+    /// World-space shading normal at the primary hit, H×W×3; zero on a miss or mask.
+    Normal,
+    /// Scene triangle index of the primary hit, H×W uint32; 0xffffffff on a miss or mask.
+    Id,
+    /// World-space unit direction of the pixel's ray (f64 lens model), H×W×3; zero where masked.
+    Direction,
+    /// 1 where the pixel has a ray, 0 where the lens masks it, H×W uint8.
+    Mask,
+}
+
+impl Channel {
+    /// Every channel, in the order `--outputs` lists them.
+    pub const ALL: [Channel; 5] = [
+        Self::Range,
+        Self::Normal,
+        Self::Id,
+        Self::Direction,
+        Self::Mask,
+    ];
+
+    /// The name on the command line and in file names.
+    pub fn name(&self) -> &'static str {
+        match self {
+            Self::Range => "range",
+            Self::Normal => "normal",
+            Self::Id => "id",
+            Self::Direction => "direction",
+            Self::Mask => "mask",
+        }
+    }
+}
+
+fn write_array<T: npyz::Serialize + npyz::AutoSerialize>(
+    path: &Path,
+    shape: &[u64],
+    data: impl IntoIterator<Item = T>,
+) -> Result<()> {
+    let io = |source| Error::Io {
+        path: path.to_path_buf(),
+        source,
+    };
+    let file = std::fs::File::create(path).map_err(io)?;
+    use npyz::WriterBuilder;
+    let mut writer = npyz::WriteOptions::new()
+        .default_dtype()
+        .shape(shape)
+        .writer(std::io::BufWriter::new(file))
+        .begin_nd()
+        .map_err(io)?;
+    writer.extend(data).map_err(io)?;
+    writer.finish().map_err(io)
+}
+
+impl RenderOutput {
+    /// Writes one channel as an NPY file. `directions` gives each pixel's world-space ray
+    /// direction (`None` where masked) and is needed only for [`Channel::Direction`].
+    pub fn write_npy(
+        &self,
+        channel: Channel,
+        directions: &[Option<DVec3>],
+        path: &Path,
+    ) -> Result<()> {
+        let (h, w) = (u64::from(self.size.height), u64::from(self.size.width));
+        match channel {
+            Channel::Range => write_array(path, &[h, w], self.geometry.iter().map(|g| g[3])),
+            Channel::Normal => write_array(
+                path,
+                &[h, w, 3],
+                self.geometry.iter().flat_map(|g| [g[0], g[1], g[2]]),
+            ),
+            Channel::Id => write_array(path, &[h, w], self.ids.iter().copied()),
+            Channel::Direction => write_array(
+                path,
+                &[h, w, 3],
+                directions
+                    .iter()
+                    .flat_map(|d| d.unwrap_or(DVec3::ZERO).as_vec3().to_array()),
+            ),
+            Channel::Mask => write_array(
+                path,
+                &[h, w],
+                self.colour.iter().map(|c| u8::from(c[3] == 1.0)),
+            ),
+        }
     }
 }
