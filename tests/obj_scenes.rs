@@ -11,10 +11,19 @@ use fisheye_rt::scene::obj::load_obj;
 use fisheye_rt::trace::{RenderOptions, render};
 use glam::Vec3;
 
+/// A file of the shared scenes beside the repository (CI clones the repository with `shared/`
+/// beside it); a clear failure if it is not there.
 fn shared(path: &str) -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
+    let file = Path::new(env!("CARGO_MANIFEST_DIR"))
         .join("../shared/scenes")
-        .join(path)
+        .join(path);
+    assert!(
+        file.exists(),
+        "{} is missing: these tests read the shared scenes from ../shared/scenes/ beside the \
+         repository (see its README)",
+        file.display()
+    );
+    file
 }
 
 fn material<'a>(
