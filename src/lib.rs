@@ -7,14 +7,28 @@
 //!   and their WGSL twin on the GPU ([`lens::gpu`]).
 //! - [`gpu`]: the one place that creates the adapter and device.
 //! - [`shader`]: how WGSL files are assembled into modules.
+//! - [`scene`], [`bvh`], [`trace`]: scenes (built-in and OBJ), the CWBVH, and the GPU tracer
+//!   with its f64 reference.
 //!
-//! ```no_run
-//! use fisheye_rt::{gpu::GpuContext, lens::{parse_spec, ImageSize, LensCamera}, lens::gpu::LensRays};
+//! Rendering a scene through a lens takes a few lines (this example runs in the tests, on
+//! lavapipe when there is no GPU):
+//!
+//! ```
+//! use fisheye_rt::gpu::GpuContext;
+//! use fisheye_rt::lens::{parse_spec, ImageSize, LensCamera};
+//! use fisheye_rt::scene::builtin;
+//! use fisheye_rt::trace::{render, RenderOptions, NO_HIT};
+//!
 //! # fn main() -> Result<(), fisheye_rt::Error> {
-//! let camera = LensCamera::new(parse_spec("samyang-7.5mm")?, ImageSize::new(1024, 768)?);
-//! let ctx = GpuContext::new()?;
-//! let directions = LensRays::new(&ctx, &camera)?.compute(&ctx)?; // one Option<Vec3> per pixel
-//! assert_eq!(directions.len(), 1024 * 768);
+//! let scene = builtin::scene("default").expect("a built-in scene"); // or scene::obj::load_obj
+//! let camera = LensCamera::new(parse_spec("samyang-7.5mm")?, ImageSize::new(64, 48)?);
+//! let ctx = GpuContext::new()?; // the one place a device is made
+//! let frame = render(&ctx, &scene, &camera, &RenderOptions::default())?;
+//! let png = frame.to_image(); // sRGB, alpha = the lens's validity mask; png.save(path) writes it
+//! assert_eq!(png.dimensions(), (64, 48));
+//! // Per pixel: linear radiance, the primary hit's normal and range, its triangle id.
+//! assert_eq!(frame.ids.len(), 64 * 48);
+//! assert!(frame.ids.iter().all(|&id| id != NO_HIT)); // the room is closed
 //! # Ok(()) }
 //! ```
 
