@@ -28,8 +28,9 @@ impl LensDemo {
         let table = LensRays::for_source(ctx, camera, source)?;
         ctx.checked("creating the lens demo", || {
             let device = &ctx.device;
-            // Declared in binding order, matching wgsl/lens_demo.wgsl. Explicit, because the
-            // table binding is dead code when directions are computed.
+            // Declared in binding order: lens and table (wgsl/primary.wgsl), then the pixels
+            // (wgsl/lens_demo.wgsl). Explicit, because the table binding is dead code when
+            // directions are computed.
             let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
                 label: Some("fisheye.lens_demo"),
                 entries: &[

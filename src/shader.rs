@@ -11,12 +11,13 @@ use crate::scene::Surface;
 use crate::trace;
 
 /// Every WGSL file of the project, by name (its file stem under `wgsl/`).
-pub const FILES: [(&str, &str); 9] = [
+pub const FILES: [(&str, &str); 10] = [
     ("math", include_str!("../wgsl/math.wgsl")),
     ("bvh", include_str!("../wgsl/bvh.wgsl")),
     ("shade", include_str!("../wgsl/shade.wgsl")),
     ("trace", include_str!("../wgsl/trace.wgsl")),
     ("lens", include_str!("../wgsl/lens.wgsl")),
+    ("primary", include_str!("../wgsl/primary.wgsl")),
     ("lens_rays", include_str!("../wgsl/lens_rays.wgsl")),
     ("lens_points", include_str!("../wgsl/lens_points.wgsl")),
     ("lens_demo", include_str!("../wgsl/lens_demo.wgsl")),

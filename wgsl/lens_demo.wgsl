@@ -3,13 +3,8 @@
 // dispatched over the image in WORKGROUP_2D × WORKGROUP_2D tiles. Directions are computed per
 // pixel or read from the direction table (the DIRECTION_SOURCE override), which is what the
 // lens benchmark compares.
-#import lens
+#import primary
 
-override DIRECTION_SOURCE: u32;
-
-@group(0) @binding(0) var<uniform> lens: LensParams;
-// The direction table of `lens_rays.wgsl`; read only when DIRECTION_SOURCE is DIRECTIONS_TABLE.
-@group(0) @binding(1) var<storage, read> table: array<vec4<f32>>;
 // RGBA8 pixels, row-major.
 @group(0) @binding(2) var<storage, read_write> pixels: array<u32>;
 
@@ -49,12 +44,6 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     if id.x >= lens.width || id.y >= lens.height {
         return;
     }
-    let index = id.y * lens.width + id.x;
-    var ray: vec4<f32>;
-    if DIRECTION_SOURCE == DIRECTIONS_TABLE {
-        ray = table[index];
-    } else {
-        ray = lens_pixel_ray(lens, id.xy);
-    }
-    pixels[index] = pack4x8unorm(vec4<f32>(clamp(shade(ray), vec3<f32>(0.0), vec3<f32>(1.0)), 1.0));
+    let colour = clamp(shade(primary_ray(id.xy)), vec3<f32>(0.0), vec3<f32>(1.0));
+    pixels[id.y * lens.width + id.x] = pack4x8unorm(vec4<f32>(colour, 1.0));
 }

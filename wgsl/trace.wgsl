@@ -1,10 +1,8 @@
 // Traces the primary ray of every pixel through the lens and shades it Whitted-style; one
 // invocation per pixel, dispatched over the image in WORKGROUP_2D × WORKGROUP_2D tiles.
 // The same kernel serves every lens, pinhole included: only ray generation differs.
-#import lens
+#import primary
 #import shade
-
-override DIRECTION_SOURCE: u32;
 
 // Mirrors `fisheye_rt::trace::Frame`: the camera-to-world rotation's columns (camera x right,
 // y down, z forward). The scene is uploaded camera-relative, so rays start at the origin.
@@ -14,10 +12,7 @@ struct Frame {
     forward: vec4<f32>,
 }
 
-@group(0) @binding(0) var<uniform> lens: LensParams;
-@group(0) @binding(1) var<uniform> frame: Frame;
-// The direction table (read only when DIRECTION_SOURCE is DIRECTIONS_TABLE).
-@group(0) @binding(2) var<storage, read> table: array<vec4<f32>>;
+@group(0) @binding(2) var<uniform> frame: Frame;
 // Linear RGB radiance; w = 1 where the pixel has a ray, all zero where masked.
 @group(0) @binding(3) var<storage, read_write> colour_out: array<vec4<f32>>;
 // World-space shading normal and distance of the primary hit; zero on a miss or mask.
@@ -31,12 +26,7 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
         return;
     }
     let index = id.y * lens.width + id.x;
-    var ray: vec4<f32>;
-    if DIRECTION_SOURCE == DIRECTIONS_TABLE {
-        ray = table[index];
-    } else {
-        ray = lens_pixel_ray(lens, id.xy);
-    }
+    let ray = primary_ray(id.xy);
     if ray.w == 0.0 {
         colour_out[index] = vec4<f32>(0.0);
         geometry_out[index] = vec4<f32>(0.0);

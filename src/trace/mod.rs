@@ -336,10 +336,11 @@ impl TracePass {
             let device = &ctx.device;
             let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
                 label: Some("fisheye.trace.frame"),
+                // Lens and table as wgsl/primary.wgsl declares them, then the frame.
                 entries: &[
                     uniform_entry(0),
-                    uniform_entry(1),
-                    storage_entry(2, true),
+                    storage_entry(1, true),
+                    uniform_entry(2),
                     storage_entry(3, false),
                     storage_entry(4, false),
                     storage_entry(5, false),
@@ -381,7 +382,7 @@ impl TracePass {
             let placeholder = output("fisheye.trace.no_table", 16);
             let table = table.as_ref().map_or(&placeholder, |t| &t.directions);
             let lens = params_buffer(device, camera);
-            let resources = [&lens, &frame, table, &colour, &geometry, &ids];
+            let resources = [&lens, table, &frame, &colour, &geometry, &ids];
             let entries: Vec<_> = resources
                 .iter()
                 .enumerate()
