@@ -101,6 +101,14 @@ pub enum Error {
         /// What went wrong.
         message: String,
     },
+    /// A scene file (TOML) that could not be read, parsed or checked.
+    #[error("{path}: {message}")]
+    SceneFile {
+        /// The file.
+        path: std::path::PathBuf,
+        /// What went wrong, with the line and key where the parser knows them.
+        message: String,
+    },
     /// A scene that cannot be rendered (with what is wrong).
     #[error("scene: {0}")]
     Scene(String),

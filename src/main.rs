@@ -32,34 +32,7 @@ struct Cli {
 enum Command {
     /// Render a scene through a lens by ray tracing; with no arguments, the built-in default
     /// scene through a 180° fisheye to fisheye.png.
-    Render {
-        /// The scene: `builtin:NAME` (see `fisheye scenes`) or an OBJ file, framed from the
-        /// front with a headlight and a sun.
-        #[arg(default_value = "builtin:default")]
-        scene: String,
-        /// Lens spec (see `fisheye lens list`).
-        #[arg(long, default_value = "canon-8-15mm@8mm")]
-        lens: String,
-        /// Image size in pixels, WIDTHxHEIGHT.
-        #[arg(long, default_value = "1024x768")]
-        size: ImageSize,
-        /// Deepest reflection/refraction bounce.
-        #[arg(long, default_value_t = 5)]
-        max_depth: u32,
-        /// BVH build preset.
-        #[arg(long, value_enum, default_value = "fast")]
-        bvh: Quality,
-        /// Primary ray directions: evaluated per pixel, or read from a table made once.
-        #[arg(long, value_enum, default_value = "computed")]
-        directions: Directions,
-        /// The colour image (PNG; alpha is the validity mask).
-        #[arg(long, short, default_value = "fisheye.png")]
-        out: PathBuf,
-        /// Ground-truth arrays to write beside the image as OUT_STEM.NAME.npy: range (distance
-        /// to the primary hit), normal, id (triangle), direction (world-space ray), mask.
-        #[arg(long, value_enum, value_delimiter = ',')]
-        outputs: Vec<Output>,
-    },
+    Render(RenderArgs),
     /// List the built-in scenes.
     Scenes,
     /// Show the GPU adapter, its optional features and limits, and measure the precision of
@@ -70,6 +43,85 @@ enum Command {
         #[command(subcommand)]
         command: LensCommand,
     },
+}
+
+#[derive(clap::Args)]
+struct RenderArgs {
+    /// The scene: `builtin:NAME` (see `fisheye scenes`), a scene file (`.toml`, see
+    /// `scenes/`), or an OBJ file, framed from the front with a headlight and a sun.
+    #[arg(default_value = "builtin:default")]
+    scene: String,
+    /// Lens spec (see `fisheye lens list`).
+    #[arg(long, default_value = "canon-8-15mm@8mm")]
+    lens: String,
+    /// Image size in pixels, WIDTHxHEIGHT.
+    #[arg(long, default_value = "1024x768")]
+    size: ImageSize,
+    /// Camera pose instead of the scene's: `X,Y,Z:LX,LY,LZ` (eye and look-at point, y up),
+    /// or `path:S` for the point S ∈ [0, 1] along the scene file's camera path.
+    #[arg(long)]
+    camera: Option<String>,
+    /// Deepest reflection/refraction bounce.
+    #[arg(long, default_value_t = 5)]
+    max_depth: u32,
+    /// BVH build preset.
+    #[arg(long, value_enum, default_value = "fast")]
+    bvh: Quality,
+    /// Primary ray directions: evaluated per pixel, or read from a table made once.
+    #[arg(long, value_enum, default_value = "computed")]
+    directions: Directions,
+    /// The colour image (PNG; alpha is the validity mask).
+    #[arg(long, short, default_value = "fisheye.png")]
+    out: PathBuf,
+    /// Ground-truth arrays to write beside the image as OUT_STEM.NAME.npy (or .exr): range
+    /// (distance to the primary hit), normal, id (triangle), direction (world-space ray), mask.
+    #[arg(long, value_enum, value_delimiter = ',')]
+    outputs: Vec<Output>,
+    /// File format of the ground-truth arrays.
+    #[arg(long, value_enum, default_value = "npy")]
+    format: ArrayFormat,
+}
+
+#[derive(Clone, Copy, PartialEq, Eq, ValueEnum)]
+enum ArrayFormat {
+    Npy,
+    Exr,
+}
+
+/// Parses `--camera`: `X,Y,Z:LX,LY,LZ` or `path:S`.
+fn parse_camera(text: &str, scene: &Scene) -> Result<fisheye_rt::scene::Camera> {
+    if let Some(s) = text.strip_prefix("path:") {
+        let s: f64 = s
+            .parse()
+            .ok()
+            .filter(|s: &f64| (0.0..=1.0).contains(s))
+            .with_context(|| format!("--camera {text:?}: S must be a number in [0, 1]"))?;
+        if scene.camera_path.is_empty() {
+            bail!("--camera {text:?}: this scene has no camera path");
+        }
+        return Ok(scene.camera_on_path(s));
+    }
+    let triple = |t: &str| -> Option<DVec3> {
+        let v: Vec<f64> = t
+            .split(',')
+            .map(|x| x.trim().parse().ok())
+            .collect::<Option<_>>()?;
+        (v.len() == 3 && v.iter().all(|x| x.is_finite())).then(|| DVec3::new(v[0], v[1], v[2]))
+    };
+    let pose = text
+        .split_once(':')
+        .and_then(|(p, l)| Some((triple(p)?, triple(l)?)))
+        .filter(|(p, l)| p != l)
+        .with_context(|| {
+            format!(
+                "--camera {text:?}: expected X,Y,Z:LX,LY,LZ (two different finite points) or path:S"
+            )
+        })?;
+    Ok(fisheye_rt::scene::Camera {
+        position: pose.0,
+        look_at: pose.1,
+        up: DVec3::Y,
+    })
 }
 
 #[derive(Clone, Copy, ValueEnum)]
@@ -202,24 +254,7 @@ impl From<Directions> for DirectionSource {
 
 fn run(cli: Cli) -> Result<()> {
     match cli.command {
-        Command::Render {
-            scene,
-            lens,
-            size,
-            max_depth,
-            bvh,
-            directions,
-            out,
-            outputs,
-        } => {
-            let options = RenderOptions {
-                max_depth,
-                bvh: bvh.into(),
-                directions: directions.into(),
-            };
-            let channels: Vec<Channel> = outputs.into_iter().map(Channel::from).collect();
-            render(&scene, &lens, size, &options, &out, &channels)
-        }
+        Command::Render(args) => render(&args),
         Command::Scenes => {
             for (name, what) in builtin::SCENES {
                 println!("builtin:{name:<14} {what}");
@@ -239,42 +274,32 @@ fn run(cli: Cli) -> Result<()> {
     }
 }
 
-/// A scene from `builtin:NAME` or an OBJ file; warnings go to stderr.
+/// A scene from `builtin:NAME`, a scene file or an OBJ file; warnings go to stderr.
 fn load_scene(spec: &str) -> Result<Scene> {
-    if let Some(name) = spec.strip_prefix("builtin:") {
-        return builtin::scene(name).with_context(|| {
-            let names: Vec<&str> = builtin::SCENES.iter().map(|(n, _)| *n).collect();
-            format!("no built-in scene {name:?}; there are {}", names.join(", "))
-        });
-    }
-    let path = std::path::Path::new(spec);
-    if !path
-        .extension()
-        .is_some_and(|e| e.eq_ignore_ascii_case("obj"))
-    {
-        bail!("scene {spec:?}: expected `builtin:NAME` or an .obj file");
-    }
-    let loaded = fisheye_rt::scene::obj::load_obj(path)?;
+    let loaded = fisheye_rt::scene::load(spec)?;
     for warning in &loaded.warnings {
         eprintln!("warning: {warning}");
     }
     Ok(loaded.scene)
 }
 
-fn render(
-    scene_spec: &str,
-    lens_spec: &str,
-    size: ImageSize,
-    options: &RenderOptions,
-    out: &std::path::Path,
-    channels: &[Channel],
-) -> Result<()> {
+fn render(args: &RenderArgs) -> Result<()> {
     let started = Instant::now();
-    let camera = LensCamera::new(parse_spec(lens_spec)?, size);
-    let scene = load_scene(scene_spec)?;
+    let options = RenderOptions {
+        max_depth: args.max_depth,
+        bvh: args.bvh.into(),
+        directions: args.directions.into(),
+    };
+    let (size, out) = (args.size, &args.out);
+    let scene_spec = &args.scene;
+    let camera = LensCamera::new(parse_spec(&args.lens)?, size);
+    let mut scene = load_scene(scene_spec)?;
+    if let Some(text) = &args.camera {
+        scene.camera = parse_camera(text, &scene)?;
+    }
     let ctx = GpuContext::new()?;
     println!("adapter: {}", ctx.adapter_name());
-    let gpu_scene = GpuScene::new(&ctx, &scene, options)?;
+    let gpu_scene = GpuScene::new(&ctx, &scene, &options)?;
     println!(
         "scene: {scene_spec}, {} triangles; BVH ({}) {} nodes, depth {}, built in {:.1} ms",
         scene.len(),
@@ -316,11 +341,21 @@ fn render(
         }
     }
     save_png(&output.to_image(), out)?;
-    if !channels.is_empty() {
+    if !args.outputs.is_empty() {
         let directions = world_directions(&camera, &scene.camera);
-        for channel in channels {
-            let path = out.with_extension(format!("{}.npy", channel.name()));
-            output.write_npy(*channel, &directions, &path)?;
+        for channel in args.outputs.iter().map(|&o| Channel::from(o)) {
+            let path = match args.format {
+                ArrayFormat::Npy => {
+                    let path = out.with_extension(format!("{}.npy", channel.name()));
+                    output.write_npy(channel, &directions, &path)?;
+                    path
+                }
+                ArrayFormat::Exr => {
+                    let path = out.with_extension(format!("{}.exr", channel.name()));
+                    output.write_exr(channel, &directions, &path)?;
+                    path
+                }
+            };
             println!("wrote {}", path.display());
         }
     }

@@ -46,6 +46,7 @@ pub fn constants() -> Vec<(String, u32)> {
     out.push(("TRAVERSAL_STACK".into(), crate::bvh::TRAVERSAL_STACK));
     out.push(("MAX_DEPTH_LIMIT".into(), trace::MAX_DEPTH_LIMIT));
     out.push(("NO_TEXTURE".into(), trace::NO_TEXTURE));
+    out.push(("MAX_SHADOW_LAYERS".into(), trace::MAX_SHADOW_LAYERS));
     out.push(("NO_HIT".into(), trace::NO_HIT));
     for surface in [Surface::Diffuse, Surface::Mirror, Surface::Glass] {
         let name = format!("SURFACE_{:?}", surface).to_uppercase();

@@ -317,5 +317,90 @@ fn render_writes_ground_truth_arrays() {
         }
     }
     assert!(mask.iter().filter(|&&m| m == 1).count() > 500);
+
+    // The same arrays as OpenEXR: every value bit for bit, in the documented channels.
+    let args = [&args[..], &["--format", "exr"]].concat();
+    stdout(&fisheye(&args, ""));
+    let exr = |name: &str| {
+        let image = exr::prelude::read_all_flat_layers_from_file(dir.join(name)).unwrap();
+        let layer = &image.layer_data[0];
+        assert_eq!((layer.size.0, layer.size.1), (64, 48), "{name}: image size");
+        layer
+            .channel_data
+            .list
+            .iter()
+            .map(|c| (c.name.to_string(), c.sample_data.clone()))
+            .collect::<Vec<_>>()
+    };
+    use exr::prelude::FlatSamples;
+    let floats = |samples: &FlatSamples| match samples {
+        FlatSamples::F32(v) => v.clone(),
+        _ => panic!("expected f32 samples"),
+    };
+    let range_exr = exr("view.range.exr");
+    assert_eq!(range_exr[0].0, "Y");
+    assert_eq!(floats(&range_exr[0].1), range);
+    let id_exr = exr("view.id.exr");
+    assert!(matches!(&id_exr[0].1, FlatSamples::U32(v) if *v == ids));
+    let mask_exr = exr("view.mask.exr");
+    let mask_f: Vec<f32> = mask.iter().map(|&m| f32::from(m)).collect();
+    assert_eq!(floats(&mask_exr[0].1), mask_f);
+    for (name, npy) in [
+        ("view.normal.exr", &normal),
+        ("view.direction.exr", &direction),
+    ] {
+        let channels = exr(name);
+        // EXR lists channels alphabetically: B, G, R.
+        let names: Vec<&str> = channels.iter().map(|c| c.0.as_str()).collect();
+        assert_eq!(names, ["B", "G", "R"], "{name}");
+        for (k, (_, samples)) in channels.iter().rev().enumerate() {
+            let component: Vec<f32> = npy.iter().skip(k).step_by(3).copied().collect();
+            assert_eq!(floats(samples), component, "{name} component {k}");
+        }
+    }
+    std::fs::remove_dir_all(dir).unwrap();
+}
+
+/// A scene file renders from the command line; `--camera` replaces its pose with an explicit
+/// one (the same pose renders the same bytes) or a point on its camera path.
+#[test]
+fn render_takes_scene_files_and_camera_poses() {
+    let dir = std::env::temp_dir().join(format!("fisheye-pose-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let scene = concat!(env!("CARGO_MANIFEST_DIR"), "/scenes/cornell-box.toml");
+    let png = |name: &str, camera: Option<&str>| {
+        let path = dir.join(name);
+        let mut args = vec![
+            "render",
+            scene,
+            "--size",
+            "48x32",
+            "--out",
+            path.to_str().unwrap(),
+        ];
+        if let Some(c) = camera {
+            args.extend(["--camera", c]);
+        }
+        stdout(&fisheye(&args, ""));
+        std::fs::read(path).unwrap()
+    };
+    let own = png("own.png", None);
+    assert_eq!(own, png("same.png", Some("0,1,0.95:0,1,0")));
+    assert_eq!(own, png("start.png", Some("path:0")));
+    assert_ne!(own, png("middle.png", Some("path:0.5")));
+    for (camera, wanted) in [
+        ("path:2", "S must be a number in [0, 1]"),
+        ("1,2:3,4,5", "expected X,Y,Z:LX,LY,LZ"),
+        ("1,2,3:1,2,3", "two different finite points"),
+    ] {
+        let output = fisheye(&["render", scene, "--camera", camera], "");
+        let stderr = String::from_utf8_lossy(&output.stderr);
+        assert!(
+            !output.status.success() && stderr.contains(wanted),
+            "{camera}: {stderr}"
+        );
+    }
+    let output = fisheye(&["render", "builtin:grid", "--camera", "path:0.5"], "");
+    assert!(String::from_utf8_lossy(&output.stderr).contains("no camera path"));
     std::fs::remove_dir_all(dir).unwrap();
 }

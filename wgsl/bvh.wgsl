@@ -78,7 +78,7 @@ fn edge(a: f32, d: f32, b: f32, c: f32) -> f32 {
     return select(e, 0.0, abs(e) <= EDGE_BAND * (abs(p) + abs(q)));
 }
 
-// Watertight ray/triangle test; returns (t, u, v, 1) on a hit within (tmin, tmax), else 0.
+// Watertight ray/triangle test; returns (t, u, v, 1) on a hit within (tmin, tmax], else 0.
 fn triangle_hit(slot: u32, ray: Ray, sh: Shear) -> vec4<f32> {
     let tri = bvh_triangles[slot];
     let a = tri.v0 - ray.origin;
@@ -104,7 +104,8 @@ fn triangle_hit(slot: u32, ray: Ray, sh: Shear) -> vec4<f32> {
     let sign_det = sign(det);
     let abs_det = abs(det);
     let t_signed = t_scaled * sign_det;
-    if t_signed <= ray.tmin * abs_det || t_signed >= ray.tmax * abs_det {
+    // tmax is inclusive so that the caller can break exact ties (see bvh_trace).
+    if t_signed <= ray.tmin * abs_det || t_signed > ray.tmax * abs_det {
         return vec4<f32>(0.0);
     }
     let inv = 1.0 / det;
@@ -195,7 +196,10 @@ fn bvh_trace(ray: Ray, any_hit: bool) -> Hit {
             triangles.y &= triangles.y - 1u;
             let slot = triangles.x + bit;
             let h = triangle_hit(slot, Ray(ray.origin, ray.dir, ray.tmin, hit.t), sh);
-            if h.w != 0.0 {
+            // Exact ties (duplicated or coplanar overlapping triangles) go to the lower scene
+            // triangle, so the result does not depend on the BVH; the reference does the same.
+            if h.w != 0.0 && (h.x < hit.t || (hit.slot != NO_HIT && h.x == hit.t
+                && bvh_triangles[slot].triangle < bvh_triangles[hit.slot].triangle)) {
                 hit = Hit(h.x, h.y, h.z, slot);
                 if any_hit {
                     return hit;

@@ -3,7 +3,7 @@
 // Features a scene does not use are switched off by overrides, so their code is dead.
 #import bvh
 
-// Mirrors `fisheye_rt::trace::GpuMaterial` (64 bytes).
+// Mirrors `fisheye_rt::trace::GpuMaterial` (80 bytes).
 struct Material {
     diffuse: vec3<f32>,
     surface: u32,
@@ -14,6 +14,9 @@ struct Material {
     transmission: vec3<f32>,
     // Index into texture_info, NO_TEXTURE if none.
     texture: u32,
+    // The fraction of light a diffuse surface stops (MTL `d`); the rest passes straight on.
+    opacity: f32,
+    pad: array<u32, 3>,
 }
 
 // Mirrors `fisheye_rt::trace::GpuLight` (32 bytes): a point light (position) or a directional
@@ -51,6 +54,7 @@ override HAS_MIRRORS: bool;
 override HAS_GLASS: bool;
 override HAS_TEXTURES: bool;
 override SMOOTH_NORMALS: bool;
+override HAS_TRANSLUCENT: bool;
 
 // Rays whose weight falls below this are not traced (the CPU reference prunes alike).
 const MIN_WEIGHT: f32 = 1e-3;
@@ -145,6 +149,35 @@ fn surface_at(ray: Ray, hit: Hit) -> Surface {
     return Surface(position, geometric, normal, front, material, triangle);
 }
 
+// The fraction of a light's irradiance that reaches `origin`: 0 or 1 through opaque scenes;
+// through partially transparent diffuse surfaces the product of their (1 - opacity), nearest
+// first, up to MAX_SHADOW_LAYERS of them.
+fn shadow_transmittance(origin: vec3<f32>, to_light: vec3<f32>, distance: f32) -> f32 {
+    if !HAS_TRANSLUCENT {
+        return select(1.0, 0.0, bvh_trace(Ray(origin, to_light, 0.0, distance), true).slot != NO_HIT);
+    }
+    var o = origin;
+    var remaining = distance;
+    var transmittance = 1.0;
+    for (var layer = 0u; layer <= MAX_SHADOW_LAYERS; layer++) {
+        let hit = bvh_trace(Ray(o, to_light, 0.0, remaining), false);
+        if hit.slot == NO_HIT {
+            return transmittance;
+        }
+        let tri = bvh_triangles[hit.slot];
+        let m = materials[tri.material];
+        transmittance *= 1.0 - m.opacity;
+        if m.surface != SURFACE_DIFFUSE || transmittance < MIN_WEIGHT || layer == MAX_SHADOW_LAYERS {
+            return 0.0;
+        }
+        let p = (1.0 - hit.u - hit.v) * tri.v0 + hit.u * tri.v1 + hit.v * tri.v2;
+        let n = normalize(cross(tri.v1 - tri.v0, tri.v2 - tri.v0));
+        o = offset_origin(p, select(-n, n, dot(n, to_light) > 0.0));
+        remaining -= hit.t;
+    }
+    return 0.0;
+}
+
 // Direct light at a diffuse surface: ambient, then each light through a shadow ray.
 fn direct_light(s: Surface, view: vec3<f32>) -> vec3<f32> {
     var colour = s.material.diffuse * shading.ambient;
@@ -168,9 +201,11 @@ fn direct_light(s: Surface, view: vec3<f32>) -> vec3<f32> {
         if cos_light <= 0.0 || dot(s.geometric, to_light) <= 0.0 {
             continue;
         }
-        if bvh_trace(Ray(origin, to_light, 0.0, distance), true).slot != NO_HIT {
+        let transmittance = shadow_transmittance(origin, to_light, distance);
+        if transmittance == 0.0 {
             continue;
         }
+        irradiance *= transmittance;
         let half_vector = normalize(to_light - view);
         let highlight = s.material.specular
             * pow(max(dot(s.normal, half_vector), 0.0), s.material.shininess);
@@ -226,8 +261,18 @@ fn shade(primary: Ray) -> Traced {
             out.normal = s.normal;
             out.triangle = s.triangle;
         }
-        out.colour += ray_in.weight * s.material.emission;
         let children = ray_in.depth < shading.max_depth;
+        var surface_weight = ray_in.weight;
+        if HAS_TRANSLUCENT && s.material.surface == SURFACE_DIFFUSE && s.material.opacity < 1.0 {
+            // The rest of the light passes straight through.
+            let through = surface_weight * (1.0 - s.material.opacity);
+            if children && max(through.x, max(through.y, through.z)) >= MIN_WEIGHT {
+                stack[count] = Pending(offset_origin(s.position, -s.geometric), ray_in.depth + 1u, ray.dir, through);
+                count += 1u;
+            }
+            surface_weight *= s.material.opacity;
+        }
+        out.colour += surface_weight * s.material.emission;
         if HAS_MIRRORS && s.material.surface == SURFACE_MIRROR {
             let weight = ray_in.weight * s.material.specular;
             if children && max(weight.x, max(weight.y, weight.z)) >= MIN_WEIGHT {
@@ -261,7 +306,7 @@ fn shade(primary: Ray) -> Traced {
                 count += 1u;
             }
         } else {
-            out.colour += ray_in.weight * direct_light(s, ray.dir);
+            out.colour += surface_weight * direct_light(s, ray.dir);
         }
     }
     return out;

@@ -5,11 +5,13 @@
 #import shade
 
 // Mirrors `fisheye_rt::trace::Frame`: the camera-to-world rotation's columns (camera x right,
-// y down, z forward). The scene is uploaded camera-relative, so rays start at the origin.
+// y down, z forward) and the eye. The scene is uploaded relative to its own camera, so the eye
+// is at the origin unless a camera path moved it.
 struct Frame {
     right: vec4<f32>,
     down: vec4<f32>,
     forward: vec4<f32>,
+    eye: vec4<f32>,
 }
 
 @group(0) @binding(2) var<uniform> frame: Frame;
@@ -34,7 +36,7 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
         return;
     }
     let dir = frame.right.xyz * ray.x + frame.down.xyz * ray.y + frame.forward.xyz * ray.z;
-    let traced = shade(Ray(vec3<f32>(0.0), dir, 0.0, 3.0e38));
+    let traced = shade(Ray(frame.eye.xyz, dir, 0.0, 3.0e38));
     colour_out[index] = vec4<f32>(traced.colour, 1.0);
     if traced.triangle == NO_HIT {
         geometry_out[index] = vec4<f32>(0.0);

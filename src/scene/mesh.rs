@@ -2,7 +2,7 @@
 
 use std::f64::consts::{PI, TAU};
 
-use glam::{DVec3, Vec2, Vec3};
+use glam::{DAffine3, DVec3, Vec2, Vec3};
 
 use super::{Camera, Light, Material, Scene, Texture, face_normal};
 
@@ -58,6 +58,43 @@ impl MeshBuilder {
     /// Whether no triangle was added yet.
     pub fn is_empty(&self) -> bool {
         self.triangles.is_empty()
+    }
+
+    /// The materials so far, to override their fields.
+    pub fn materials_mut(&mut self) -> &mut [Material] {
+        &mut self.materials
+    }
+
+    /// Moves the triangles from index `first` on by `transform`: corners as points, normals by
+    /// the inverse transpose. A mirroring transform swaps two corners so that faces keep their
+    /// side.
+    pub fn transform_since(&mut self, first: usize, transform: DAffine3) {
+        let normal_matrix = transform.matrix3.inverse().transpose();
+        let mirrored = transform.matrix3.determinant() < 0.0;
+        for i in first..self.triangles.len() {
+            let t = &mut self.triangles[i];
+            *t = t.map(|p| transform.transform_point3(p));
+            let n = &mut self.normals[i];
+            if let Some(n) = n {
+                *n = n.map(|n| (normal_matrix * n.as_dvec3()).normalize_or_zero().as_vec3());
+            }
+            if mirrored {
+                t.swap(1, 2);
+                if let Some(n) = n {
+                    n.swap(1, 2);
+                }
+                if let Some(uv) = &mut self.uvs[i] {
+                    uv.swap(1, 2);
+                }
+            }
+        }
+    }
+
+    /// Gives the triangles from index `first` on the material `material`.
+    pub fn set_material_since(&mut self, first: usize, material: u32) {
+        for m in &mut self.material_of[first..] {
+            *m = material;
+        }
     }
 
     /// Adds one triangle.
@@ -213,6 +250,7 @@ impl MeshBuilder {
             sky,
             ambient,
             camera,
+            camera_path: Vec::new(),
         }
     }
 }

@@ -4,6 +4,7 @@
 //! to f32 once, so a scene far from the origin renders as it does at the origin.
 
 pub mod builtin;
+pub mod file;
 mod mesh;
 pub mod obj;
 
@@ -44,6 +45,9 @@ pub struct Material {
     pub ior: f32,
     /// `Tf`: transmission filter of glass.
     pub transmission: Vec3,
+    /// `d` (or `1 - Tr`): the fraction of light the surface stops. Below 1 the rest passes
+    /// straight through, for camera, secondary and shadow rays alike.
+    pub opacity: f32,
 }
 
 impl Material {
@@ -59,6 +63,7 @@ impl Material {
             emission: Vec3::ZERO,
             ior: 1.0,
             transmission: Vec3::ONE,
+            opacity: 1.0,
         }
     }
 
@@ -182,6 +187,8 @@ pub struct Scene {
     pub ambient: Vec3,
     /// The camera pose.
     pub camera: Camera,
+    /// Keyframes of a camera path (for benchmarks); empty if the scene has none.
+    pub camera_path: Vec<Camera>,
 }
 
 impl Scene {
@@ -198,6 +205,27 @@ impl Scene {
     /// The axis-aligned bounds of all triangles (`None` when empty).
     pub fn bounds(&self) -> Option<(DVec3, DVec3)> {
         bounds(&self.triangles)
+    }
+
+    /// The pose at `s` ∈ [0, 1] along the camera path: keyframes equally spaced, positions and
+    /// look-at points interpolated linearly between them. The scene camera without a path.
+    pub fn camera_on_path(&self, s: f64) -> Camera {
+        let keys = &self.camera_path;
+        match keys.len() {
+            0 => self.camera,
+            1 => keys[0],
+            n => {
+                let x = s.clamp(0.0, 1.0) * (n - 1) as f64;
+                let i = (x.floor() as usize).min(n - 2);
+                let f = x - i as f64;
+                let (a, b) = (keys[i], keys[i + 1]);
+                Camera {
+                    position: a.position.lerp(b.position, f),
+                    look_at: a.look_at.lerp(b.look_at, f),
+                    up: a.up,
+                }
+            }
+        }
     }
 
     /// Which features the scene uses, for specialising kernels.
@@ -218,7 +246,38 @@ impl Scene {
             glass: used.iter().any(|m| m.surface == Surface::Glass),
             textures: self.uvs.is_some() && used.iter().any(|m| m.diffuse_texture.is_some()),
             smooth_normals: self.normals.is_some(),
+            translucent: used.iter().any(|m| m.opacity < 1.0),
         }
+    }
+}
+
+/// Loads a scene from `builtin:NAME`, a scene file (`.toml`) or a bare OBJ (`.obj`).
+pub fn load(spec: &str) -> crate::error::Result<obj::Loaded> {
+    use crate::error::Error;
+    if let Some(name) = spec.strip_prefix("builtin:") {
+        let scene = builtin::scene(name).ok_or_else(|| {
+            let names: Vec<&str> = builtin::SCENES.iter().map(|(n, _)| *n).collect();
+            Error::Scene(format!(
+                "no built-in scene {name:?}; there are {}",
+                names.join(", ")
+            ))
+        })?;
+        return Ok(obj::Loaded {
+            scene,
+            warnings: Vec::new(),
+        });
+    }
+    let path = std::path::Path::new(spec);
+    let extension = path
+        .extension()
+        .and_then(|e| e.to_str())
+        .map(str::to_ascii_lowercase);
+    match extension.as_deref() {
+        Some("toml") => file::load_scene_file(path),
+        Some("obj") => obj::load_obj(path),
+        _ => Err(Error::Scene(format!(
+            "{spec:?}: expected `builtin:NAME`, a scene file (.toml) or an OBJ file (.obj)"
+        ))),
     }
 }
 
@@ -233,6 +292,8 @@ pub struct Features {
     pub textures: bool,
     /// Vertex normals are interpolated.
     pub smooth_normals: bool,
+    /// Some surface is partially transparent (`d` < 1).
+    pub translucent: bool,
 }
 
 /// The axis-aligned bounds of some triangles (`None` when there are none).

@@ -64,8 +64,23 @@ fn material(
             }
         }
     });
+    // `d` is opacity; some exporters write `Tr` (= 1 - d) instead.
+    let opacity = m
+        .dissolve
+        .or_else(|| floats("Tr").and_then(|t| t.first().map(|t| 1.0 - f64::from(*t))))
+        .map_or(1.0, |d| {
+            if !d.is_finite() {
+                warnings.push(format!("material {}: opacity d = {d}; using 1", m.name));
+            }
+            if d.is_finite() {
+                d.clamp(0.0, 1.0) as f32
+            } else {
+                1.0
+            }
+        });
     Material {
         name: m.name.clone(),
+        opacity,
         surface,
         diffuse: m.diffuse.map_or(Vec3::splat(0.8), vec3),
         diffuse_texture,
@@ -157,14 +172,14 @@ pub fn load_into(path: &Path, b: &mut MeshBuilder, warnings: &mut Vec<String>) -
     Ok(())
 }
 
-/// A bare OBJ as a scene: a camera that frames its bounding box from the front (+z, slightly
-/// above), whatever its units or offset, a headlight at the camera and a sun, so that any OBJ
-/// shows something.
-pub fn load_obj(path: &Path) -> Result<Loaded> {
-    let mut b = MeshBuilder::new();
-    let mut warnings = Vec::new();
-    load_into(path, &mut b, &mut warnings)?;
-    let (lo, hi) = b.bounds().unwrap_or((DVec3::ZERO, DVec3::ZERO));
+/// The sky of scenes that do not set one.
+pub const DEFAULT_SKY: Vec3 = Vec3::new(0.35, 0.4, 0.5);
+/// The ambient light of scenes that do not set one.
+pub const DEFAULT_AMBIENT: Vec3 = Vec3::splat(0.08);
+
+/// A camera that frames the box `lo`..`hi` from the front (+z, slightly above) at 1.3 bounding
+/// radii, whatever its units or offset, with a headlight at the camera and a sun.
+pub fn framing(lo: DVec3, hi: DVec3) -> (Camera, Vec<Light>) {
     let centre = (lo + hi) / 2.0;
     let radius = ((hi - lo).length() / 2.0).max(1e-6);
     let position = centre + DVec3::new(0.0, 0.3 * radius, 1.3 * radius);
@@ -183,6 +198,16 @@ pub fn load_obj(path: &Path) -> Result<Loaded> {
         look_at: centre,
         up: DVec3::Y,
     };
-    let scene = b.finish(lights, Vec3::new(0.35, 0.4, 0.5), Vec3::splat(0.08), camera);
+    (camera, lights)
+}
+
+/// A bare OBJ as a scene, [`framing`] its bounds so that any OBJ shows something.
+pub fn load_obj(path: &Path) -> Result<Loaded> {
+    let mut b = MeshBuilder::new();
+    let mut warnings = Vec::new();
+    load_into(path, &mut b, &mut warnings)?;
+    let (lo, hi) = b.bounds().unwrap_or((DVec3::ZERO, DVec3::ZERO));
+    let (camera, lights) = framing(lo, hi);
+    let scene = b.finish(lights, DEFAULT_SKY, DEFAULT_AMBIENT, camera);
     Ok(Loaded { scene, warnings })
 }

@@ -7,7 +7,7 @@
 
 use glam::{DMat3, DVec2, DVec3, Vec3};
 
-use super::{MAX_DEPTH_LIMIT, NO_HIT, RenderOutput};
+use super::{MAX_DEPTH_LIMIT, MAX_SHADOW_LAYERS, NO_HIT, RenderOutput};
 use crate::lens::LensCamera;
 use crate::scene::{Features, Scene, Surface, Texture};
 
@@ -151,7 +151,8 @@ impl<'a> Reference<'a> {
         index
     }
 
-    /// Watertight ray/triangle test (Woop, Benthin and Wald 2013) in f64, edges inclusive.
+    /// Watertight ray/triangle test (Woop, Benthin and Wald 2013) in f64, edges inclusive, for
+    /// t in (tmin, tmax].
     fn triangle_hit(
         &self,
         triangle: u32,
@@ -182,7 +183,7 @@ impl<'a> Reference<'a> {
             return None;
         }
         let t = (u * a[kz] + v * b[kz] + w * c[kz]) * sz / det;
-        (t > tmin && t < tmax).then_some(Hit {
+        (t > tmin && t <= tmax).then_some(Hit {
             t,
             u: v / det,
             v: w / det,
@@ -221,7 +222,9 @@ impl<'a> Reference<'a> {
                     }
                     for &tri in &self.order[first as usize..(first + count) as usize] {
                         let limit = best.map_or(tmax, |h| h.t);
-                        if let Some(hit) = self.triangle_hit(tri, origin, dir, tmin, limit) {
+                        if let Some(hit) = self.triangle_hit(tri, origin, dir, tmin, limit)
+                            && closer(&hit, best.as_ref(), tmax)
+                        {
                             best = Some(hit);
                             if any {
                                 return best;
@@ -249,7 +252,9 @@ impl<'a> Reference<'a> {
         let mut best: Option<Hit> = None;
         for tri in 0..self.corners.len() as u32 {
             let limit = best.map_or(f64::INFINITY, |h| h.t);
-            if let Some(hit) = self.triangle_hit(tri, origin, dir, 0.0, limit) {
+            if let Some(hit) = self.triangle_hit(tri, origin, dir, 0.0, limit)
+                && closer(&hit, best.as_ref(), f64::INFINITY)
+            {
                 best = Some(hit);
             }
         }
@@ -299,7 +304,6 @@ impl<'a> Reference<'a> {
                 first = ([n.x, n.y, n.z, hit.t as f32], hit.triangle);
             }
             let m = &self.scene.materials[self.scene.material_of[hit.triangle as usize] as usize];
-            colour += weight * v3(m.emission);
             let children = depth < self.max_depth;
             let push = |stack: &mut Vec<_>, origin, dir, w: DVec3| {
                 if children && w.max_element() >= MIN_WEIGHT {
@@ -308,6 +312,13 @@ impl<'a> Reference<'a> {
             };
             let above = s.position + s.geometric * 1e-9 * (1.0 + s.position.length());
             let below = s.position - s.geometric * 1e-9 * (1.0 + s.position.length());
+            let mut surface_weight = weight;
+            if self.features.translucent && m.surface == Surface::Diffuse && m.opacity < 1.0 {
+                let opacity = f64::from(m.opacity);
+                push(&mut stack, below, dir, weight * (1.0 - opacity));
+                surface_weight *= opacity;
+            }
+            colour += surface_weight * v3(m.emission);
             match m.surface {
                 Surface::Mirror if self.features.mirrors => {
                     push(
@@ -340,7 +351,7 @@ impl<'a> Reference<'a> {
                         weight * reflectance,
                     );
                 }
-                _ => colour += weight * self.direct_light(&s, dir, above),
+                _ => colour += surface_weight * self.direct_light(&s, dir, above),
             }
         }
         let c = colour.as_vec3();
@@ -395,14 +406,48 @@ impl<'a> Reference<'a> {
             if cos_light <= 0.0 || s.geometric.dot(to_light) <= 0.0 {
                 continue;
             }
-            if self.trace(origin, to_light, 0.0, distance, true).is_some() {
+            let transmittance = self.shadow_transmittance(origin, to_light, distance);
+            if transmittance == 0.0 {
                 continue;
             }
+            let irradiance = irradiance * transmittance;
             let half = (to_light - view).normalize();
             let highlight = s.specular * s.normal.dot(half).max(0.0).powf(s.shininess);
             colour += irradiance * (s.diffuse * cos_light + highlight);
         }
         colour
+    }
+}
+
+impl Reference<'_> {
+    /// As `shadow_transmittance` in `wgsl/shade.wgsl`: the product of (1 - opacity) over the
+    /// partially transparent diffuse surfaces between `origin` and the light.
+    fn shadow_transmittance(&self, origin: DVec3, to_light: DVec3, distance: f64) -> f64 {
+        if !self.features.translucent {
+            return match self.trace(origin, to_light, 0.0, distance, true) {
+                Some(_) => 0.0,
+                None => 1.0,
+            };
+        }
+        let (mut o, mut remaining, mut transmittance) = (origin, distance, 1.0);
+        for layer in 0..=MAX_SHADOW_LAYERS {
+            let Some(hit) = self.trace(o, to_light, 0.0, remaining, false) else {
+                return transmittance;
+            };
+            let i = hit.triangle as usize;
+            let m = &self.scene.materials[self.scene.material_of[i] as usize];
+            transmittance *= 1.0 - f64::from(m.opacity);
+            if m.surface != Surface::Diffuse
+                || transmittance < MIN_WEIGHT
+                || layer == MAX_SHADOW_LAYERS
+            {
+                return 0.0;
+            }
+            let p = o + to_light * hit.t;
+            o = p + to_light * 1e-9 * (1.0 + p.length());
+            remaining -= hit.t;
+        }
+        0.0
     }
 }
 
@@ -414,6 +459,15 @@ struct SurfacePoint {
     diffuse: DVec3,
     specular: DVec3,
     shininess: f64,
+}
+
+/// Whether `hit` beats `best` (or, without one, lies before `tmax`): nearer, or as near and of
+/// a lower scene triangle, as `bvh_trace` in `wgsl/bvh.wgsl` decides exact ties.
+fn closer(hit: &Hit, best: Option<&Hit>, tmax: f64) -> bool {
+    match best {
+        None => hit.t < tmax,
+        Some(b) => hit.t < b.t || (hit.t == b.t && hit.triangle < b.triangle),
+    }
 }
 
 fn reflect(d: DVec3, n: DVec3) -> DVec3 {

@@ -16,11 +16,14 @@ use crate::error::{Error, Result};
 use crate::gpu::{GpuContext, dispatch_over_image, storage_entry, uniform_entry};
 use crate::lens::LensCamera;
 use crate::lens::gpu::{DirectionSource, LensRays, lens_constants, params_buffer};
-use crate::scene::{Features, Scene, Surface};
+use crate::scene::{Camera, Features, Scene, Surface};
 use crate::shader;
 
 /// The deepest Whitted recursion a kernel can run (its ray stack has one more entry).
 pub const MAX_DEPTH_LIMIT: u32 = 8;
+/// A shadow ray passes at most this many partially transparent surfaces; behind more, the
+/// light counts as blocked.
+pub const MAX_SHADOW_LAYERS: u32 = 8;
 /// `Material::texture` of an untextured material.
 pub const NO_TEXTURE: u32 = u32::MAX;
 /// The id of a miss or a masked pixel in [`RenderOutput::ids`].
@@ -38,7 +41,7 @@ pub fn surface_id(surface: Surface) -> u32 {
 /// The WGSL id of a light kind: `LIGHT_POINT`, `LIGHT_DIRECTIONAL`.
 pub const LIGHT_KINDS: [(&str, u32); 2] = [("LIGHT_POINT", 0), ("LIGHT_DIRECTIONAL", 1)];
 
-/// A material as `wgsl/shade.wgsl` reads it (64 bytes).
+/// A material as `wgsl/shade.wgsl` reads it (80 bytes).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, PartialEq, Pod, Zeroable)]
 pub struct GpuMaterial {
@@ -58,6 +61,10 @@ pub struct GpuMaterial {
     pub transmission: [f32; 3],
     /// Texture index or [`NO_TEXTURE`].
     pub texture: u32,
+    /// `d`.
+    pub opacity: f32,
+    /// Padding.
+    pub pad: [u32; 3],
 }
 
 /// A light as `wgsl/shade.wgsl` reads it (32 bytes).
@@ -88,7 +95,8 @@ pub struct Shading {
     pub max_depth: u32,
 }
 
-/// The camera-to-world rotation (48 bytes): camera x, y, z axes in world space.
+/// The camera pose of a frame (64 bytes): the camera-to-world rotation's columns (camera x, y,
+/// z axes in world space) and the eye relative to the scene's origin.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, PartialEq, Pod, Zeroable)]
 pub struct Frame {
@@ -98,6 +106,8 @@ pub struct Frame {
     pub down: [f32; 4],
     /// Camera z (forward).
     pub forward: [f32; 4],
+    /// Eye position relative to [`GpuScene::origin`] (xyz).
+    pub eye: [f32; 4],
 }
 
 /// How to render.
@@ -140,6 +150,21 @@ pub fn shading_vertices(scene: &Scene, features: Features) -> Vec<[f32; 4]> {
         }
     }
     out
+}
+
+/// The frame of `pose` for a scene uploaded relative to `origin`.
+fn frame_for(origin: DVec3, pose: &Camera) -> Frame {
+    let rotation = pose.rotation();
+    let col = |v: DVec3| {
+        let v = v.as_vec3();
+        [v.x, v.y, v.z, 0.0]
+    };
+    Frame {
+        right: col(rotation.x_axis),
+        down: col(rotation.y_axis),
+        forward: col(rotation.z_axis),
+        eye: col(pose.position - origin),
+    }
 }
 
 /// A storage buffer holding `data`, or one zero element where `data` is empty (bindings may
@@ -201,6 +226,8 @@ impl GpuScene {
                 ior: m.ior,
                 transmission: to3(m.transmission),
                 texture: m.diffuse_texture.unwrap_or(NO_TEXTURE),
+                opacity: m.opacity,
+                pad: [0; 3],
             })
             .collect();
         let lights: Vec<GpuLight> = scene
@@ -234,16 +261,7 @@ impl GpuScene {
             ambient: to3(scene.ambient),
             max_depth: options.max_depth,
         };
-        let rotation = scene.camera.rotation();
-        let col = |v: DVec3| {
-            let v = v.as_vec3();
-            [v.x, v.y, v.z, 0.0]
-        };
-        let frame = Frame {
-            right: col(rotation.x_axis),
-            down: col(rotation.y_axis),
-            forward: col(rotation.z_axis),
-        };
+        let frame = frame_for(origin, &scene.camera);
 
         let buffers = [
             storage(ctx, "fisheye.scene.bvh_nodes", &bvh.nodes)?,
@@ -311,6 +329,7 @@ pub struct TracePass {
     colour: wgpu::Buffer,
     geometry: wgpu::Buffer,
     ids: wgpu::Buffer,
+    frame: wgpu::Buffer,
     camera: LensCamera,
 }
 
@@ -355,6 +374,7 @@ impl TracePass {
                 ("HAS_GLASS", flag(f.glass)),
                 ("HAS_TEXTURES", flag(f.textures)),
                 ("SMOOTH_NORMALS", flag(f.smooth_normals)),
+                ("HAS_TRANSLUCENT", flag(f.translucent)),
             ]);
             let pipeline = shader::compute_pipeline(
                 device,
@@ -377,7 +397,7 @@ impl TracePass {
             let frame = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
                 label: Some("fisheye.trace.frame"),
                 contents: bytemuck::bytes_of(&scene.frame),
-                usage: wgpu::BufferUsages::UNIFORM,
+                usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
             });
             let placeholder = output("fisheye.trace.no_table", 16);
             let table = table.as_ref().map_or(&placeholder, |t| &t.directions);
@@ -402,9 +422,19 @@ impl TracePass {
                 colour,
                 geometry,
                 ids,
+                frame,
                 camera: *camera,
             }
         })
+    }
+
+    /// Moves the camera to `pose` for the frames encoded from now on (a camera path). The scene
+    /// stays where it was uploaded, relative to its own camera, so poses far from it lose the
+    /// precision that relative upload buys; paths through a scene are fine.
+    pub fn set_pose(&self, ctx: &GpuContext, scene: &GpuScene, pose: &Camera) {
+        let frame = frame_for(scene.origin, pose);
+        ctx.queue
+            .write_buffer(&self.frame, 0, bytemuck::bytes_of(&frame));
     }
 
     /// Records one frame, optionally timed.
@@ -500,6 +530,8 @@ mod tests {
                 ("ior", offset_of!(GpuMaterial, ior)),
                 ("transmission", offset_of!(GpuMaterial, transmission)),
                 ("texture", offset_of!(GpuMaterial, texture)),
+                ("opacity", offset_of!(GpuMaterial, opacity)),
+                ("pad", offset_of!(GpuMaterial, pad)),
             ],
         );
         assert_wgsl_layout(
@@ -532,6 +564,7 @@ mod tests {
                 ("right", offset_of!(Frame, right)),
                 ("down", offset_of!(Frame, down)),
                 ("forward", offset_of!(Frame, forward)),
+                ("eye", offset_of!(Frame, eye)),
             ],
         );
     }

@@ -70,7 +70,9 @@ impl RenderOutput {
 }
 
 /// A per-pixel array `fisheye render --outputs` can write beside the image, as NPY (row-major,
-/// image rows first; float32 unless noted).
+/// image rows first; float32 unless noted) or OpenEXR (ZIP-compressed, one file per array: a
+/// scalar in channel `Y`, the id as uint32 in channel `id`, a vector in `R`, `G`, `B`, so that
+/// any EXR viewer shows it).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Channel {
     /// Euclidean distance from the camera to the primary hit, H×W; 0 on a miss or mask.
@@ -128,7 +130,38 @@ fn write_array<T: npyz::Serialize + npyz::AutoSerialize>(
     writer.finish().map_err(io)
 }
 
+/// One array of a [`Channel`]: its per-pixel component count and the values, row-major.
+enum Values {
+    F32(usize, Vec<f32>),
+    U32(Vec<u32>),
+    U8(Vec<u8>),
+}
+
 impl RenderOutput {
+    fn values(&self, channel: Channel, directions: &[Option<DVec3>]) -> Values {
+        match channel {
+            Channel::Range => Values::F32(1, self.geometry.iter().map(|g| g[3]).collect()),
+            Channel::Normal => Values::F32(
+                3,
+                self.geometry
+                    .iter()
+                    .flat_map(|g| [g[0], g[1], g[2]])
+                    .collect(),
+            ),
+            Channel::Id => Values::U32(self.ids.clone()),
+            Channel::Direction => Values::F32(
+                3,
+                directions
+                    .iter()
+                    .flat_map(|d| d.unwrap_or(DVec3::ZERO).as_vec3().to_array())
+                    .collect(),
+            ),
+            Channel::Mask => {
+                Values::U8(self.colour.iter().map(|c| u8::from(c[3] == 1.0)).collect())
+            }
+        }
+    }
+
     /// Writes one channel as an NPY file. `directions` gives each pixel's world-space ray
     /// direction (`None` where masked) and is needed only for [`Channel::Direction`].
     pub fn write_npy(
@@ -138,26 +171,61 @@ impl RenderOutput {
         path: &Path,
     ) -> Result<()> {
         let (h, w) = (u64::from(self.size.height), u64::from(self.size.width));
-        match channel {
-            Channel::Range => write_array(path, &[h, w], self.geometry.iter().map(|g| g[3])),
-            Channel::Normal => write_array(
-                path,
-                &[h, w, 3],
-                self.geometry.iter().flat_map(|g| [g[0], g[1], g[2]]),
-            ),
-            Channel::Id => write_array(path, &[h, w], self.ids.iter().copied()),
-            Channel::Direction => write_array(
-                path,
-                &[h, w, 3],
-                directions
-                    .iter()
-                    .flat_map(|d| d.unwrap_or(DVec3::ZERO).as_vec3().to_array()),
-            ),
-            Channel::Mask => write_array(
-                path,
-                &[h, w],
-                self.colour.iter().map(|c| u8::from(c[3] == 1.0)),
-            ),
+        match self.values(channel, directions) {
+            Values::F32(1, v) => write_array(path, &[h, w], v),
+            Values::F32(n, v) => write_array(path, &[h, w, n as u64], v),
+            Values::U32(v) => write_array(path, &[h, w], v),
+            Values::U8(v) => write_array(path, &[h, w], v),
         }
+    }
+
+    /// Writes one channel as an OpenEXR file (see [`Channel`] for the channel names); the mask
+    /// is stored as float 0 or 1.
+    pub fn write_exr(
+        &self,
+        channel: Channel,
+        directions: &[Option<DVec3>],
+        path: &Path,
+    ) -> Result<()> {
+        use exr::prelude::{
+            AnyChannel, AnyChannels, Encoding, FlatSamples, Image, Layer, LayerAttributes,
+            SmallVec, WritableImage,
+        };
+        let list: SmallVec<[AnyChannel<FlatSamples>; 4]> = match self.values(channel, directions) {
+            Values::F32(1, v) => [AnyChannel::new("Y", FlatSamples::F32(v))]
+                .into_iter()
+                .collect(),
+            Values::F32(n, v) => ["R", "G", "B"]
+                .iter()
+                .enumerate()
+                .map(|(k, name)| {
+                    let component = v.iter().skip(k).step_by(n).copied().collect();
+                    AnyChannel::new(*name, FlatSamples::F32(component))
+                })
+                .collect(),
+            Values::U32(v) => [AnyChannel::new("id", FlatSamples::U32(v))]
+                .into_iter()
+                .collect(),
+            Values::U8(v) => [AnyChannel::new(
+                "Y",
+                FlatSamples::F32(v.into_iter().map(f32::from).collect()),
+            )]
+            .into_iter()
+            .collect(),
+        };
+        let size = (self.size.width as usize, self.size.height as usize);
+        let layer = Layer::new(
+            size,
+            LayerAttributes::named(channel.name()),
+            Encoding::SMALL_LOSSLESS,
+            AnyChannels::sort(list),
+        );
+        Image::from_layer(layer)
+            .write()
+            .to_file(path)
+            .map_err(|e| Error::Io {
+                path: path.to_path_buf(),
+                source: std::io::Error::other(e.to_string()),
+            })
     }
 }

@@ -1,0 +1,388 @@
+//! Scene files (TOML): meshes placed in the world, material overrides, lights, a sky and a
+//! camera with an optional path. Unknown keys are errors, and paths resolve relative to the
+//! scene file.
+//!
+//! ```toml
+//! sky = [0.35, 0.4, 0.5]          # radiance of escaping rays (default as for a bare OBJ)
+//! ambient = [0.05, 0.05, 0.05]    # Whitted's ambient term
+//!
+//! [camera]                        # default: frames the scene's bounds from the front
+//! position = [0.0, 1.0, 3.4]
+//! look_at = [0.0, 1.0, 0.0]
+//! up = [0.0, 1.0, 0.0]            # default
+//!
+//! [[camera.path]]                 # keyframes for benchmarks, equally spaced
+//! position = [0.5, 1.0, 3.4]
+//! look_at = [0.0, 1.0, 0.0]
+//!
+//! [[mesh]]
+//! path = "box.obj"                # or shape = "box" (the unit cube) or "sphere" (unit radius)
+//! scale = 1.0                     # or [x, y, z]
+//! rotation = [0.0, 90.0, 0.0]     # degrees about x, then y, then z
+//! translation = [0.0, 0.0, 0.0]
+//! material = { diffuse = [0.8, 0.8, 0.8] }   # replaces every material of this mesh
+//!
+//! [[material]]                    # overrides the fields it names in materials of that name
+//! name = "light"
+//! emission = [17.0, 12.0, 4.0]
+//!
+//! [[light]]
+//! type = "point"                  # or "sun" with direction and irradiance
+//! position = [0.0, 1.9, 0.0]
+//! intensity = [1.0, 1.0, 1.0]
+//! ```
+
+use std::path::{Path, PathBuf};
+
+use glam::{DAffine3, DMat3, DVec3, Vec3};
+use serde::Deserialize;
+
+use super::obj::{DEFAULT_AMBIENT, DEFAULT_SKY, Loaded, framing, load_into};
+use super::{Camera, Light, Material, MeshBuilder, Surface};
+use crate::error::{Error, Result};
+
+type Triple = [f64; 3];
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct SceneFile {
+    sky: Option<Triple>,
+    ambient: Option<Triple>,
+    camera: Option<CameraSpec>,
+    #[serde(default, rename = "mesh")]
+    meshes: Vec<MeshSpec>,
+    #[serde(default, rename = "material")]
+    materials: Vec<MaterialSpec>,
+    #[serde(default, rename = "light")]
+    lights: Vec<LightSpec>,
+}
+
+fn world_up() -> Triple {
+    [0.0, 1.0, 0.0]
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct CameraSpec {
+    position: Triple,
+    look_at: Triple,
+    #[serde(default = "world_up")]
+    up: Triple,
+    #[serde(default)]
+    path: Vec<Keyframe>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct Keyframe {
+    position: Triple,
+    look_at: Triple,
+}
+
+#[derive(Deserialize, Clone, Copy)]
+#[serde(rename_all = "lowercase")]
+enum Shape {
+    Box,
+    Sphere,
+}
+
+#[derive(Deserialize, Clone, Copy)]
+#[serde(untagged, expecting = "a number or an [x, y, z] array")]
+enum Scale {
+    Uniform(f64),
+    Axes(Triple),
+}
+
+impl Default for Scale {
+    fn default() -> Self {
+        Scale::Uniform(1.0)
+    }
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct MeshSpec {
+    path: Option<PathBuf>,
+    shape: Option<Shape>,
+    #[serde(default)]
+    scale: Scale,
+    #[serde(default)]
+    rotation: Triple,
+    #[serde(default)]
+    translation: Triple,
+    material: Option<MaterialSpec>,
+}
+
+#[derive(Deserialize, Clone, Copy)]
+#[serde(rename_all = "lowercase")]
+enum SurfaceSpec {
+    Diffuse,
+    Mirror,
+    Glass,
+}
+
+#[derive(Deserialize, Clone, Default)]
+#[serde(deny_unknown_fields)]
+struct MaterialSpec {
+    name: Option<String>,
+    surface: Option<SurfaceSpec>,
+    diffuse: Option<Triple>,
+    specular: Option<Triple>,
+    shininess: Option<f64>,
+    emission: Option<Triple>,
+    ior: Option<f64>,
+    transmission: Option<Triple>,
+    opacity: Option<f64>,
+}
+
+#[derive(Deserialize)]
+#[serde(tag = "type", rename_all = "lowercase", deny_unknown_fields)]
+enum LightSpec {
+    Point {
+        position: Triple,
+        intensity: Triple,
+    },
+    Sun {
+        direction: Triple,
+        irradiance: Triple,
+    },
+}
+
+/// Checks a value the parser accepted (TOML allows `nan` and `inf`).
+struct Check<'a> {
+    path: &'a Path,
+}
+
+impl Check<'_> {
+    fn fail<T>(&self, message: String) -> Result<T> {
+        Err(Error::SceneFile {
+            path: self.path.to_path_buf(),
+            message,
+        })
+    }
+
+    fn finite(&self, what: &str, v: Triple) -> Result<DVec3> {
+        if v.iter().all(|x| x.is_finite()) {
+            Ok(DVec3::from(v))
+        } else {
+            self.fail(format!("{what} = {v:?}: every component must be finite"))
+        }
+    }
+
+    fn colour(&self, what: &str, v: Triple) -> Result<Vec3> {
+        let c = self.finite(what, v)?;
+        if c.min_element() < 0.0 {
+            return self.fail(format!("{what} = {v:?}: must not be negative"));
+        }
+        Ok(c.as_vec3())
+    }
+
+    fn number(&self, what: &str, x: f64, lo: f64, hi: f64) -> Result<f32> {
+        if x.is_finite() && (lo..=hi).contains(&x) {
+            Ok(x as f32)
+        } else {
+            self.fail(format!("{what} = {x}: must lie in [{lo}, {hi}]"))
+        }
+    }
+
+    fn camera(&self, what: &str, position: Triple, look_at: Triple, up: DVec3) -> Result<Camera> {
+        let position = self.finite(&format!("{what}.position"), position)?;
+        let look_at = self.finite(&format!("{what}.look_at"), look_at)?;
+        if position == look_at {
+            return self.fail(format!(
+                "{what}: position and look_at are the same point, so it looks nowhere"
+            ));
+        }
+        Ok(Camera {
+            position,
+            look_at,
+            up,
+        })
+    }
+
+    /// Applies the fields `spec` sets to `m`.
+    fn apply(&self, what: &str, spec: &MaterialSpec, m: &mut Material) -> Result<()> {
+        if let Some(s) = spec.surface {
+            m.surface = match s {
+                SurfaceSpec::Diffuse => Surface::Diffuse,
+                SurfaceSpec::Mirror => Surface::Mirror,
+                SurfaceSpec::Glass => Surface::Glass,
+            };
+        }
+        if let Some(v) = spec.diffuse {
+            m.diffuse = self.colour(&format!("{what}.diffuse"), v)?;
+        }
+        if let Some(v) = spec.specular {
+            m.specular = self.colour(&format!("{what}.specular"), v)?;
+        }
+        if let Some(x) = spec.shininess {
+            m.shininess = self.number(&format!("{what}.shininess"), x, 1.0, 1e6)?;
+        }
+        if let Some(v) = spec.emission {
+            m.emission = self.colour(&format!("{what}.emission"), v)?;
+        }
+        if let Some(x) = spec.ior {
+            m.ior = self.number(&format!("{what}.ior"), x, 1e-3, 100.0)?;
+        }
+        if let Some(v) = spec.transmission {
+            m.transmission = self.colour(&format!("{what}.transmission"), v)?;
+        }
+        if let Some(x) = spec.opacity {
+            m.opacity = self.number(&format!("{what}.opacity"), x, 0.0, 1.0)?;
+        }
+        Ok(())
+    }
+
+    /// The mesh's placement: scale, then rotation about x, y and z, then translation.
+    fn transform(&self, what: &str, mesh: &MeshSpec) -> Result<DAffine3> {
+        let scale = match mesh.scale {
+            Scale::Uniform(s) => DVec3::splat(s),
+            Scale::Axes(v) => DVec3::from(v),
+        };
+        if !scale.is_finite() || scale.abs().min_element() == 0.0 {
+            return self.fail(format!(
+                "{what}.scale = {scale}: must be finite and non-zero"
+            ));
+        }
+        let r = self.finite(&format!("{what}.rotation"), mesh.rotation)?
+            * (std::f64::consts::PI / 180.0);
+        let rotation =
+            DMat3::from_rotation_z(r.z) * DMat3::from_rotation_y(r.y) * DMat3::from_rotation_x(r.x);
+        let translation = self.finite(&format!("{what}.translation"), mesh.translation)?;
+        Ok(DAffine3 {
+            matrix3: rotation * DMat3::from_diagonal(scale),
+            translation,
+        })
+    }
+}
+
+/// Loads a scene file: its meshes (OBJ files loaded with their MTL, or shapes), material
+/// overrides, lights, sky and camera. Problems that do not stop the load come back as warnings.
+pub fn load_scene_file(path: &Path) -> Result<Loaded> {
+    let check = Check { path };
+    let text = std::fs::read_to_string(path).map_err(|source| Error::Io {
+        path: path.to_path_buf(),
+        source,
+    })?;
+    let file: SceneFile = toml::from_str(&text).map_err(|e| Error::SceneFile {
+        path: path.to_path_buf(),
+        message: e.to_string().trim_end().to_string(),
+    })?;
+    let dir = path.parent().unwrap_or(Path::new(""));
+    let mut warnings = Vec::new();
+    let mut b = MeshBuilder::new();
+    if file.meshes.is_empty() {
+        return check.fail("no [[mesh]]: a scene needs at least one".into());
+    }
+    for (i, mesh) in file.meshes.iter().enumerate() {
+        let what = format!("mesh {}", i + 1);
+        let transform = check.transform(&what, mesh)?;
+        let first = b.len();
+        match (&mesh.path, mesh.shape) {
+            (Some(obj), None) => load_into(&dir.join(obj), &mut b, &mut warnings)?,
+            (None, Some(shape)) => {
+                let grey = b.material(Material::diffuse(&what, Vec3::splat(0.8)));
+                match shape {
+                    Shape::Box => b.cuboid(DVec3::splat(-0.5), DVec3::splat(0.5), grey),
+                    Shape::Sphere => b.sphere(DVec3::ZERO, 1.0, 64, 32, false, grey),
+                }
+            }
+            _ => return check.fail(format!("{what}: give exactly one of path and shape")),
+        }
+        if b.len() == first {
+            warnings.push(format!("{what}: no triangles"));
+        }
+        b.transform_since(first, transform);
+        if let Some(spec) = &mesh.material {
+            let mut m = Material::diffuse(&what, Vec3::splat(0.8));
+            check.apply(&format!("{what}.material"), spec, &mut m)?;
+            let id = b.material(m);
+            b.set_material_since(first, id);
+        }
+    }
+    for spec in &file.materials {
+        let Some(name) = &spec.name else {
+            return check
+                .fail("a [[material]] needs the name of the materials it overrides".into());
+        };
+        let what = format!("material {name:?}");
+        let mut found = false;
+        for m in b.materials_mut().iter_mut().filter(|m| &m.name == name) {
+            check.apply(&what, spec, m)?;
+            found = true;
+        }
+        if !found {
+            let mut names: Vec<String> = b.materials_mut().iter().map(|m| m.name.clone()).collect();
+            names.sort();
+            names.dedup();
+            return check.fail(format!(
+                "{what} matches no material of the meshes; they have: {}",
+                names.join(", ")
+            ));
+        }
+    }
+    let mut lights = Vec::new();
+    for (i, light) in file.lights.iter().enumerate() {
+        let what = format!("light {}", i + 1);
+        lights.push(match *light {
+            LightSpec::Point {
+                position,
+                intensity,
+            } => Light::Point {
+                position: check.finite(&format!("{what}.position"), position)?,
+                intensity: check.colour(&format!("{what}.intensity"), intensity)?,
+            },
+            LightSpec::Sun {
+                direction,
+                irradiance,
+            } => {
+                let direction = check.finite(&format!("{what}.direction"), direction)?;
+                if direction == DVec3::ZERO {
+                    return check.fail(format!("{what}.direction is zero"));
+                }
+                Light::Directional {
+                    direction,
+                    irradiance: check.colour(&format!("{what}.irradiance"), irradiance)?,
+                }
+            }
+        });
+    }
+    let sky = match file.sky {
+        Some(v) => check.colour("sky", v)?,
+        None => DEFAULT_SKY,
+    };
+    let ambient = match file.ambient {
+        Some(v) => check.colour("ambient", v)?,
+        None => DEFAULT_AMBIENT,
+    };
+    let (camera, path_keys) = match &file.camera {
+        Some(c) => {
+            let up = check.finite("camera.up", c.up)?;
+            let camera = check.camera("camera", c.position, c.look_at, up)?;
+            let keys = c
+                .path
+                .iter()
+                .enumerate()
+                .map(|(i, k)| {
+                    check.camera(&format!("camera.path {}", i + 1), k.position, k.look_at, up)
+                })
+                .collect::<Result<Vec<_>>>()?;
+            (camera, keys)
+        }
+        None => {
+            let (lo, hi) = b.bounds().unwrap_or((DVec3::ZERO, DVec3::ZERO));
+            (framing(lo, hi).0, Vec::new())
+        }
+    };
+    let mut scene = b.finish(lights, sky, ambient, camera);
+    scene.camera_path = path_keys;
+    let emits = scene
+        .materials
+        .iter()
+        .any(|m| m.emission.max_element() > 0.0);
+    if scene.lights.is_empty() && !emits && sky.max_element() == 0.0 && ambient.max_element() == 0.0
+    {
+        warnings.push("nothing lights this scene: no lights, emission, sky or ambient".into());
+    }
+    Ok(Loaded { scene, warnings })
+}
