@@ -5,14 +5,9 @@
 //! `cargo bench --bench lens` (set `FRAMES` to change the count).
 
 use fisheye_rt::demo::LensDemo;
-use fisheye_rt::gpu::{GpuContext, Queries};
+use fisheye_rt::gpu::{GpuContext, Queries, median};
 use fisheye_rt::lens::gpu::{DirectionSource, LensRays};
 use fisheye_rt::lens::{ImageSize, LensCamera, parse_spec};
-
-fn median(mut v: Vec<f64>) -> f64 {
-    v.sort_by(f64::total_cmp);
-    v[v.len() / 2]
-}
 
 /// Median GPU milliseconds of `frames` frames recorded by `encode`, after one warm-up frame.
 fn time(
@@ -21,18 +16,10 @@ fn time(
     frames: usize,
     encode: impl Fn(&mut wgpu::CommandEncoder, wgpu::ComputePassTimestampWrites<'_>),
 ) -> f64 {
-    let mut samples = Vec::with_capacity(frames);
-    for frame in 0..=frames {
-        let mut encoder = ctx.device.create_command_encoder(&Default::default());
-        encode(&mut encoder, queries.writes(0));
-        queries.resolve(&mut encoder);
-        ctx.queue.submit([encoder.finish()]);
-        let ns = queries.read_ns(ctx).expect("timestamps read back")[0];
-        if frame > 0 {
-            samples.push(ns * 1e-6);
-        }
-    }
-    median(samples)
+    let samples = queries
+        .time_frames(ctx, 1, frames, |_, e, t| encode(e, t))
+        .expect("timestamps read back");
+    median(&samples)
 }
 
 fn main() {

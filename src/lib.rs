@@ -33,6 +33,7 @@
 //! ```
 
 pub mod bvh;
+pub mod cube;
 pub mod demo;
 mod error;
 pub mod gpu;

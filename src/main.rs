@@ -7,6 +7,7 @@ use std::time::Instant;
 use anyhow::{Context, Result, bail};
 use clap::{Parser, Subcommand, ValueEnum};
 use fisheye_rt::bvh::BvhQuality;
+use fisheye_rt::cube::{CubeRt, FACES};
 use fisheye_rt::demo::{LensDemo, save_png};
 use fisheye_rt::gpu::{GpuContext, Queries};
 use fisheye_rt::lens::gpu::{DirectionSource, LensPoints};
@@ -14,7 +15,9 @@ use fisheye_rt::lens::{
     DirectionFormula, ImageSize, LensCamera, LensModel, PRESET_FOV_DEGREES, PRESETS, parse_spec,
 };
 use fisheye_rt::scene::{Scene, builtin};
-use fisheye_rt::trace::{Channel, GpuScene, RenderOptions, TracePass, world_directions};
+use fisheye_rt::trace::{
+    Channel, GpuScene, RenderOptions, TracePass, colour_image, world_directions,
+};
 use glam::{DVec2, DVec3};
 
 #[derive(Parser)]
@@ -61,6 +64,13 @@ struct RenderArgs {
     /// or `path:S` for the point S ∈ [0, 1] along the scene file's camera path.
     #[arg(long)]
     camera: Option<String>,
+    /// How to make the image: `rt` traces the lens's rays directly; `cube-rt` traces the six
+    /// faces of a cube map (those the lens reaches) and resamples it.
+    #[arg(long, value_enum, default_value = "rt")]
+    method: Method,
+    /// Face size of the cube map in texels (`--method cube-rt`).
+    #[arg(long, default_value_t = 1024)]
+    cube_size: u32,
     /// Deepest reflection/refraction bounce.
     #[arg(long, default_value_t = 5)]
     max_depth: u32,
@@ -80,6 +90,12 @@ struct RenderArgs {
     /// File format of the ground-truth arrays.
     #[arg(long, value_enum, default_value = "npy")]
     format: ArrayFormat,
+}
+
+#[derive(Clone, Copy, PartialEq, Eq, ValueEnum)]
+enum Method {
+    Rt,
+    CubeRt,
 }
 
 #[derive(Clone, Copy, PartialEq, Eq, ValueEnum)]
@@ -312,6 +328,31 @@ fn render(args: &RenderArgs) -> Result<()> {
         "lens: {} at {size}; compiling the trace kernel...",
         camera.lens
     );
+    if args.method == Method::CubeRt {
+        if !args.outputs.is_empty() {
+            bail!("--outputs come from the direct tracer; use --method rt for ground-truth arrays");
+        }
+        let cube = CubeRt::new(&ctx, &camera, &gpu_scene, args.cube_size)?;
+        let faces: Vec<&str> = FACES
+            .iter()
+            .zip(cube.needed())
+            .filter_map(|(f, n)| n.then_some(f.name))
+            .collect();
+        println!(
+            "cube map: {} faces of {}² texels ({}), each traced, then resampled",
+            faces.len(),
+            args.cube_size,
+            faces.join(" ")
+        );
+        let colour = cube.render(&ctx, &gpu_scene, &scene.camera)?;
+        save_png(&colour_image(size, &colour), out)?;
+        println!(
+            "wrote {} ({:.1} s in all)",
+            out.display(),
+            started.elapsed().as_secs_f64()
+        );
+        return Ok(());
+    }
     let pass = TracePass::new(&ctx, &camera, &gpu_scene, options.directions)?;
     let queries = Queries::new(&ctx, 1);
     ctx.checked("tracing", || {

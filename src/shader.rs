@@ -11,7 +11,7 @@ use crate::scene::Surface;
 use crate::trace;
 
 /// Every WGSL file of the project, by name (its file stem under `wgsl/`).
-pub const FILES: [(&str, &str); 10] = [
+pub const FILES: [(&str, &str); 13] = [
     ("math", include_str!("../wgsl/math.wgsl")),
     ("bvh", include_str!("../wgsl/bvh.wgsl")),
     ("shade", include_str!("../wgsl/shade.wgsl")),
@@ -22,6 +22,9 @@ pub const FILES: [(&str, &str); 10] = [
     ("lens_points", include_str!("../wgsl/lens_points.wgsl")),
     ("lens_demo", include_str!("../wgsl/lens_demo.wgsl")),
     ("trig_probe", include_str!("../wgsl/trig_probe.wgsl")),
+    ("cube", include_str!("../wgsl/cube.wgsl")),
+    ("cube_probe", include_str!("../wgsl/cube_probe.wgsl")),
+    ("cube_sample", include_str!("../wgsl/cube_sample.wgsl")),
 ];
 
 /// Side of the square workgroups of per-pixel kernels.
@@ -96,6 +99,7 @@ pub fn compose(entry: &str) -> String {
     for (name, value) in constants() {
         writeln!(out, "const {name}: u32 = {value}u;").unwrap();
     }
+    out.push_str(&crate::cube::wgsl_faces());
     append(entry, &mut Vec::new(), &mut out);
     out
 }

@@ -404,3 +404,52 @@ fn render_takes_scene_files_and_camera_poses() {
     assert!(String::from_utf8_lossy(&output.stderr).contains("no camera path"));
     std::fs::remove_dir_all(dir).unwrap();
 }
+
+/// `--method cube-rt` renders through a ray-traced cube map, names the faces it traced, and
+/// writes a PNG with the same mask as the direct render; bad combinations are clear errors.
+#[test]
+fn render_through_a_cube_map() {
+    let dir = std::env::temp_dir().join(format!("fisheye-cube-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let (direct, cube) = (dir.join("direct.png"), dir.join("cube.png"));
+    stdout(&fisheye(
+        &["render", "--size", "64x48", "-o", direct.to_str().unwrap()],
+        "",
+    ));
+    let args = ["render", "--size", "64x48", "--method", "cube-rt"];
+    let text = stdout(&fisheye(
+        &[
+            &args[..],
+            &["--cube-size", "32", "-o", cube.to_str().unwrap()],
+        ]
+        .concat(),
+        "",
+    ));
+    assert!(
+        text.contains("5 faces of 32² texels (+x -x +y -y +z)"),
+        "{text}"
+    );
+    let (a, b) = (
+        image::open(&direct).unwrap().to_rgba8(),
+        image::open(&cube).unwrap().to_rgba8(),
+    );
+    assert!(
+        a.pixels().zip(b.pixels()).all(|(p, q)| p[3] == q[3]),
+        "masks differ"
+    );
+    for (extra, wanted) in [
+        (
+            &["--outputs", "range", "-o", cube.to_str().unwrap()][..],
+            "use --method rt",
+        ),
+        (&["--cube-size", "0"][..], "cube face size 0"),
+    ] {
+        let output = fisheye(&[&args[..], extra].concat(), "");
+        let stderr = String::from_utf8_lossy(&output.stderr);
+        assert!(
+            !output.status.success() && stderr.contains(wanted),
+            "{stderr}"
+        );
+    }
+    std::fs::remove_dir_all(dir).unwrap();
+}

@@ -5,7 +5,7 @@ mod timing;
 
 use std::sync::{Arc, Mutex};
 
-pub use timing::Queries;
+pub use timing::{Queries, median};
 
 use crate::error::{Error, Result};
 

@@ -57,4 +57,35 @@ impl Queries {
             .map(|pair| pair[1].wrapping_sub(pair[0]) as f64 * self.period_ns)
             .collect())
     }
+
+    /// Times `frames` frames of one pass after `warmup` untimed ones: `encode(frame, encoder,
+    /// writes)` records frame number `frame` (counting the warm-up) with the given timestamp
+    /// writes on its pass. Returns each timed frame's GPU milliseconds.
+    pub fn time_frames(
+        &self,
+        ctx: &GpuContext,
+        warmup: usize,
+        frames: usize,
+        mut encode: impl FnMut(usize, &mut wgpu::CommandEncoder, wgpu::ComputePassTimestampWrites<'_>),
+    ) -> Result<Vec<f64>> {
+        let mut samples = Vec::with_capacity(frames);
+        for frame in 0..warmup + frames {
+            let mut encoder = ctx.device.create_command_encoder(&Default::default());
+            encode(frame, &mut encoder, self.writes(0));
+            self.resolve(&mut encoder);
+            ctx.queue.submit([encoder.finish()]);
+            let ns = self.read_ns(ctx)?[0];
+            if frame >= warmup {
+                samples.push(ns * 1e-6);
+            }
+        }
+        Ok(samples)
+    }
+}
+
+/// The median of some samples (the upper one of an even count); NaN if there are none.
+pub fn median(samples: &[f64]) -> f64 {
+    let mut v = samples.to_vec();
+    v.sort_by(f64::total_cmp);
+    v.get(v.len() / 2).copied().unwrap_or(f64::NAN)
 }

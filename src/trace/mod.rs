@@ -6,10 +6,10 @@ pub mod cpu;
 mod output;
 
 use bytemuck::{Pod, Zeroable};
-use glam::DVec3;
+use glam::{DMat3, DVec3};
 use wgpu::util::DeviceExt;
 
-pub use output::{Channel, RenderOutput};
+pub use output::{Channel, RenderOutput, colour_image, linear_to_srgb};
 
 use crate::bvh::{BvhQuality, SceneBvh};
 use crate::error::{Error, Result};
@@ -154,7 +154,12 @@ pub fn shading_vertices(scene: &Scene, features: Features) -> Vec<[f32; 4]> {
 
 /// The frame of `pose` for a scene uploaded relative to `origin`.
 fn frame_for(origin: DVec3, pose: &Camera) -> Frame {
-    let rotation = pose.rotation();
+    view_frame(origin, pose.position, pose.rotation())
+}
+
+/// The frame of an eye and a camera-to-world rotation for a scene uploaded relative to
+/// `origin`.
+fn view_frame(origin: DVec3, eye: DVec3, rotation: DMat3) -> Frame {
     let col = |v: DVec3| {
         let v = v.as_vec3();
         [v.x, v.y, v.z, 0.0]
@@ -163,7 +168,7 @@ fn frame_for(origin: DVec3, pose: &Camera) -> Frame {
         right: col(rotation.x_axis),
         down: col(rotation.y_axis),
         forward: col(rotation.z_axis),
-        eye: col(pose.position - origin),
+        eye: col(eye - origin),
     }
 }
 
@@ -432,9 +437,21 @@ impl TracePass {
     /// stays where it was uploaded, relative to its own camera, so poses far from it lose the
     /// precision that relative upload buys; paths through a scene are fine.
     pub fn set_pose(&self, ctx: &GpuContext, scene: &GpuScene, pose: &Camera) {
-        let frame = frame_for(scene.origin, pose);
+        self.set_view(ctx, scene, pose.position, pose.rotation());
+    }
+
+    /// As [`TracePass::set_pose`], with the camera-to-world rotation given (columns: the
+    /// camera's right, down and forward axes in world space).
+    pub fn set_view(&self, ctx: &GpuContext, scene: &GpuScene, eye: DVec3, rotation: DMat3) {
+        let frame = view_frame(scene.origin, eye, rotation);
         ctx.queue
             .write_buffer(&self.frame, 0, bytemuck::bytes_of(&frame));
+    }
+
+    /// The colour output of the last frame (as [`RenderOutput::colour`]), for passes that
+    /// read it on the GPU.
+    pub fn colour_buffer(&self) -> &wgpu::Buffer {
+        &self.colour
     }
 
     /// Records one frame, optionally timed.

@@ -36,6 +36,24 @@ pub fn linear_to_srgb(x: f32) -> f32 {
 /// Masked pixels' colour in [`RenderOutput::to_image`] (sRGB).
 pub const MASKED_RGB: [u8; 3] = [0, 0, 0];
 
+/// The image of linear colours whose `w` is the validity mask (as [`RenderOutput::colour`]):
+/// sRGB-encoded and clamped, opaque where a pixel has a ray, transparent (alpha 0) where not.
+pub fn colour_image(size: ImageSize, colour: &[[f32; 4]]) -> image::RgbaImage {
+    let mut out = Vec::with_capacity(colour.len() * 4);
+    for c in colour {
+        if c[3] == 1.0 {
+            for v in &c[..3] {
+                out.push((linear_to_srgb(v.clamp(0.0, 1.0)) * 255.0).round() as u8);
+            }
+            out.push(255);
+        } else {
+            out.extend_from_slice(&MASKED_RGB);
+            out.push(0);
+        }
+    }
+    image::RgbaImage::from_raw(size.width, size.height, out).expect("width × height RGBA8 pixels")
+}
+
 impl RenderOutput {
     /// Whether pixel `i` (row-major) has a ray.
     pub fn valid(&self, i: usize) -> bool {
@@ -45,20 +63,7 @@ impl RenderOutput {
     /// The colour image, sRGB-encoded and clamped, opaque where a pixel has a ray and
     /// transparent (alpha 0) where it is masked.
     pub fn to_image(&self) -> image::RgbaImage {
-        let mut out = Vec::with_capacity(self.colour.len() * 4);
-        for c in &self.colour {
-            if c[3] == 1.0 {
-                for v in &c[..3] {
-                    out.push((linear_to_srgb(v.clamp(0.0, 1.0)) * 255.0).round() as u8);
-                }
-                out.push(255);
-            } else {
-                out.extend_from_slice(&MASKED_RGB);
-                out.push(0);
-            }
-        }
-        image::RgbaImage::from_raw(self.size.width, self.size.height, out)
-            .expect("width × height RGBA8 pixels")
+        colour_image(self.size, &self.colour)
     }
 
     /// Number of pixels with a ray, and of those whose primary ray hit something.

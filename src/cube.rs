@@ -1,0 +1,473 @@
+//! The cube map around a camera: its six faces, which face and where on it a direction lands,
+//! and bilinear sampling with a one-texel border so that filtering is correct across seams.
+//!
+//! The cube lives in the camera's space (x right, y down, z forward). Each face is a 90° view
+//! with its own right, down and forward axes, all ±1 permutations of the camera's, so the face
+//! coordinates of a direction are exact component selections: on the +z face
+//! `uv = (d.xy / d.z + 1) / 2`. `wgsl/cube.wgsl` is the GPU twin; its face table is generated
+//! from [`FACES`], and a test checks that both pick the same face and UV.
+
+use glam::{DMat3, DVec3, Vec2, Vec3};
+use wgpu::util::DeviceExt;
+
+use crate::error::{Error, Result};
+use crate::gpu::{GpuContext, dispatch_over_image, storage_entry, uniform_entry};
+use crate::lens::gpu::{DirectionSource, lens_constants, params_buffer};
+use crate::lens::{ImageSize, Lens, LensCamera, LensModel};
+use crate::scene::Camera;
+use crate::shader;
+use crate::trace::{GpuScene, TracePass};
+
+/// One face of the cube: its name and its axes in camera space.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Face {
+    /// `+x`, `-x`, `+y`, `-y`, `+z`, `-z` (y is down: `+y` looks at the floor).
+    pub name: &'static str,
+    /// The face image's right (u) axis.
+    pub right: Vec3,
+    /// The face image's down (v) axis.
+    pub down: Vec3,
+    /// The axis the face looks along.
+    pub forward: Vec3,
+}
+
+impl Face {
+    /// Face-to-camera rotation: columns right, down, forward (a proper rotation).
+    pub fn rotation(&self) -> DMat3 {
+        DMat3::from_cols(
+            self.right.as_dvec3(),
+            self.down.as_dvec3(),
+            self.forward.as_dvec3(),
+        )
+    }
+}
+
+/// The faces in id order: the axis of largest magnitude picks `2 · axis + (negative ? 1 : 0)`.
+pub const FACES: [Face; 6] = [
+    Face {
+        name: "+x",
+        right: Vec3::NEG_Z,
+        down: Vec3::Y,
+        forward: Vec3::X,
+    },
+    Face {
+        name: "-x",
+        right: Vec3::Z,
+        down: Vec3::Y,
+        forward: Vec3::NEG_X,
+    },
+    Face {
+        name: "+y",
+        right: Vec3::X,
+        down: Vec3::NEG_Z,
+        forward: Vec3::Y,
+    },
+    Face {
+        name: "-y",
+        right: Vec3::X,
+        down: Vec3::Z,
+        forward: Vec3::NEG_Y,
+    },
+    Face {
+        name: "+z",
+        right: Vec3::X,
+        down: Vec3::Y,
+        forward: Vec3::Z,
+    },
+    Face {
+        name: "-z",
+        right: Vec3::NEG_X,
+        down: Vec3::Y,
+        forward: Vec3::NEG_Z,
+    },
+];
+
+/// The face a direction lands on, and its UV in [0, 1]² (u right, v down), in f32 as the GPU
+/// computes it. The axis of largest magnitude wins; exact ties go to x over y over z, and a
+/// zero component counts as positive. The zero vector maps to the centre of `+z`.
+pub fn face_uv(d: Vec3) -> (u32, Vec2) {
+    let a = d.abs();
+    let axis = if a.x >= a.y && a.x >= a.z {
+        0
+    } else if a.y >= a.z {
+        1
+    } else {
+        2
+    };
+    if a[axis] == 0.0 {
+        return (4, Vec2::splat(0.5));
+    }
+    let face = 2 * axis as u32 + u32::from(d[axis] < 0.0);
+    let f = &FACES[face as usize];
+    let major = d.dot(f.forward);
+    let uv = (Vec2::new(d.dot(f.right), d.dot(f.down)) / major + 1.0) * 0.5;
+    (face, uv)
+}
+
+/// The WGSL declaration of [`FACES`] as face-to-camera matrices (columns right, down,
+/// forward), prepended to every module.
+pub fn wgsl_faces() -> String {
+    let v = |v: Vec3| format!("vec3<f32>({:.1}, {:.1}, {:.1})", v.x, v.y, v.z);
+    let faces: Vec<String> = FACES
+        .iter()
+        .map(|f| {
+            format!(
+                "mat3x3<f32>({}, {}, {})",
+                v(f.right),
+                v(f.down),
+                v(f.forward)
+            )
+        })
+        .collect();
+    format!(
+        "const CUBE_FACES = array<mat3x3<f32>, 6>({});\n",
+        faces.join(", ")
+    )
+}
+
+/// Faces with a one-texel border: a face of `size` texels is stored as `(size + 2)²` texels,
+/// the border holding the neighbouring faces' samples (rendered as directions just past the
+/// edge), so that bilinear filtering near a seam reads real neighbours, never clamped ones.
+pub fn bordered(size: u32) -> u32 {
+    size + 2
+}
+
+/// The rectilinear focal length (in the lens module's normalized units, half-width = 1) of a
+/// bordered face image: its inner `size` texels span exactly 90°.
+pub fn bordered_focal(size: u32) -> f64 {
+    f64::from(size) / f64::from(bordered(size))
+}
+
+/// Bilinear lookup of a bordered face at `uv`, as `wgsl/cube.wgsl` does: texels are
+/// `texels[face][row][column]` of side `size + 2`, centres at `(i + 0.5) / size` past the border.
+pub fn sample_bordered(texels: &[[f32; 4]], size: u32, face: u32, uv: Vec2) -> [f32; 4] {
+    let side = bordered(size) as usize;
+    let st = uv * size as f32 + 0.5;
+    let base = st.floor();
+    let f = st - base;
+    let x = (base.x.max(0.0) as usize).min(side - 2);
+    let y = (base.y.max(0.0) as usize).min(side - 2);
+    let at = |x: usize, y: usize| texels[(face as usize * side + y) * side + x];
+    let mix = |a: [f32; 4], b: [f32; 4], t: f32| std::array::from_fn(|k| a[k] + (b[k] - a[k]) * t);
+    let top = mix(at(x, y), at(x + 1, y), f.x);
+    let bottom = mix(at(x, y + 1), at(x + 1, y + 1), f.x);
+    mix(top, bottom, f.y)
+}
+
+/// Which faces directions can land on: a face is needed when some direction lies within a
+/// small margin of it (so that the GPU's f32 directions, which differ from the f64 ones by
+/// about 1e-7, never pick a face that was not rendered).
+pub fn needed_faces(directions: impl IntoIterator<Item = DVec3>) -> [bool; 6] {
+    const MARGIN: f64 = 1e-4;
+    let mut needed = [false; 6];
+    for d in directions {
+        for (i, f) in FACES.iter().enumerate() {
+            let forward = d.dot(f.forward.as_dvec3());
+            let side = d
+                .dot(f.right.as_dvec3())
+                .abs()
+                .max(d.dot(f.down.as_dvec3()).abs());
+            if forward > 0.0 && forward * (1.0 + MARGIN) >= side {
+                needed[i] = true;
+            }
+        }
+    }
+    needed
+}
+
+/// The cube-map path with ray-traced faces: the tracer renders each face the lens can reach
+/// as a 90° pinhole view (plus its border), then a compute pass resamples the cube into the
+/// lens image. Compared with the direct fisheye render, it isolates the error of cube-map
+/// resampling alone.
+pub struct CubeRt {
+    size: u32,
+    needed: [bool; 6],
+    faces: TracePass,
+    texels: wgpu::Buffer,
+    sampler: wgpu::ComputePipeline,
+    bind_group: wgpu::BindGroup,
+    colour: wgpu::Buffer,
+    camera: LensCamera,
+}
+
+impl CubeRt {
+    /// Faces of `size` × `size` texels for `camera` on `scene`.
+    pub fn new(ctx: &GpuContext, camera: &LensCamera, scene: &GpuScene, size: u32) -> Result<Self> {
+        let max = ctx.device.limits().max_texture_dimension_2d;
+        if size == 0 || size > max {
+            return Err(Error::Scene(format!(
+                "cube face size {size}: must be between 1 and the adapter's limit of {max}"
+            )));
+        }
+        let side = bordered(size);
+        let face_size = ImageSize::new(side, side)?;
+        let face_lens = Lens::new(LensModel::Rectilinear, bordered_focal(size))?;
+        let face_camera = LensCamera::new(face_lens, face_size);
+        let texel_bytes = 16 * 6 * u64::from(side) * u64::from(side);
+        ctx.check_binding("the cube faces", texel_bytes)?;
+        ctx.check_binding(
+            "the cube-map colour output",
+            16 * camera.size.pixels() as u64,
+        )?;
+        let needed = needed_faces(camera.directions().into_iter().flatten());
+        let faces = TracePass::new(ctx, &face_camera, scene, DirectionSource::Computed)?;
+        ctx.checked("creating the cube-map sampler", || {
+            let device = &ctx.device;
+            let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+                label: Some("fisheye.cube_sample"),
+                // Lens and table as wgsl/primary.wgsl declares them, faces, output.
+                entries: &[
+                    uniform_entry(0),
+                    storage_entry(1, true),
+                    storage_entry(2, true),
+                    storage_entry(3, false),
+                ],
+            });
+            let mut constants = lens_constants(camera).to_vec();
+            constants.extend([
+                (
+                    "DIRECTION_SOURCE",
+                    f64::from(DirectionSource::Computed as u32),
+                ),
+                ("CUBE_SIZE", f64::from(size)),
+            ]);
+            let sampler =
+                shader::compute_pipeline(device, "cube_sample", "main", &constants, &[&layout]);
+            let buffer = |label: &str, bytes: u64, usage: wgpu::BufferUsages| {
+                device.create_buffer(&wgpu::BufferDescriptor {
+                    label: Some(label),
+                    size: bytes,
+                    usage,
+                    mapped_at_creation: false,
+                })
+            };
+            use wgpu::BufferUsages as U;
+            let texels = buffer(
+                "fisheye.cube.texels",
+                texel_bytes,
+                U::STORAGE | U::COPY_DST | U::COPY_SRC,
+            );
+            let colour = buffer(
+                "fisheye.cube.colour",
+                16 * camera.size.pixels() as u64,
+                U::STORAGE | U::COPY_SRC,
+            );
+            let no_table = buffer("fisheye.cube.no_table", 16, U::STORAGE);
+            let lens = params_buffer(device, camera);
+            let resources = [&lens, &no_table, &texels, &colour];
+            let entries: Vec<_> = resources
+                .iter()
+                .enumerate()
+                .map(|(b, buffer)| wgpu::BindGroupEntry {
+                    binding: b as u32,
+                    resource: buffer.as_entire_binding(),
+                })
+                .collect();
+            let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some("fisheye.cube_sample"),
+                layout: &layout,
+                entries: &entries,
+            });
+            Self {
+                size,
+                needed,
+                faces,
+                texels,
+                sampler,
+                bind_group,
+                colour,
+                camera: *camera,
+            }
+        })
+    }
+
+    /// Which faces this lens needs (in [`FACES`] order); the others are never rendered.
+    pub fn needed(&self) -> [bool; 6] {
+        self.needed
+    }
+
+    /// Renders the needed faces from `pose` (one submission each, since each moves the face
+    /// camera), then resamples them into the lens image. Returns the lens image's colours (as
+    /// [`RenderOutput::colour`](crate::trace::RenderOutput::colour)).
+    pub fn render(
+        &self,
+        ctx: &GpuContext,
+        scene: &GpuScene,
+        pose: &Camera,
+    ) -> Result<Vec<[f32; 4]>> {
+        let rotation = pose.rotation();
+        let side = u64::from(bordered(self.size));
+        for (i, face) in FACES.iter().enumerate() {
+            if !self.needed[i] {
+                continue;
+            }
+            self.faces
+                .set_view(ctx, scene, pose.position, rotation * face.rotation());
+            ctx.checked("rendering a cube face", || {
+                let mut encoder = ctx.device.create_command_encoder(&Default::default());
+                self.faces.encode(&mut encoder, scene, None);
+                let bytes = 16 * side * side;
+                encoder.copy_buffer_to_buffer(
+                    self.faces.colour_buffer(),
+                    0,
+                    &self.texels,
+                    bytes * i as u64,
+                    bytes,
+                );
+                ctx.queue.submit([encoder.finish()]);
+            })?;
+        }
+        ctx.checked("resampling the cube", || {
+            let mut encoder = ctx.device.create_command_encoder(&Default::default());
+            dispatch_over_image(
+                &mut encoder,
+                "fisheye.cube_sample",
+                &self.sampler,
+                &[&self.bind_group],
+                self.camera.size,
+                None,
+            );
+            ctx.queue.submit([encoder.finish()]);
+        })?;
+        ctx.read_buffer(&self.colour)
+    }
+
+    /// The faces of the last render: `6 × (size + 2)²` texels, row-major per face (faces not
+    /// needed hold nothing meaningful).
+    pub fn texels(&self, ctx: &GpuContext) -> Result<Vec<[f32; 4]>> {
+        ctx.read_buffer(&self.texels)
+    }
+}
+
+/// Runs `wgsl/cube.wgsl`'s face selection on the GPU for each direction.
+pub fn face_uv_gpu(ctx: &GpuContext, directions: &[Vec3]) -> Result<Vec<(u32, Vec2)>> {
+    let input: Vec<[f32; 4]> = directions.iter().map(|d| [d.x, d.y, d.z, 0.0]).collect();
+    ctx.check_binding("the probe directions", 16 * input.len() as u64)?;
+    let out = ctx.checked("probing cube faces", || {
+        let device = &ctx.device;
+        let pipeline = shader::compute_pipeline(device, "cube_probe", "main", &[], &[]);
+        let points = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("fisheye.cube_probe.directions"),
+            contents: bytemuck::cast_slice(&input),
+            usage: wgpu::BufferUsages::STORAGE,
+        });
+        let results = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("fisheye.cube_probe.results"),
+            size: points.size(),
+            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
+            mapped_at_creation: false,
+        });
+        let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("fisheye.cube_probe"),
+            layout: &pipeline.get_bind_group_layout(0),
+            entries: &[
+                wgpu::BindGroupEntry {
+                    binding: 0,
+                    resource: points.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 1,
+                    resource: results.as_entire_binding(),
+                },
+            ],
+        });
+        let mut encoder = device.create_command_encoder(&Default::default());
+        {
+            let mut pass = encoder.begin_compute_pass(&Default::default());
+            pass.set_pipeline(&pipeline);
+            pass.set_bind_group(0, &bind_group, &[]);
+            pass.dispatch_workgroups(
+                (input.len() as u32).div_ceil(crate::shader::WORKGROUP_1D),
+                1,
+                1,
+            );
+        }
+        ctx.queue.submit([encoder.finish()]);
+        results
+    })?;
+    let raw: Vec<[f32; 4]> = ctx.read_buffer(&out)?;
+    Ok(raw
+        .into_iter()
+        .map(|v| (v[0].to_bits(), Vec2::new(v[1], v[2])))
+        .collect())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn faces_are_rotations_and_uv_follows_the_axes() {
+        for (i, f) in FACES.iter().enumerate() {
+            let r = f.rotation();
+            assert!((r.determinant() - 1.0).abs() < 1e-15, "{}", f.name);
+            // The face's centre, and its right and down edges.
+            assert_eq!(face_uv(f.forward), (i as u32, Vec2::splat(0.5)));
+            let right = face_uv(f.forward + 0.5 * f.right);
+            assert_eq!(right, (i as u32, Vec2::new(0.75, 0.5)), "{}", f.name);
+            let down = face_uv(f.forward + 0.5 * f.down);
+            assert_eq!(down, (i as u32, Vec2::new(0.5, 0.75)), "{}", f.name);
+        }
+        // The formula on +z.
+        let d = Vec3::new(0.3, -0.2, 0.9);
+        assert_eq!(face_uv(d), (4, (Vec2::new(d.x, d.y) / d.z + 1.0) * 0.5));
+        // Ties: x over y over z, zero counts as positive.
+        assert_eq!(face_uv(Vec3::new(1.0, 1.0, 1.0)).0, 0);
+        assert_eq!(face_uv(Vec3::new(0.0, -1.0, 1.0)).0, 3);
+        assert_eq!(face_uv(Vec3::new(-1.0, 1.0, 0.0)).0, 1);
+        assert_eq!(face_uv(Vec3::ZERO), (4, Vec2::splat(0.5)));
+    }
+
+    #[test]
+    fn a_face_edge_is_shared_by_its_neighbours_in_the_border() {
+        // A point on the +z/+x edge, seen from both faces: u = 1 on +z, u = 0 on +x.
+        let d = Vec3::new(1.0, 0.25, 1.0);
+        let on_z = (Vec2::new(d.x, d.y) / d.z + 1.0) * 0.5;
+        assert_eq!(on_z, Vec2::new(1.0, 0.625));
+        let x = &FACES[0];
+        let on_x = (Vec2::new(d.dot(x.right), d.dot(x.down)) / d.dot(x.forward) + 1.0) * 0.5;
+        assert_eq!(on_x, Vec2::new(0.0, 0.625));
+    }
+
+    #[test]
+    fn bilinear_sampling_reads_the_border() {
+        // A face of 2 texels (4 × 4 bordered) whose texel (x, y) holds x + 10 y: sampling is
+        // exact for this linear function anywhere, the border included.
+        let size = 2;
+        let side = bordered(size) as usize;
+        let texels: Vec<[f32; 4]> = (0..6 * side * side)
+            .map(|i| {
+                let (x, y) = ((i % side) as f32, ((i / side) % side) as f32);
+                [x + 10.0 * y, 0.0, 0.0, 1.0]
+            })
+            .collect();
+        for (u, v) in [(0.0, 0.0), (0.5, 0.5), (1.0, 1.0), (0.1, 0.9), (0.75, 0.25)] {
+            let s = sample_bordered(&texels, size, 3, Vec2::new(u, v));
+            // Texel centre of bordered column x is at u = (x - 0.5) / size.
+            let expected = (u * 2.0 + 0.5) + 10.0 * (v * 2.0 + 0.5);
+            assert!(
+                (s[0] - expected).abs() < 1e-5,
+                "{u} {v}: {s:?} vs {expected}"
+            );
+        }
+    }
+
+    #[test]
+    fn needed_faces_follow_the_field_of_view() {
+        // Straight ahead only: the front face. A hemisphere: five faces, never the back.
+        assert_eq!(
+            needed_faces([DVec3::Z]),
+            [false, false, false, false, true, false]
+        );
+        let hemisphere = (0..=90).flat_map(|t| {
+            (0..360).map(move |p| {
+                let (t, p) = (f64::from(t).to_radians(), f64::from(p).to_radians());
+                DVec3::new(t.sin() * p.cos(), t.sin() * p.sin(), t.cos())
+            })
+        });
+        assert_eq!(
+            needed_faces(hemisphere),
+            [true, true, true, true, true, false]
+        );
+    }
+}
