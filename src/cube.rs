@@ -11,7 +11,7 @@ use glam::{DMat3, DVec3, Vec2, Vec3};
 use wgpu::util::DeviceExt;
 
 use crate::error::{Error, Result};
-use crate::gpu::{GpuContext, dispatch_over_image, storage_entry, uniform_entry};
+use crate::gpu::{GpuContext, bind_buffers, dispatch_over_image, storage_entry, uniform_entry};
 use crate::lens::gpu::{DirectionSource, lens_constants, params_buffer};
 use crate::lens::{ImageSize, Lens, LensCamera, LensModel};
 use crate::scene::Camera;
@@ -254,20 +254,12 @@ impl CubeRt {
             );
             let no_table = buffer("fisheye.cube.no_table", 16, U::STORAGE);
             let lens = params_buffer(device, camera);
-            let resources = [&lens, &no_table, &texels, &colour];
-            let entries: Vec<_> = resources
-                .iter()
-                .enumerate()
-                .map(|(b, buffer)| wgpu::BindGroupEntry {
-                    binding: b as u32,
-                    resource: buffer.as_entire_binding(),
-                })
-                .collect();
-            let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-                label: Some("fisheye.cube_sample"),
-                layout: &layout,
-                entries: &entries,
-            });
+            let bind_group = bind_buffers(
+                device,
+                "fisheye.cube_sample",
+                &layout,
+                &[&lens, &no_table, &texels, &colour],
+            );
             Self {
                 size,
                 needed,
@@ -357,20 +349,12 @@ pub fn face_uv_gpu(ctx: &GpuContext, directions: &[Vec3]) -> Result<Vec<(u32, Ve
             usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
             mapped_at_creation: false,
         });
-        let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("fisheye.cube_probe"),
-            layout: &pipeline.get_bind_group_layout(0),
-            entries: &[
-                wgpu::BindGroupEntry {
-                    binding: 0,
-                    resource: points.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 1,
-                    resource: results.as_entire_binding(),
-                },
-            ],
-        });
+        let bind_group = bind_buffers(
+            device,
+            "fisheye.cube_probe",
+            &pipeline.get_bind_group_layout(0),
+            &[&points, &results],
+        );
         let mut encoder = device.create_command_encoder(&Default::default());
         {
             let mut pass = encoder.begin_compute_pass(&Default::default());

@@ -64,24 +64,12 @@ impl LensDemo {
                 }
             };
             let params = params_buffer(device, camera);
-            let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-                label: Some("fisheye.lens_demo"),
-                layout: &layout,
-                entries: &[
-                    wgpu::BindGroupEntry {
-                        binding: 0,
-                        resource: params.as_entire_binding(),
-                    },
-                    wgpu::BindGroupEntry {
-                        binding: 1,
-                        resource: table_buffer.as_entire_binding(),
-                    },
-                    wgpu::BindGroupEntry {
-                        binding: 2,
-                        resource: pixels.as_entire_binding(),
-                    },
-                ],
-            });
+            let bind_group = crate::gpu::bind_buffers(
+                device,
+                "fisheye.lens_demo",
+                &layout,
+                &[&params, table_buffer, &pixels],
+            );
             Self {
                 pipeline,
                 bind_group,

@@ -51,20 +51,12 @@ pub fn measure_trig(ctx: &GpuContext) -> Result<Vec<TrigError>> {
             usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
             mapped_at_creation: false,
         });
-        let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("fisheye.trig_probe"),
-            layout: &pipeline.get_bind_group_layout(0),
-            entries: &[
-                wgpu::BindGroupEntry {
-                    binding: 0,
-                    resource: input.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 1,
-                    resource: values.as_entire_binding(),
-                },
-            ],
-        });
+        let bind_group = crate::gpu::bind_buffers(
+            device,
+            "fisheye.trig_probe",
+            &pipeline.get_bind_group_layout(0),
+            &[&input, &values],
+        );
         let mut encoder = device.create_command_encoder(&Default::default());
         {
             let mut pass = encoder.begin_compute_pass(&Default::default());

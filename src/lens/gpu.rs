@@ -202,20 +202,12 @@ impl LensRays {
                 mapped_at_creation: false,
             });
             let params = params_buffer(device, camera);
-            let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-                label: Some("fisheye.lens_rays"),
-                layout: &pipeline.get_bind_group_layout(0),
-                entries: &[
-                    wgpu::BindGroupEntry {
-                        binding: 0,
-                        resource: params.as_entire_binding(),
-                    },
-                    wgpu::BindGroupEntry {
-                        binding: 1,
-                        resource: directions.as_entire_binding(),
-                    },
-                ],
-            });
+            let bind_group = crate::gpu::bind_buffers(
+                device,
+                "fisheye.lens_rays",
+                &pipeline.get_bind_group_layout(0),
+                &[&params, &directions],
+            );
             Self {
                 pipeline,
                 bind_group,
@@ -357,24 +349,12 @@ impl LensPoints {
                     usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
                     mapped_at_creation: false,
                 });
-                let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-                    label: Some("fisheye.lens_points"),
-                    layout: &pipeline.get_bind_group_layout(0),
-                    entries: &[
-                        wgpu::BindGroupEntry {
-                            binding: 0,
-                            resource: self.params.as_entire_binding(),
-                        },
-                        wgpu::BindGroupEntry {
-                            binding: 1,
-                            resource: points.as_entire_binding(),
-                        },
-                        wgpu::BindGroupEntry {
-                            binding: 2,
-                            resource: results.as_entire_binding(),
-                        },
-                    ],
-                });
+                let bind_group = crate::gpu::bind_buffers(
+                    device,
+                    "fisheye.lens_points",
+                    &pipeline.get_bind_group_layout(0),
+                    &[&self.params, &points, &results],
+                );
                 let mut encoder = device.create_command_encoder(&Default::default());
                 {
                     let mut pass = encoder.begin_compute_pass(&Default::default());

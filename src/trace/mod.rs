@@ -13,7 +13,7 @@ pub use output::{Channel, RenderOutput, colour_image, linear_to_srgb};
 
 use crate::bvh::{BvhQuality, SceneBvh};
 use crate::error::{Error, Result};
-use crate::gpu::{GpuContext, dispatch_over_image, storage_entry, uniform_entry};
+use crate::gpu::{GpuContext, bind_buffers, dispatch_over_image, storage_entry, uniform_entry};
 use crate::lens::LensCamera;
 use crate::lens::gpu::{DirectionSource, LensRays, lens_constants, params_buffer};
 use crate::scene::{Camera, Features, Scene, Surface};
@@ -295,23 +295,9 @@ impl GpuScene {
                 label: Some("fisheye.scene"),
                 entries: &entries,
             });
-            let mut resources: Vec<wgpu::BindGroupEntry> = buffers
-                .iter()
-                .enumerate()
-                .map(|(b, buffer)| wgpu::BindGroupEntry {
-                    binding: b as u32,
-                    resource: buffer.as_entire_binding(),
-                })
-                .collect();
-            resources.push(wgpu::BindGroupEntry {
-                binding: 7,
-                resource: uniform.as_entire_binding(),
-            });
-            let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-                label: Some("fisheye.scene"),
-                layout: &layout,
-                entries: &resources,
-            });
+            let mut resources: Vec<&wgpu::Buffer> = buffers.iter().collect();
+            resources.push(&uniform);
+            let bind_group = bind_buffers(device, "fisheye.scene", &layout, &resources);
             Self {
                 layout,
                 bind_group,
@@ -407,20 +393,12 @@ impl TracePass {
             let placeholder = output("fisheye.trace.no_table", 16);
             let table = table.as_ref().map_or(&placeholder, |t| &t.directions);
             let lens = params_buffer(device, camera);
-            let resources = [&lens, table, &frame, &colour, &geometry, &ids];
-            let entries: Vec<_> = resources
-                .iter()
-                .enumerate()
-                .map(|(b, buffer)| wgpu::BindGroupEntry {
-                    binding: b as u32,
-                    resource: buffer.as_entire_binding(),
-                })
-                .collect();
-            let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-                label: Some("fisheye.trace.frame"),
-                layout: &layout,
-                entries: &entries,
-            });
+            let bind_group = bind_buffers(
+                device,
+                "fisheye.trace.frame",
+                &layout,
+                &[&lens, table, &frame, &colour, &geometry, &ids],
+            );
             Self {
                 pipeline,
                 bind_group,
