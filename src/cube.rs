@@ -154,25 +154,67 @@ pub fn sample_bordered(texels: &[[f32; 4]], size: u32, face: u32, uv: Vec2) -> [
     mix(top, bottom, f.y)
 }
 
-/// Which faces directions can land on: a face is needed when some direction lies within a
-/// small margin of it (so that the GPU's f32 directions, which differ from the f64 ones by
-/// about 1e-7, never pick a face that was not rendered).
-pub fn needed_faces(directions: impl IntoIterator<Item = DVec3>) -> [bool; 6] {
+/// A rectangle of a bordered face, in texels: columns `x0..x1`, rows `y0..y1`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Region {
+    /// First column.
+    pub x0: u32,
+    /// First row.
+    pub y0: u32,
+    /// One past the last column.
+    pub x1: u32,
+    /// One past the last row.
+    pub y1: u32,
+}
+
+impl Region {
+    /// Number of texels.
+    pub fn texels(&self) -> u64 {
+        u64::from(self.x1 - self.x0) * u64::from(self.y1 - self.y0)
+    }
+}
+
+/// The part of each bordered face of `size` texels that sampling `directions` reads: the
+/// bilinear footprints of every direction that lands on the face or within a small margin of
+/// it, grown by one texel, so that the GPU's f32 directions (about 1e-7 rad from these f64
+/// ones) never read a texel that was not rendered. `None` for faces nothing reaches.
+pub fn face_regions(directions: impl IntoIterator<Item = DVec3>, size: u32) -> [Option<Region>; 6] {
     const MARGIN: f64 = 1e-4;
-    let mut needed = [false; 6];
+    let side = i64::from(bordered(size));
+    let mut regions: [Option<Region>; 6] = [None; 6];
     for d in directions {
         for (i, f) in FACES.iter().enumerate() {
             let forward = d.dot(f.forward.as_dvec3());
-            let side = d
-                .dot(f.right.as_dvec3())
-                .abs()
-                .max(d.dot(f.down.as_dvec3()).abs());
-            if forward > 0.0 && forward * (1.0 + MARGIN) >= side {
-                needed[i] = true;
+            let (sc, tc) = (d.dot(f.right.as_dvec3()), d.dot(f.down.as_dvec3()));
+            if forward <= 0.0 || forward * (1.0 + MARGIN) < sc.abs().max(tc.abs()) {
+                continue;
             }
+            // As `sample_bordered`: texels floor(st) and floor(st) + 1, clamped, then ±1.
+            let texel = |c: f64| {
+                let st = ((c / forward + 1.0) * 0.5) * f64::from(size) + 0.5;
+                let x = (st.floor() as i64).clamp(0, side - 2);
+                ((x - 1).max(0) as u32, (x + 3).min(side) as u32)
+            };
+            let ((x0, x1), (y0, y1)) = (texel(sc), texel(tc));
+            let r = regions[i].get_or_insert(Region { x0, y0, x1, y1 });
+            *r = Region {
+                x0: r.x0.min(x0),
+                y0: r.y0.min(y0),
+                x1: r.x1.max(x1),
+                y1: r.y1.max(y1),
+            };
         }
     }
-    needed
+    regions
+}
+
+/// How much of each face [`CubeRt`] renders.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Coverage {
+    /// Only the part of each face the lens can reach ([`face_regions`]).
+    Reachable,
+    /// Every texel of every face the lens reaches (to compare).
+    WholeFaces,
 }
 
 /// The cube-map path with ray-traced faces: the tracer renders each face the lens can reach
@@ -181,7 +223,7 @@ pub fn needed_faces(directions: impl IntoIterator<Item = DVec3>) -> [bool; 6] {
 /// resampling alone.
 pub struct CubeRt {
     size: u32,
-    needed: [bool; 6],
+    regions: [Option<Region>; 6],
     faces: TracePass,
     texels: wgpu::Buffer,
     sampler: wgpu::ComputePipeline,
@@ -191,8 +233,14 @@ pub struct CubeRt {
 }
 
 impl CubeRt {
-    /// Faces of `size` × `size` texels for `camera` on `scene`.
-    pub fn new(ctx: &GpuContext, camera: &LensCamera, scene: &GpuScene, size: u32) -> Result<Self> {
+    /// Faces of `size` × `size` texels for `camera` on `scene`, rendered where `coverage` says.
+    pub fn new(
+        ctx: &GpuContext,
+        camera: &LensCamera,
+        scene: &GpuScene,
+        size: u32,
+        coverage: Coverage,
+    ) -> Result<Self> {
         let max = ctx.device.limits().max_texture_dimension_2d;
         if size == 0 || size > max {
             return Err(Error::Scene(format!(
@@ -209,7 +257,17 @@ impl CubeRt {
             "the cube-map colour output",
             16 * camera.size.pixels() as u64,
         )?;
-        let needed = needed_faces(camera.directions().into_iter().flatten());
+        let mut regions = face_regions(camera.directions().into_iter().flatten(), size);
+        if coverage == Coverage::WholeFaces {
+            for r in regions.iter_mut().flatten() {
+                *r = Region {
+                    x0: 0,
+                    y0: 0,
+                    x1: side,
+                    y1: side,
+                };
+            }
+        }
         let faces = TracePass::new(ctx, &face_camera, scene, DirectionSource::Computed)?;
         ctx.checked("creating the cube-map sampler", || {
             let device = &ctx.device;
@@ -262,7 +320,7 @@ impl CubeRt {
             );
             Self {
                 size,
-                needed,
+                regions,
                 faces,
                 texels,
                 sampler,
@@ -273,14 +331,15 @@ impl CubeRt {
         })
     }
 
-    /// Which faces this lens needs (in [`FACES`] order); the others are never rendered.
-    pub fn needed(&self) -> [bool; 6] {
-        self.needed
+    /// The rendered part of each face (in [`FACES`] order), `None` for faces the lens never
+    /// reaches.
+    pub fn regions(&self) -> [Option<Region>; 6] {
+        self.regions
     }
 
-    /// Renders the needed faces from `pose` (one submission each, since each moves the face
-    /// camera), then resamples them into the lens image. Returns the lens image's colours (as
-    /// [`RenderOutput::colour`](crate::trace::RenderOutput::colour)).
+    /// Renders the reachable faces (or parts) from `pose`, one submission each since each
+    /// moves the face camera, then resamples them into the lens image. Returns the lens
+    /// image's colours (as [`RenderOutput::colour`](crate::trace::RenderOutput::colour)).
     pub fn render(
         &self,
         ctx: &GpuContext,
@@ -290,14 +349,18 @@ impl CubeRt {
         let rotation = pose.rotation();
         let side = u64::from(bordered(self.size));
         for (i, face) in FACES.iter().enumerate() {
-            if !self.needed[i] {
-                continue;
-            }
-            self.faces
-                .set_view(ctx, scene, pose.position, rotation * face.rotation());
+            let Some(r) = self.regions[i] else { continue };
+            self.faces.set_view(
+                ctx,
+                scene,
+                pose.position,
+                rotation * face.rotation(),
+                [r.x0, r.y0],
+            );
             ctx.checked("rendering a cube face", || {
                 let mut encoder = ctx.device.create_command_encoder(&Default::default());
-                self.faces.encode(&mut encoder, scene, None);
+                let extent = ImageSize::new(r.x1 - r.x0, r.y1 - r.y0).expect("a non-empty region");
+                self.faces.encode_region(&mut encoder, scene, extent, None);
                 let bytes = 16 * side * side;
                 encoder.copy_buffer_to_buffer(
                     self.faces.colour_buffer(),
@@ -324,8 +387,8 @@ impl CubeRt {
         ctx.read_buffer(&self.colour)
     }
 
-    /// The faces of the last render: `6 × (size + 2)²` texels, row-major per face (faces not
-    /// needed hold nothing meaningful).
+    /// The faces of the last render: `6 × (size + 2)²` texels, row-major per face (texels
+    /// outside the regions hold nothing meaningful).
     pub fn texels(&self, ctx: &GpuContext) -> Result<Vec<[f32; 4]>> {
         ctx.read_buffer(&self.texels)
     }
@@ -437,21 +500,36 @@ mod tests {
     }
 
     #[test]
-    fn needed_faces_follow_the_field_of_view() {
-        // Straight ahead only: the front face. A hemisphere: five faces, never the back.
+    fn regions_follow_the_field_of_view() {
+        let reached = |r: [Option<Region>; 6]| r.map(|r| r.is_some());
+        // Straight ahead only: the centre of the front face, with its footprint.
+        let ahead = face_regions([DVec3::Z], 8);
+        assert_eq!(reached(ahead), [false, false, false, false, true, false]);
         assert_eq!(
-            needed_faces([DVec3::Z]),
-            [false, false, false, false, true, false]
+            ahead[4],
+            Some(Region {
+                x0: 3,
+                y0: 3,
+                x1: 7,
+                y1: 7
+            })
         );
+        // A hemisphere: all of the front face, the front half of each side face, never the
+        // back face.
         let hemisphere = (0..=90).flat_map(|t| {
             (0..360).map(move |p| {
                 let (t, p) = (f64::from(t).to_radians(), f64::from(p).to_radians());
                 DVec3::new(t.sin() * p.cos(), t.sin() * p.sin(), t.cos())
             })
         });
-        assert_eq!(
-            needed_faces(hemisphere),
-            [true, true, true, true, true, false]
-        );
+        let size = 64;
+        let r = face_regions(hemisphere, size);
+        assert_eq!(reached(r), [true, true, true, true, true, false]);
+        let side = bordered(size);
+        assert_eq!(r[4].unwrap().texels(), u64::from(side * side));
+        for i in 0..4 {
+            let t = r[i].unwrap().texels() as f64 / f64::from(side * side);
+            assert!((0.5..0.56).contains(&t), "face {}: {t}", FACES[i].name);
+        }
     }
 }

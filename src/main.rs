@@ -7,7 +7,7 @@ use std::time::Instant;
 use anyhow::{Context, Result, bail};
 use clap::{Parser, Subcommand, ValueEnum};
 use fisheye_rt::bvh::BvhQuality;
-use fisheye_rt::cube::{CubeRt, FACES};
+use fisheye_rt::cube::{Coverage, CubeRt, FACES};
 use fisheye_rt::demo::{LensDemo, save_png};
 use fisheye_rt::gpu::{GpuContext, Queries};
 use fisheye_rt::lens::gpu::{DirectionSource, LensPoints};
@@ -332,17 +332,28 @@ fn render(args: &RenderArgs) -> Result<()> {
         if !args.outputs.is_empty() {
             bail!("--outputs come from the direct tracer; use --method rt for ground-truth arrays");
         }
-        let cube = CubeRt::new(&ctx, &camera, &gpu_scene, args.cube_size)?;
+        let cube = CubeRt::new(
+            &ctx,
+            &camera,
+            &gpu_scene,
+            args.cube_size,
+            Coverage::Reachable,
+        )?;
+        let regions = cube.regions();
         let faces: Vec<&str> = FACES
             .iter()
-            .zip(cube.needed())
-            .filter_map(|(f, n)| n.then_some(f.name))
+            .zip(regions)
+            .filter_map(|(f, r)| r.map(|_| f.name))
             .collect();
+        let traced: u64 = regions.iter().flatten().map(|r| r.texels()).sum();
+        let side = u64::from(args.cube_size + 2);
         println!(
-            "cube map: {} faces of {}² texels ({}), each traced, then resampled",
+            "cube map: {} faces of {}² texels ({}); traced {:.0}% of their texels (the parts the \
+             lens reaches), then resampled",
             faces.len(),
             args.cube_size,
-            faces.join(" ")
+            faces.join(" "),
+            100.0 * traced as f64 / (faces.len() as u64 * side * side) as f64
         );
         let colour = cube.render(&ctx, &gpu_scene, &scene.camera)?;
         save_png(&colour_image(size, &colour), out)?;

@@ -5,7 +5,7 @@
 mod common;
 
 use common::{camera, ctx};
-use fisheye_rt::cube::{CubeRt, FACES, face_uv, face_uv_gpu, sample_bordered};
+use fisheye_rt::cube::{Coverage, CubeRt, FACES, face_uv, face_uv_gpu, sample_bordered};
 use fisheye_rt::scene::builtin;
 use fisheye_rt::trace::{GpuScene, RenderOptions, TracePass, linear_to_srgb};
 use glam::Vec3;
@@ -73,32 +73,44 @@ fn gpu_picks_the_same_face_and_uv_as_the_cpu() {
     eprintln!("{} directions, largest uv difference {worst:e}", dirs.len());
 }
 
+/// Faces the lens cannot reach are never rendered, and of the others only the part sampling
+/// reads: the image is bit for bit the one rendered from whole faces.
 #[test]
-fn only_the_faces_the_lens_reaches_are_rendered() {
+fn only_the_reachable_parts_of_faces_are_rendered() {
     let scene = builtin::scene("default").unwrap();
     let gpu_scene = GpuScene::new(ctx(), &scene, &RenderOptions::default()).unwrap();
-    let fisheye = CubeRt::new(
-        ctx(),
-        &camera("equidistant:f=0.45,fov=180", 64, 48),
-        &gpu_scene,
-        16,
-    )
-    .unwrap();
-    let names = |needed: [bool; 6]| -> Vec<&str> {
+    let cam = camera("equidistant:f=0.45,fov=180", 64, 48);
+    let new = |cam: &fisheye_rt::lens::LensCamera, size, coverage| {
+        CubeRt::new(ctx(), cam, &gpu_scene, size, coverage)
+    };
+    let names = |cube: &CubeRt| -> Vec<&str> {
         FACES
             .iter()
-            .zip(needed)
-            .filter(|(_, n)| *n)
-            .map(|(f, _)| f.name)
+            .zip(cube.regions())
+            .filter_map(|(f, r)| r.map(|_| f.name))
             .collect()
     };
-    assert_eq!(names(fisheye.needed()), ["+x", "-x", "+y", "-y", "+z"]);
-    let narrow = CubeRt::new(ctx(), &camera("rectilinear:f=2", 64, 48), &gpu_scene, 16).unwrap();
-    assert_eq!(names(narrow.needed()), ["+z"]);
-    let message = CubeRt::new(ctx(), &camera("rectilinear:f=2", 64, 48), &gpu_scene, 0)
-        .err()
-        .unwrap()
-        .to_string();
+    let parts = new(&cam, 32, Coverage::Reachable).unwrap();
+    let whole = new(&cam, 32, Coverage::WholeFaces).unwrap();
+    assert_eq!(names(&parts), ["+x", "-x", "+y", "-y", "+z"]);
+    let traced = |c: &CubeRt| {
+        c.regions()
+            .iter()
+            .flatten()
+            .map(|r| r.texels())
+            .sum::<u64>()
+    };
+    // A 180° lens reaches the front face and the front half of each side face.
+    let share = traced(&parts) as f64 / traced(&whole) as f64;
+    assert!(share < 0.65, "traced {share} of the whole faces");
+    let a = parts.render(ctx(), &gpu_scene, &scene.camera).unwrap();
+    let b = whole.render(ctx(), &gpu_scene, &scene.camera).unwrap();
+    let bits = |c: &[[f32; 4]]| c.iter().flatten().map(|x| x.to_bits()).collect::<Vec<_>>();
+    assert_eq!(bits(&a), bits(&b));
+
+    let narrow = new(&camera("rectilinear:f=2", 64, 48), 16, Coverage::Reachable).unwrap();
+    assert_eq!(names(&narrow), ["+z"]);
+    let message = new(&cam, 0, Coverage::Reachable).err().unwrap().to_string();
     assert!(message.contains("cube face size 0"), "{message}");
 }
 
@@ -119,7 +131,7 @@ fn cube_error_falls_as_faces_grow() {
     let directions = cam.directions();
     let mut errors = Vec::new();
     for size in [16, 32, 64, 128, 256] {
-        let cube = CubeRt::new(ctx(), &cam, &gpu_scene, size).unwrap();
+        let cube = CubeRt::new(ctx(), &cam, &gpu_scene, size, Coverage::Reachable).unwrap();
         let colour = cube.render(ctx(), &gpu_scene, &scene.camera).unwrap();
         let texels = cube.texels(ctx()).unwrap();
         let (mut sum, mut count) = (0.0f64, 0);

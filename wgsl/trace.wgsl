@@ -12,6 +12,8 @@ struct Frame {
     down: vec4<f32>,
     forward: vec4<f32>,
     eye: vec4<f32>,
+    // The pixel of the first invocation (xy), for dispatches over a part of the image.
+    offset: vec4<u32>,
 }
 
 @group(0) @binding(2) var<uniform> frame: Frame;
@@ -24,11 +26,12 @@ struct Frame {
 
 @compute @workgroup_size(WORKGROUP_2D, WORKGROUP_2D)
 fn main(@builtin(global_invocation_id) id: vec3<u32>) {
-    if id.x >= lens.width || id.y >= lens.height {
+    let pixel = id.xy + frame.offset.xy;
+    if pixel.x >= lens.width || pixel.y >= lens.height {
         return;
     }
-    let index = id.y * lens.width + id.x;
-    let ray = primary_ray(id.xy);
+    let index = pixel.y * lens.width + pixel.x;
+    let ray = primary_ray(pixel);
     if ray.w == 0.0 {
         colour_out[index] = vec4<f32>(0.0);
         geometry_out[index] = vec4<f32>(0.0);

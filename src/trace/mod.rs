@@ -95,7 +95,7 @@ pub struct Shading {
     pub max_depth: u32,
 }
 
-/// The camera pose of a frame (64 bytes): the camera-to-world rotation's columns (camera x, y,
+/// The camera pose of a frame (80 bytes): the camera-to-world rotation's columns (camera x, y,
 /// z axes in world space) and the eye relative to the scene's origin.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, PartialEq, Pod, Zeroable)]
@@ -108,6 +108,8 @@ pub struct Frame {
     pub forward: [f32; 4],
     /// Eye position relative to [`GpuScene::origin`] (xyz).
     pub eye: [f32; 4],
+    /// The pixel of the first invocation (x, y), for dispatches over a part of the image.
+    pub offset: [u32; 4],
 }
 
 /// How to render.
@@ -154,12 +156,12 @@ pub fn shading_vertices(scene: &Scene, features: Features) -> Vec<[f32; 4]> {
 
 /// The frame of `pose` for a scene uploaded relative to `origin`.
 fn frame_for(origin: DVec3, pose: &Camera) -> Frame {
-    view_frame(origin, pose.position, pose.rotation())
+    view_frame(origin, pose.position, pose.rotation(), [0, 0])
 }
 
 /// The frame of an eye and a camera-to-world rotation for a scene uploaded relative to
 /// `origin`.
-fn view_frame(origin: DVec3, eye: DVec3, rotation: DMat3) -> Frame {
+fn view_frame(origin: DVec3, eye: DVec3, rotation: DMat3, offset: [u32; 2]) -> Frame {
     let col = |v: DVec3| {
         let v = v.as_vec3();
         [v.x, v.y, v.z, 0.0]
@@ -169,6 +171,7 @@ fn view_frame(origin: DVec3, eye: DVec3, rotation: DMat3) -> Frame {
         down: col(rotation.y_axis),
         forward: col(rotation.z_axis),
         eye: col(eye - origin),
+        offset: [offset[0], offset[1], 0, 0],
     }
 }
 
@@ -415,13 +418,21 @@ impl TracePass {
     /// stays where it was uploaded, relative to its own camera, so poses far from it lose the
     /// precision that relative upload buys; paths through a scene are fine.
     pub fn set_pose(&self, ctx: &GpuContext, scene: &GpuScene, pose: &Camera) {
-        self.set_view(ctx, scene, pose.position, pose.rotation());
+        self.set_view(ctx, scene, pose.position, pose.rotation(), [0, 0]);
     }
 
     /// As [`TracePass::set_pose`], with the camera-to-world rotation given (columns: the
-    /// camera's right, down and forward axes in world space).
-    pub fn set_view(&self, ctx: &GpuContext, scene: &GpuScene, eye: DVec3, rotation: DMat3) {
-        let frame = view_frame(scene.origin, eye, rotation);
+    /// camera's right, down and forward axes in world space), and the first pixel that
+    /// [`TracePass::encode_region`] traces.
+    pub fn set_view(
+        &self,
+        ctx: &GpuContext,
+        scene: &GpuScene,
+        eye: DVec3,
+        rotation: DMat3,
+        offset: [u32; 2],
+    ) {
+        let frame = view_frame(scene.origin, eye, rotation, offset);
         ctx.queue
             .write_buffer(&self.frame, 0, bytemuck::bytes_of(&frame));
     }
@@ -439,12 +450,25 @@ impl TracePass {
         scene: &GpuScene,
         timestamp_writes: Option<wgpu::ComputePassTimestampWrites<'_>>,
     ) {
+        self.encode_region(encoder, scene, self.camera.size, timestamp_writes);
+    }
+
+    /// Records a frame of only the `extent` pixels from the offset given to
+    /// [`TracePass::set_view`] (the whole image from a zero offset); the other pixels keep what
+    /// they had.
+    pub fn encode_region(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        scene: &GpuScene,
+        extent: crate::lens::ImageSize,
+        timestamp_writes: Option<wgpu::ComputePassTimestampWrites<'_>>,
+    ) {
         dispatch_over_image(
             encoder,
             "fisheye.trace",
             &self.pipeline,
             &[&self.bind_group, &scene.bind_group],
-            self.camera.size,
+            extent,
             timestamp_writes,
         );
     }
@@ -560,6 +584,7 @@ mod tests {
                 ("down", offset_of!(Frame, down)),
                 ("forward", offset_of!(Frame, forward)),
                 ("eye", offset_of!(Frame, eye)),
+                ("offset", offset_of!(Frame, offset)),
             ],
         );
     }
