@@ -418,18 +418,7 @@ pub fn face_uv_gpu(ctx: &GpuContext, directions: &[Vec3]) -> Result<Vec<(u32, Ve
             &pipeline.get_bind_group_layout(0),
             &[&points, &results],
         );
-        let mut encoder = device.create_command_encoder(&Default::default());
-        {
-            let mut pass = encoder.begin_compute_pass(&Default::default());
-            pass.set_pipeline(&pipeline);
-            pass.set_bind_group(0, &bind_group, &[]);
-            pass.dispatch_workgroups(
-                (input.len() as u32).div_ceil(crate::shader::WORKGROUP_1D),
-                1,
-                1,
-            );
-        }
-        ctx.queue.submit([encoder.finish()]);
+        crate::gpu::submit_over_elements(ctx, &pipeline, &bind_group, input.len());
         results
     })?;
     let raw: Vec<[f32; 4]> = ctx.read_buffer(&out)?;

@@ -7,7 +7,7 @@ use wgpu::util::DeviceExt;
 
 use crate::error::Result;
 use crate::gpu::GpuContext;
-use crate::shader::{WORKGROUP_1D, compute_pipeline};
+use crate::shader::compute_pipeline;
 
 /// The largest absolute error of one function over its probed domain.
 #[derive(Clone, Debug)]
@@ -57,14 +57,7 @@ pub fn measure_trig(ctx: &GpuContext) -> Result<Vec<TrigError>> {
             &pipeline.get_bind_group_layout(0),
             &[&input, &values],
         );
-        let mut encoder = device.create_command_encoder(&Default::default());
-        {
-            let mut pass = encoder.begin_compute_pass(&Default::default());
-            pass.set_pipeline(&pipeline);
-            pass.set_bind_group(0, &bind_group, &[]);
-            pass.dispatch_workgroups((args.len() as u32).div_ceil(WORKGROUP_1D), 1, 1);
-        }
-        ctx.queue.submit([encoder.finish()]);
+        crate::gpu::submit_over_elements(ctx, &pipeline, &bind_group, args.len());
         values
     })?;
     let values: Vec<[f32; 8]> = ctx.read_buffer(&values)?;

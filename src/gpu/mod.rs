@@ -76,6 +76,24 @@ pub fn dispatch_over_image(
     pass.dispatch_workgroups(size.width.div_ceil(tile), size.height.div_ceil(tile), 1);
 }
 
+/// Submits one dispatch of `pipeline` (bind group 0) over `count` elements, in workgroups of
+/// `WORKGROUP_1D`, for kernels that map arrays of points or directions.
+pub fn submit_over_elements(
+    ctx: &GpuContext,
+    pipeline: &wgpu::ComputePipeline,
+    bind_group: &wgpu::BindGroup,
+    count: usize,
+) {
+    let mut encoder = ctx.device.create_command_encoder(&Default::default());
+    {
+        let mut pass = encoder.begin_compute_pass(&Default::default());
+        pass.set_pipeline(pipeline);
+        pass.set_bind_group(0, bind_group, &[]);
+        pass.dispatch_workgroups((count as u32).div_ceil(crate::shader::WORKGROUP_1D), 1, 1);
+    }
+    ctx.queue.submit([encoder.finish()]);
+}
+
 /// Optional device features the project uses when the adapter has them.
 pub const OPTIONAL_FEATURES: [(wgpu::Features, &str); 5] = [
     (wgpu::Features::TIMESTAMP_QUERY, "timestamp queries"),

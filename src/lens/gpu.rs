@@ -355,14 +355,7 @@ impl LensPoints {
                     &pipeline.get_bind_group_layout(0),
                     &[&self.params, &points, &results],
                 );
-                let mut encoder = device.create_command_encoder(&Default::default());
-                {
-                    let mut pass = encoder.begin_compute_pass(&Default::default());
-                    pass.set_pipeline(pipeline);
-                    pass.set_bind_group(0, &bind_group, &[]);
-                    pass.dispatch_workgroups((part.len() as u32).div_ceil(WORKGROUP_1D), 1, 1);
-                }
-                ctx.queue.submit([encoder.finish()]);
+                crate::gpu::submit_over_elements(ctx, pipeline, &bind_group, part.len());
                 results
             })?;
             out.extend(ctx.read_buffer::<[f32; 4]>(&results)?);
