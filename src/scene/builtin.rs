@@ -252,9 +252,15 @@ fn many_small() -> Scene {
             palette[(k % 16) as usize],
         );
     }
+    outdoors(b, DVec3::new(0.0, 1.7, 0.0), DVec3::new(0.0, 1.2, -10.0))
+}
+
+/// An outdoor scene: the sun and sky of [`outdoor_lights`], a camera at `position` looking at
+/// `look_at`.
+fn outdoors(b: MeshBuilder, position: DVec3, look_at: DVec3) -> Scene {
     let camera = Camera {
-        position: DVec3::new(0.0, 1.7, 0.0),
-        look_at: DVec3::new(0.0, 1.2, -10.0),
+        position,
+        look_at,
         up: DVec3::Y,
     };
     b.finish(
@@ -284,17 +290,7 @@ fn few_detailed() -> Scene {
         // 500 × 200 × 2 = 200,000 triangles each.
         b.torus(DVec3::new(x, 1.0, -4.0), 1.1, 0.45, 500, 200, m);
     }
-    let camera = Camera {
-        position: DVec3::new(0.0, 1.6, 1.0),
-        look_at: DVec3::new(0.0, 1.0, -4.0),
-        up: DVec3::Y,
-    };
-    b.finish(
-        outdoor_lights(),
-        Vec3::new(0.55, 0.7, 0.95),
-        Vec3::splat(0.15),
-        camera,
-    )
+    outdoors(b, DVec3::new(0.0, 1.6, 1.0), DVec3::new(0.0, 1.0, -4.0))
 }
 
 #[cfg(test)]
