@@ -12,7 +12,7 @@
 
 mod common;
 
-use common::{assert_agrees, both, camera, ctx};
+use common::{assert_agrees, assert_every_hit_is, both, camera, ctx};
 use fisheye_rt::scene::{Camera, Light, Material, MeshBuilder, builtin};
 use fisheye_rt::trace::{NO_HIT, RenderOptions, cpu::Reference, render};
 use glam::{DVec3, Vec2, Vec3};
@@ -141,18 +141,7 @@ fn mirror_has_no_acne() {
         )
         .unwrap();
         let expected = Vec3::new(0.9, 0.8, 0.7) * sky;
-        let mut on_mirror = 0;
-        for (i, id) in out.ids.iter().enumerate() {
-            if *id == NO_HIT {
-                continue;
-            }
-            on_mirror += 1;
-            let c = Vec3::from_slice(&out.colour[i][..3]);
-            assert!(
-                (c - expected).abs().max_element() < 1e-5,
-                "pixel {i}: {c} (offset {offset})"
-            );
-        }
+        let on_mirror = assert_every_hit_is(&out, expected, 1e-5, &format!("offset {offset}"));
         assert!(on_mirror > 2000);
     }
 }
@@ -198,18 +187,7 @@ fn diffuse_plane_has_no_shadow_acne_even_grazing() {
         )
         .unwrap();
         let expected = kd * (ambient + e * (-light.y as f32));
-        let mut hits = 0;
-        for (i, id) in out.ids.iter().enumerate() {
-            if *id == NO_HIT {
-                continue;
-            }
-            hits += 1;
-            let c = Vec3::from_slice(&out.colour[i][..3]);
-            assert!(
-                (c - expected).abs().max_element() < 1e-5,
-                "pixel {i}: {c} vs {expected} (offset {offset})"
-            );
-        }
+        let hits = assert_every_hit_is(&out, expected, 1e-5, &format!("offset {offset}"));
         assert!(hits > 2000);
     }
 }

@@ -105,6 +105,29 @@ pub fn assert_agrees(name: &str, gpu: &RenderOutput, cpu: &RenderOutput) -> Agre
     }
 }
 
+/// Asserts that every pixel whose primary ray hit shows `expected` to within `tolerance` (per
+/// channel); returns how many hit.
+pub fn assert_every_hit_is(
+    out: &RenderOutput,
+    expected: glam::Vec3,
+    tolerance: f32,
+    what: &str,
+) -> usize {
+    let mut hits = 0;
+    for (i, id) in out.ids.iter().enumerate() {
+        if *id == NO_HIT {
+            continue;
+        }
+        hits += 1;
+        let c = glam::Vec3::from_slice(&out.colour[i][..3]);
+        assert!(
+            (c - expected).abs().max_element() <= tolerance,
+            "{what}: pixel {i} shows {c}, not {expected}"
+        );
+    }
+    hits
+}
+
 pub fn both(scene: &Scene, cam: &LensCamera) -> (RenderOutput, RenderOutput) {
     let options = RenderOptions::default();
     let gpu = render(ctx(), scene, cam, &options).unwrap();
