@@ -14,6 +14,7 @@ use crate::error::{Error, Result};
 use crate::gpu::{GpuContext, bind_buffers, dispatch_over_image, storage_entry, uniform_entry};
 use crate::lens::gpu::{DirectionSource, lens_constants, params_buffer};
 use crate::lens::{ImageSize, Lens, LensCamera, LensModel};
+use crate::raster::{RasterFaces, RasterMethod};
 use crate::scene::Camera;
 use crate::shader;
 use crate::trace::{GpuScene, TracePass};
@@ -208,7 +209,7 @@ pub fn face_regions(directions: impl IntoIterator<Item = DVec3>, size: u32) -> [
     regions
 }
 
-/// How much of each face [`CubeRt`] renders.
+/// How much of each face [`CubeMap`] renders.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Coverage {
     /// Only the part of each face the lens can reach ([`face_regions`]).
@@ -217,14 +218,80 @@ pub enum Coverage {
     WholeFaces,
 }
 
-/// The cube-map path with ray-traced faces: the tracer renders each face the lens can reach
-/// as a 90° pinhole view (plus its border), then a compute pass resamples the cube into the
-/// lens image. Compared with the direct fisheye render, it isolates the error of cube-map
-/// resampling alone.
-pub struct CubeRt {
+/// How the cube's faces are rendered.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum CubeMethod {
+    /// By the tracer, as 90° pinhole views: compared with the direct fisheye render, this
+    /// isolates the error of cube-map resampling alone.
+    Traced,
+    /// By the rasterizer ([`crate::raster`]).
+    Raster(RasterMethod),
+}
+
+impl CubeMethod {
+    /// Every method, in the order of `fisheye render --method`'s names.
+    pub const ALL: [CubeMethod; 4] = [
+        Self::Traced,
+        Self::Raster(RasterMethod::Forward),
+        Self::Raster(RasterMethod::Deferred),
+        Self::Raster(RasterMethod::SinglePass),
+    ];
+
+    /// The name on the command line.
+    pub fn name(&self) -> &'static str {
+        match self {
+            Self::Traced => "cube-rt",
+            Self::Raster(RasterMethod::Forward) => "cube-forward",
+            Self::Raster(RasterMethod::Deferred) => "cube-deferred",
+            Self::Raster(RasterMethod::SinglePass) => "cube-single",
+        }
+    }
+}
+
+/// How [`CubeMap`] renders its faces.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct CubeSettings {
+    /// Inner texels per face side.
+    pub size: u32,
+    /// What renders the faces.
+    pub method: CubeMethod,
+    /// How much of each face.
+    pub coverage: Coverage,
+    /// Texels per side of each shadow-map layer (rasterized faces only).
+    pub shadow_size: u32,
+}
+
+impl CubeSettings {
+    /// Faces of `size` by `method`, only where the lens reaches, shadow maps of 2048².
+    pub fn new(size: u32, method: CubeMethod) -> Self {
+        Self {
+            size,
+            method,
+            coverage: Coverage::Reachable,
+            shadow_size: 2048,
+        }
+    }
+}
+
+/// The rectilinear camera of one bordered face of `size` inner texels, as the tracer renders
+/// it: `(size + 2)²` pixels, 90° across the inner `size`.
+pub fn face_camera(size: u32) -> Result<LensCamera> {
+    let side = bordered(size);
+    let lens = Lens::new(LensModel::Rectilinear, bordered_focal(size))?;
+    Ok(LensCamera::new(lens, ImageSize::new(side, side)?))
+}
+
+enum Faces {
+    Traced(TracePass),
+    Raster(RasterFaces),
+}
+
+/// The cube-map path: renders each face the lens can reach (by the tracer or the rasterizer,
+/// plus a one-texel border), then a compute pass resamples the cube into the lens image.
+pub struct CubeMap {
     size: u32,
     regions: [Option<Region>; 6],
-    faces: TracePass,
+    faces: Faces,
     texels: wgpu::Buffer,
     sampler: wgpu::ComputePipeline,
     bind_group: wgpu::BindGroup,
@@ -232,25 +299,24 @@ pub struct CubeRt {
     camera: LensCamera,
 }
 
-impl CubeRt {
-    /// Faces of `size` × `size` texels for `camera` on `scene`, rendered where `coverage` says.
+impl CubeMap {
+    /// The cube for `camera` on `scene`, rendered as `settings` say.
     pub fn new(
         ctx: &GpuContext,
         camera: &LensCamera,
         scene: &GpuScene,
-        size: u32,
-        coverage: Coverage,
+        settings: &CubeSettings,
     ) -> Result<Self> {
+        let size = settings.size;
         let max = ctx.device.limits().max_texture_dimension_2d;
-        if size == 0 || size > max {
+        if size == 0 || bordered(size) > max {
             return Err(Error::Scene(format!(
-                "cube face size {size}: must be between 1 and the adapter's limit of {max}"
+                "cube face size {size}: must be between 1 and {} (the adapter's limit of {max}, \
+                 less the two-texel border)",
+                max - 2
             )));
         }
         let side = bordered(size);
-        let face_size = ImageSize::new(side, side)?;
-        let face_lens = Lens::new(LensModel::Rectilinear, bordered_focal(size))?;
-        let face_camera = LensCamera::new(face_lens, face_size);
         let texel_bytes = 16 * 6 * u64::from(side) * u64::from(side);
         ctx.check_binding("the cube faces", texel_bytes)?;
         ctx.check_binding(
@@ -258,7 +324,7 @@ impl CubeRt {
             16 * camera.size.pixels() as u64,
         )?;
         let mut regions = face_regions(camera.directions().into_iter().flatten(), size);
-        if coverage == Coverage::WholeFaces {
+        if settings.coverage == Coverage::WholeFaces {
             for r in regions.iter_mut().flatten() {
                 *r = Region {
                     x0: 0,
@@ -268,7 +334,33 @@ impl CubeRt {
                 };
             }
         }
-        let faces = TracePass::new(ctx, &face_camera, scene, DirectionSource::Computed)?;
+        let texels = ctx.checked("creating the cube faces", || {
+            ctx.device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("fisheye.cube.texels"),
+                size: texel_bytes,
+                usage: wgpu::BufferUsages::STORAGE
+                    | wgpu::BufferUsages::COPY_DST
+                    | wgpu::BufferUsages::COPY_SRC,
+                mapped_at_creation: false,
+            })
+        })?;
+        let faces = match settings.method {
+            CubeMethod::Traced => Faces::Traced(TracePass::new(
+                ctx,
+                &face_camera(size)?,
+                scene,
+                DirectionSource::Computed,
+            )?),
+            CubeMethod::Raster(method) => Faces::Raster(RasterFaces::new(
+                ctx,
+                scene,
+                size,
+                regions,
+                method,
+                settings.shadow_size,
+                &texels,
+            )?),
+        };
         ctx.checked("creating the cube-map sampler", || {
             let device = &ctx.device;
             let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
@@ -300,11 +392,6 @@ impl CubeRt {
                 })
             };
             use wgpu::BufferUsages as U;
-            let texels = buffer(
-                "fisheye.cube.texels",
-                texel_bytes,
-                U::STORAGE | U::COPY_DST | U::COPY_SRC,
-            );
             let colour = buffer(
                 "fisheye.cube.colour",
                 16 * camera.size.pixels() as u64,
@@ -337,40 +424,33 @@ impl CubeRt {
         self.regions
     }
 
-    /// Renders the reachable faces (or parts) from `pose`, one submission each since each
-    /// moves the face camera, then resamples them into the lens image. Returns the lens
-    /// image's colours (as [`RenderOutput::colour`](crate::trace::RenderOutput::colour)).
+    /// The rasterized faces' shadow maps (`None` for traced faces).
+    pub fn shadow_maps(&self) -> Option<&crate::raster::ShadowMaps> {
+        match &self.faces {
+            Faces::Traced(_) => None,
+            Faces::Raster(r) => Some(r.shadows()),
+        }
+    }
+
+    /// Renders the reachable faces (or parts) from `pose`, then resamples them into the lens
+    /// image. Returns the lens image's colours (as
+    /// [`RenderOutput::colour`](crate::trace::RenderOutput::colour)).
     pub fn render(
         &self,
         ctx: &GpuContext,
         scene: &GpuScene,
         pose: &Camera,
     ) -> Result<Vec<[f32; 4]>> {
-        let rotation = pose.rotation();
-        let side = u64::from(bordered(self.size));
-        for (i, face) in FACES.iter().enumerate() {
-            let Some(r) = self.regions[i] else { continue };
-            self.faces.set_view(
-                ctx,
-                scene,
-                pose.position,
-                rotation * face.rotation(),
-                [r.x0, r.y0],
-            );
-            ctx.checked("rendering a cube face", || {
-                let mut encoder = ctx.device.create_command_encoder(&Default::default());
-                let extent = ImageSize::new(r.x1 - r.x0, r.y1 - r.y0).expect("a non-empty region");
-                self.faces.encode_region(&mut encoder, scene, extent, None);
-                let bytes = 16 * side * side;
-                encoder.copy_buffer_to_buffer(
-                    self.faces.colour_buffer(),
-                    0,
-                    &self.texels,
-                    bytes * i as u64,
-                    bytes,
-                );
-                ctx.queue.submit([encoder.finish()]);
-            })?;
+        match &self.faces {
+            Faces::Traced(pass) => self.trace_faces(ctx, scene, pose, pass)?,
+            Faces::Raster(faces) => {
+                faces.set_pose(ctx, scene, pose);
+                ctx.checked("rasterizing the cube faces", || {
+                    let mut encoder = ctx.device.create_command_encoder(&Default::default());
+                    faces.encode(&mut encoder, scene);
+                    ctx.queue.submit([encoder.finish()]);
+                })?;
+            }
         }
         ctx.checked("resampling the cube", || {
             let mut encoder = ctx.device.create_command_encoder(&Default::default());
@@ -385,6 +465,43 @@ impl CubeRt {
             ctx.queue.submit([encoder.finish()]);
         })?;
         ctx.read_buffer(&self.colour)
+    }
+
+    /// Traced faces, one submission each since each moves the face camera.
+    fn trace_faces(
+        &self,
+        ctx: &GpuContext,
+        scene: &GpuScene,
+        pose: &Camera,
+        pass: &TracePass,
+    ) -> Result<()> {
+        let rotation = pose.rotation();
+        let side = u64::from(bordered(self.size));
+        for (i, face) in FACES.iter().enumerate() {
+            let Some(r) = self.regions[i] else { continue };
+            pass.set_view(
+                ctx,
+                scene,
+                pose.position,
+                rotation * face.rotation(),
+                [r.x0, r.y0],
+            );
+            ctx.checked("rendering a cube face", || {
+                let mut encoder = ctx.device.create_command_encoder(&Default::default());
+                let extent = ImageSize::new(r.x1 - r.x0, r.y1 - r.y0).expect("a non-empty region");
+                pass.encode_region(&mut encoder, scene, extent, None);
+                let bytes = 16 * side * side;
+                encoder.copy_buffer_to_buffer(
+                    pass.colour_buffer(),
+                    0,
+                    &self.texels,
+                    bytes * i as u64,
+                    bytes,
+                );
+                ctx.queue.submit([encoder.finish()]);
+            })?;
+        }
+        Ok(())
     }
 
     /// The faces of the last render: `6 × (size + 2)²` texels, row-major per face (texels

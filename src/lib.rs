@@ -9,6 +9,8 @@
 //! - [`shader`]: how WGSL files are assembled into modules.
 //! - [`scene`], [`bvh`], [`trace`]: scenes (built-in and OBJ), the CWBVH, and the GPU tracer
 //!   with its f64 reference.
+//! - [`cube`], [`raster`]: the cube-map path (faces ray traced or rasterized, then resampled),
+//!   to compare with direct ray tracing.
 //!
 //! Rendering a scene through a lens takes a few lines (this example runs in the tests, on
 //! lavapipe when there is no GPU):
@@ -39,6 +41,7 @@ mod error;
 pub mod gpu;
 pub mod lens;
 pub mod precision;
+pub mod raster;
 pub mod scene;
 pub mod shader;
 pub mod trace;

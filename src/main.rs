@@ -7,13 +7,14 @@ use std::time::Instant;
 use anyhow::{Context, Result, bail};
 use clap::{Parser, Subcommand, ValueEnum};
 use fisheye_rt::bvh::BvhQuality;
-use fisheye_rt::cube::{Coverage, CubeRt, FACES};
+use fisheye_rt::cube::{CubeMap, CubeMethod, CubeSettings, FACES};
 use fisheye_rt::demo::{LensDemo, save_png};
 use fisheye_rt::gpu::{GpuContext, Queries};
 use fisheye_rt::lens::gpu::{DirectionSource, LensPoints};
 use fisheye_rt::lens::{
     DirectionFormula, ImageSize, LensCamera, LensModel, PRESET_FOV_DEGREES, PRESETS, parse_spec,
 };
+use fisheye_rt::raster::RasterMethod;
 use fisheye_rt::scene::{Scene, builtin};
 use fisheye_rt::trace::{
     Channel, GpuScene, RenderOptions, TracePass, colour_image, world_directions,
@@ -64,13 +65,19 @@ struct RenderArgs {
     /// or `path:S` for the point S ∈ [0, 1] along the scene file's camera path.
     #[arg(long)]
     camera: Option<String>,
-    /// How to make the image: `rt` traces the lens's rays directly; `cube-rt` traces the six
-    /// faces of a cube map (those the lens reaches) and resamples it.
+    /// How to make the image: `rt` traces the lens's rays directly; the `cube-*` methods render
+    /// the faces of a cube map (those the lens reaches, and of them only the parts it reaches)
+    /// and resample it: `cube-rt` traces them; `cube-forward` (a render pass per face),
+    /// `cube-deferred` (G-buffer, then lighting in a compute pass) and `cube-single` (one
+    /// multiview pass) rasterize them, with shadow maps and no reflection or refraction.
     #[arg(long, value_enum, default_value = "rt")]
     method: Method,
-    /// Face size of the cube map in texels (`--method cube-rt`).
+    /// Face size of the cube map in texels (`cube-*` methods).
     #[arg(long, default_value_t = 1024)]
     cube_size: u32,
+    /// Shadow-map size in texels per side and layer (rasterized `cube-*` methods).
+    #[arg(long, default_value_t = 2048)]
+    shadow_size: u32,
     /// Deepest reflection/refraction bounce.
     #[arg(long, default_value_t = 5)]
     max_depth: u32,
@@ -96,6 +103,23 @@ struct RenderArgs {
 enum Method {
     Rt,
     CubeRt,
+    CubeForward,
+    CubeDeferred,
+    CubeSingle,
+}
+
+impl Method {
+    /// The cube-map method, `None` for direct ray tracing.
+    fn cube(self) -> Option<CubeMethod> {
+        let raster = |m| Some(CubeMethod::Raster(m));
+        match self {
+            Self::Rt => None,
+            Self::CubeRt => Some(CubeMethod::Traced),
+            Self::CubeForward => raster(RasterMethod::Forward),
+            Self::CubeDeferred => raster(RasterMethod::Deferred),
+            Self::CubeSingle => raster(RasterMethod::SinglePass),
+        }
+    }
 }
 
 #[derive(Clone, Copy, PartialEq, Eq, ValueEnum)]
@@ -328,33 +352,40 @@ fn render(args: &RenderArgs) -> Result<()> {
         "lens: {} at {size}; compiling the trace kernel...",
         camera.lens
     );
-    if args.method == Method::CubeRt {
+    if let Some(method) = args.method.cube() {
         if !args.outputs.is_empty() {
             bail!("--outputs come from the direct tracer; use --method rt for ground-truth arrays");
         }
-        let cube = CubeRt::new(
-            &ctx,
-            &camera,
-            &gpu_scene,
-            args.cube_size,
-            Coverage::Reachable,
-        )?;
+        let settings = CubeSettings {
+            shadow_size: args.shadow_size,
+            ..CubeSettings::new(args.cube_size, method)
+        };
+        let cube = CubeMap::new(&ctx, &camera, &gpu_scene, &settings)?;
         let regions = cube.regions();
         let faces: Vec<&str> = FACES
             .iter()
             .zip(regions)
             .filter_map(|(f, r)| r.map(|_| f.name))
             .collect();
-        let traced: u64 = regions.iter().flatten().map(|r| r.texels()).sum();
+        let rendered: u64 = regions.iter().flatten().map(|r| r.texels()).sum();
         let side = u64::from(args.cube_size + 2);
         println!(
-            "cube map: {} faces of {}² texels ({}); traced {:.0}% of their texels (the parts the \
-             lens reaches), then resampled",
+            "cube map ({}): {} faces of {}² texels ({}); rendered {:.0}% of their texels (the \
+             parts the lens reaches), then resampled",
+            method.name(),
             faces.len(),
             args.cube_size,
             faces.join(" "),
-            100.0 * traced as f64 / (faces.len() as u64 * side * side) as f64
+            100.0 * rendered as f64 / (faces.len() as u64 * side * side) as f64
         );
+        if let Some(maps) = cube.shadow_maps() {
+            println!(
+                "shadow maps: {} layers of {}² for {} lights",
+                maps.views().len(),
+                maps.size(),
+                scene.lights.len()
+            );
+        }
         let colour = cube.render(&ctx, &gpu_scene, &scene.camera)?;
         save_png(&colour_image(size, &colour), out)?;
         println!(

@@ -11,9 +11,11 @@ use crate::scene::Surface;
 use crate::trace;
 
 /// Every WGSL file of the project, by name (its file stem under `wgsl/`).
-pub const FILES: [(&str, &str); 13] = [
+pub const FILES: [(&str, &str); 17] = [
     ("math", include_str!("../wgsl/math.wgsl")),
+    ("triangles", include_str!("../wgsl/triangles.wgsl")),
     ("bvh", include_str!("../wgsl/bvh.wgsl")),
+    ("surface", include_str!("../wgsl/surface.wgsl")),
     ("shade", include_str!("../wgsl/shade.wgsl")),
     ("trace", include_str!("../wgsl/trace.wgsl")),
     ("lens", include_str!("../wgsl/lens.wgsl")),
@@ -25,6 +27,11 @@ pub const FILES: [(&str, &str); 13] = [
     ("cube", include_str!("../wgsl/cube.wgsl")),
     ("cube_probe", include_str!("../wgsl/cube_probe.wgsl")),
     ("cube_sample", include_str!("../wgsl/cube_sample.wgsl")),
+    ("raster", include_str!("../wgsl/raster.wgsl")),
+    (
+        "raster_multiview",
+        include_str!("../wgsl/raster_multiview.wgsl"),
+    ),
 ];
 
 /// Side of the square workgroups of per-pixel kernels.
@@ -112,9 +119,6 @@ pub fn module(device: &wgpu::Device, entry: &str) -> wgpu::ShaderModule {
     })
 }
 
-/// Checks that the WGSL struct `name` of the module `file` has the given size and, in order,
-/// the given members at the given byte offsets (naga's layout): Rust structs that mirror WGSL
-/// ones call this with their `size_of` and `offset_of!`s.
 /// Creates the compute pipeline for `entry_point` of the WGSL file `file`, specialised by the
 /// override `constants`. With no `layouts` the layout is derived from the shader; passes whose
 /// kernels leave a binding unused in some specialisation give theirs explicitly, in group
@@ -149,6 +153,9 @@ pub fn compute_pipeline(
     })
 }
 
+/// Checks that the WGSL struct `name` of the module `file` has the given size and, in order,
+/// the given members at the given byte offsets (naga's layout): Rust structs that mirror WGSL
+/// ones call this with their `size_of` and `offset_of!`s.
 #[cfg(test)]
 pub(crate) fn assert_wgsl_layout(file: &str, name: &str, size: usize, fields: &[(&str, usize)]) {
     let source = compose(file);

@@ -5,7 +5,9 @@
 mod common;
 
 use common::{camera, ctx};
-use fisheye_rt::cube::{Coverage, CubeRt, FACES, face_uv, face_uv_gpu, sample_bordered};
+use fisheye_rt::cube::{
+    Coverage, CubeMap, CubeMethod, CubeSettings, FACES, face_uv, face_uv_gpu, sample_bordered,
+};
 use fisheye_rt::scene::builtin;
 use fisheye_rt::trace::{GpuScene, RenderOptions, TracePass, linear_to_srgb};
 use glam::Vec3;
@@ -81,9 +83,13 @@ fn only_the_reachable_parts_of_faces_are_rendered() {
     let gpu_scene = GpuScene::new(ctx(), &scene, &RenderOptions::default()).unwrap();
     let cam = camera("equidistant:f=0.45,fov=180", 64, 48);
     let new = |cam: &fisheye_rt::lens::LensCamera, size, coverage| {
-        CubeRt::new(ctx(), cam, &gpu_scene, size, coverage)
+        let settings = CubeSettings {
+            coverage,
+            ..CubeSettings::new(size, CubeMethod::Traced)
+        };
+        CubeMap::new(ctx(), cam, &gpu_scene, &settings)
     };
-    let names = |cube: &CubeRt| -> Vec<&str> {
+    let names = |cube: &CubeMap| -> Vec<&str> {
         FACES
             .iter()
             .zip(cube.regions())
@@ -93,7 +99,7 @@ fn only_the_reachable_parts_of_faces_are_rendered() {
     let parts = new(&cam, 32, Coverage::Reachable).unwrap();
     let whole = new(&cam, 32, Coverage::WholeFaces).unwrap();
     assert_eq!(names(&parts), ["+x", "-x", "+y", "-y", "+z"]);
-    let traced = |c: &CubeRt| {
+    let traced = |c: &CubeMap| {
         c.regions()
             .iter()
             .flatten()
@@ -133,7 +139,8 @@ fn cube_error_falls_as_faces_grow() {
     let mut errors = Vec::new();
     let mut concentration = Vec::new();
     for size in [16, 32, 64, 128, 256] {
-        let cube = CubeRt::new(ctx(), &cam, &gpu_scene, size, Coverage::Reachable).unwrap();
+        let settings = CubeSettings::new(size, CubeMethod::Traced);
+        let cube = CubeMap::new(ctx(), &cam, &gpu_scene, &settings).unwrap();
         let colour = cube.render(ctx(), &gpu_scene, &scene.camera).unwrap();
         let texels = cube.texels(ctx()).unwrap();
         let (mut sum, mut count) = (0.0f64, 0);

@@ -3,6 +3,7 @@
 // Through Compressed Wide BVHs") and obvhs's node encoding. Robust by construction: child
 // boxes are tested conservatively (padded by a bound on every rounding, after Ize 2013,
 // "Robust BVH Ray Traversal"), and triangles watertightly (Woop, Benthin and Wald 2013).
+#import triangles
 
 // Mirrors `obvhs::cwbvh::node::CwBvhNode` (80 bytes) as five vec4<u32> per node:
 // [0] p.xyz (f32 bits), e.x | e.y << 8 | e.z << 16 | imask << 24
@@ -11,40 +12,12 @@
 // [3] child_min_y, child_max_y
 // [4] child_min_z, child_max_z
 @group(1) @binding(0) var<storage, read> bvh_nodes: array<vec4<u32>>;
-// Mirrors `fisheye_rt::bvh::GpuTriangle` (48 bytes): camera-relative corners, the scene
-// triangle it came from and its material.
-struct BvhTriangle {
-    v0: vec3<f32>,
-    triangle: u32,
-    v1: vec3<f32>,
-    material: u32,
-    v2: vec3<f32>,
-    pad: u32,
-}
-
-@group(1) @binding(1) var<storage, read> bvh_triangles: array<BvhTriangle>;
 
 // 4 ulp: covers the roundings of the slab test and of obvhs's quantization.
 const BOX_PAD: f32 = 4.0 * 1.1920929e-7;
 // Edge functions this close to zero (relative to their products) count as zero, so a point
 // on a shared edge is inside both triangles even where the driver fuses multiply-adds.
 const EDGE_BAND: f32 = 2.0 * 1.1920929e-7;
-
-struct Ray {
-    origin: vec3<f32>,
-    dir: vec3<f32>,
-    tmin: f32,
-    tmax: f32,
-}
-
-struct Hit {
-    t: f32,
-    // Barycentric weights of v1 and v2 (v0's is 1 - u - v).
-    u: f32,
-    v: f32,
-    // Index into bvh_triangles, NO_HIT if none.
-    slot: u32,
-}
 
 // Woop et al.'s per-ray shear: kz is the dominant axis, (kx, ky) keep the winding.
 struct Shear {

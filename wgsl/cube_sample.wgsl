@@ -3,11 +3,29 @@
 #import primary
 #import cube
 
+// Six faces of (size + 2)² texels, row-major, linear RGB (w unused by sampling).
+@group(0) @binding(2) var<storage, read> cube_texels: array<vec4<f32>>;
+
 // Linear RGB; w = 1 where the pixel has a ray, all zero where masked (as the tracer writes).
 @group(0) @binding(3) var<storage, read_write> colour_out: array<vec4<f32>>;
 
 // Inner texels per face side.
 override CUBE_SIZE: u32;
+
+// Bilinear lookup at `uv` of `face` in `texels`: six faces of (size + 2)² texels, row-major,
+// the border holding samples just past each edge, so the four texels read always exist.
+fn cube_sample(face: u32, uv: vec2<f32>, size: u32) -> vec4<f32> {
+    let side = size + 2u;
+    let st = uv * f32(size) + 0.5;
+    let base = floor(st);
+    let f = st - base;
+    let x = min(u32(max(base.x, 0.0)), side - 2u);
+    let y = min(u32(max(base.y, 0.0)), side - 2u);
+    let row = (face * side + y) * side + x;
+    let top = mix(cube_texels[row], cube_texels[row + 1u], f.x);
+    let bottom = mix(cube_texels[row + side], cube_texels[row + side + 1u], f.x);
+    return mix(top, bottom, f.y);
+}
 
 @compute @workgroup_size(WORKGROUP_2D, WORKGROUP_2D)
 fn main(@builtin(global_invocation_id) id: vec3<u32>) {

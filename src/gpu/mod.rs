@@ -9,6 +9,11 @@ pub use timing::{Queries, median};
 
 use crate::error::{Error, Result};
 
+/// The stages this project's shaders run in, for bindings that compute passes and render
+/// pipelines share.
+pub const ALL_STAGES: wgpu::ShaderStages =
+    wgpu::ShaderStages::VERTEX_FRAGMENT.union(wgpu::ShaderStages::COMPUTE);
+
 /// A compute-visible storage buffer entry of a bind group layout.
 pub fn storage_entry(binding: u32, read_only: bool) -> wgpu::BindGroupLayoutEntry {
     buffer_entry(binding, wgpu::BufferBindingType::Storage { read_only })
@@ -95,7 +100,7 @@ pub fn submit_over_elements(
 }
 
 /// Optional device features the project uses when the adapter has them.
-pub const OPTIONAL_FEATURES: [(wgpu::Features, &str); 5] = [
+pub const OPTIONAL_FEATURES: [(wgpu::Features, &str); 6] = [
     (wgpu::Features::TIMESTAMP_QUERY, "timestamp queries"),
     (
         wgpu::Features::TIMESTAMP_QUERY_INSIDE_ENCODERS,
@@ -103,6 +108,10 @@ pub const OPTIONAL_FEATURES: [(wgpu::Features, &str); 5] = [
     ),
     (wgpu::Features::EXPERIMENTAL_RAY_QUERY, "ray query"),
     (wgpu::Features::MULTIVIEW, "multiview"),
+    (
+        wgpu::Features::SELECTIVE_MULTIVIEW,
+        "multiview of some layers",
+    ),
     (wgpu::Features::SHADER_F64, "f64 in shaders"),
 ];
 

@@ -77,8 +77,9 @@ pub struct GpuLight {
     pub kind: u32,
     /// Intensity or irradiance.
     pub colour: [f32; 3],
-    /// Padding.
-    pub pad: u32,
+    /// The light's first layer in the rasterizer's shadow maps: six for a point light (one
+    /// per cube face, in [`crate::cube::FACES`] order), one for a directional light.
+    pub shadow_layer: u32,
 }
 
 /// Per-scene shading constants (32 bytes).
@@ -194,12 +195,22 @@ fn storage<T: Pod>(ctx: &GpuContext, label: &str, data: &[T]) -> Result<wgpu::Bu
 /// A scene on the GPU: its BVH, triangles, materials, lights, shading data and textures, in
 /// bind group 1 of the trace kernel. Built once; every frame reuses it.
 pub struct GpuScene {
-    layout: wgpu::BindGroupLayout,
-    bind_group: wgpu::BindGroup,
+    pub(crate) layout: wgpu::BindGroupLayout,
+    pub(crate) bind_group: wgpu::BindGroup,
     /// What the scene uses; the trace kernel is specialised to it.
     pub features: Features,
     /// The world position the scene was made relative to (the camera's).
     pub origin: DVec3,
+    /// Triangles, in BVH order: the rasterizer draws `3 × triangles` vertices.
+    pub triangles: u32,
+    /// The lights as uploaded.
+    pub lights: Vec<GpuLight>,
+    /// Layers the rasterizer's shadow maps need (see [`GpuLight::shadow_layer`]).
+    pub shadow_layers: u32,
+    /// The scene's bounding box relative to [`GpuScene::origin`] (`None` if empty).
+    pub bounds: Option<(DVec3, DVec3)>,
+    /// Radiance of escaping rays.
+    pub sky: glam::Vec3,
     /// The BVH's statistics.
     pub bvh_nodes: usize,
     /// Deepest BVH node.
@@ -238,11 +249,14 @@ impl GpuScene {
                 pad: [0; 3],
             })
             .collect();
+        let mut shadow_layers = 0;
         let lights: Vec<GpuLight> = scene
             .lights
             .iter()
             .map(|l| {
                 let (point, vector, colour) = l.relative_to(origin);
+                let shadow_layer = shadow_layers;
+                shadow_layers += if point { 6 } else { 1 };
                 GpuLight {
                     vector: vector.to_array(),
                     kind: if point {
@@ -251,7 +265,7 @@ impl GpuScene {
                         LIGHT_KINDS[1].1
                     },
                     colour: to3(colour),
-                    pad: 0,
+                    shadow_layer,
                 }
             })
             .collect();
@@ -291,9 +305,13 @@ impl GpuScene {
                 contents: bytemuck::bytes_of(&shading),
                 usage: wgpu::BufferUsages::UNIFORM,
             });
-            // Binding order = @binding(n) order in wgsl/bvh.wgsl and wgsl/shade.wgsl.
+            // Binding order = @binding(n) order in wgsl/bvh.wgsl, wgsl/triangles.wgsl and
+            // wgsl/surface.wgsl; the rasterizer reads them in its vertex and fragment stages.
             let mut entries: Vec<_> = (0..7).map(|b| storage_entry(b, true)).collect();
             entries.push(uniform_entry(7));
+            for entry in &mut entries {
+                entry.visibility = crate::gpu::ALL_STAGES;
+            }
             let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
                 label: Some("fisheye.scene"),
                 entries: &entries,
@@ -305,6 +323,11 @@ impl GpuScene {
                 layout,
                 bind_group,
                 features,
+                triangles: bvh.triangles.len() as u32,
+                lights,
+                shadow_layers,
+                sky: scene.sky,
+                bounds: scene.bounds().map(|(lo, hi)| (lo - origin, hi - origin)),
                 origin,
                 bvh_nodes: bvh.nodes.len(),
                 bvh_depth: bvh.depth,
@@ -524,7 +547,7 @@ mod tests {
     #[test]
     fn gpu_structs_match_their_wgsl_twins() {
         assert_wgsl_layout(
-            "bvh",
+            "triangles",
             "BvhTriangle",
             size_of::<GpuTriangle>(),
             &[
@@ -561,7 +584,7 @@ mod tests {
                 ("vector", offset_of!(GpuLight, vector)),
                 ("kind", offset_of!(GpuLight, kind)),
                 ("colour", offset_of!(GpuLight, colour)),
-                ("pad", offset_of!(GpuLight, pad)),
+                ("shadow_layer", offset_of!(GpuLight, shadow_layer)),
             ],
         );
         assert_wgsl_layout(

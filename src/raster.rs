@@ -1,0 +1,843 @@
+//! Rasterized cube faces: the classic way engines make fisheye images, with wgpu render
+//! pipelines, so that [`crate::cube::CubeMap`] can compare it with direct ray tracing.
+//!
+//! The scene's triangles are drawn straight from the tracer's buffers by vertex pulling (no
+//! vertex buffer), and shaded by the same WGSL as the tracer's (`wgsl/surface.wgsl`), in three
+//! ways ([`RasterMethod`]): forward (one render pass per face, lighting in the fragment
+//! shader), deferred (per face a G-buffer pass, then one compute pass that lights only the
+//! visible surfaces) and single pass (all faces in one multiview render pass).
+//!
+//! What a rasterizer cannot do, it does not, and that is part of what the comparison shows:
+//! - Lights reach surfaces through shadow maps ([`ShadowMaps`]: six faces per point light, an
+//!   orthographic map per directional light), filtered over 2×2 texels, so shadow edges are
+//!   softened and shifted by about a texel where the tracer's shadow rays are exact.
+//! - Mirrors and glass reflect and transmit the sky (as an engine's environment map would),
+//!   weighted by their tint and Fresnel reflectance; they show no scene geometry.
+//! - Partially transparent surfaces (`d` < 1) are drawn opaque, and cast full shadows.
+//!
+//! Faces are rendered as the tracer renders them: each is a 90° view plus a one-texel border,
+//! with reversed depth and no far plane, at the same pixel centres, so on diffuse, unshadowed
+//! surfaces both give the same texels (a test holds them to it).
+
+use std::num::NonZeroU32;
+
+use bytemuck::{Pod, Zeroable};
+use glam::{DAffine3, DMat3, DMat4, DVec3, DVec4};
+use wgpu::util::DeviceExt;
+
+use crate::cube::{FACES, Region, bordered, bordered_focal};
+use crate::error::{Error, Result};
+use crate::gpu::GpuContext;
+use crate::scene::Camera;
+use crate::shader;
+use crate::trace::{GpuScene, LIGHT_KINDS};
+
+/// How [`RasterFaces`] renders the faces.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum RasterMethod {
+    /// One render pass per face, lighting in the fragment shader.
+    Forward,
+    /// Per face a G-buffer pass (triangle and barycentrics), then one compute pass that lights
+    /// every visible surface once.
+    Deferred,
+    /// Every face in one multiview render pass, lighting in the fragment shader.
+    SinglePass,
+}
+
+/// Per-frame face views as `wgsl/raster.wgsl` reads them (496 bytes).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, PartialEq, Pod, Zeroable)]
+pub struct Views {
+    /// Per face: scene space to clip space (column-major).
+    pub clip: [[f32; 16]; 6],
+    /// Per face: the rendered texels `x0, y0, x1, y1`, empty for skipped faces.
+    pub regions: [[u32; 4]; 6],
+    /// The eye in scene space (xyz).
+    pub eye: [f32; 4],
+}
+
+/// One layer of the shadow maps as `wgsl/raster.wgsl` reads it (80 bytes).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, PartialEq, Pod, Zeroable)]
+pub struct ShadowView {
+    /// Scene space to the layer's clip space (column-major), depth reversed.
+    pub clip: [f32; 16],
+    /// `x`: a texel's width in scene units, at unit distance for a point light's face.
+    pub texel: [f32; 4],
+}
+
+/// The near plane of every view, relative to the scene's size: with reversed f32 depth the
+/// precision is relative, so it can be tiny (geometry nearer than this is clipped).
+const NEAR: f64 = 1e-6;
+
+/// Reversed-depth perspective with no far plane for a view whose image half-width is at
+/// `x/z = 1/focal`: camera space (x right, y down, z forward) to clip space, depth `near / z`.
+fn perspective(focal: f64, near: f64) -> DMat4 {
+    DMat4::from_cols(
+        DVec4::new(focal, 0.0, 0.0, 0.0),
+        DVec4::new(0.0, -focal, 0.0, 0.0),
+        DVec4::new(0.0, 0.0, 0.0, 1.0),
+        DVec4::new(0.0, 0.0, near, 0.0),
+    )
+}
+
+/// Scene space to the camera space of a view at `eye` whose axes (right, down, forward) are
+/// the columns of `rotation`.
+fn view(rotation: DMat3, eye: DVec3) -> DMat4 {
+    let inverse = rotation.transpose();
+    DMat4::from(DAffine3::from_mat3_translation(inverse, -(inverse * eye)))
+}
+
+fn columns(m: DMat4) -> [f32; 16] {
+    m.as_mat4().to_cols_array()
+}
+
+/// The scene's size, for near planes (1 for an empty scene).
+fn extent(scene: &GpuScene) -> f64 {
+    scene
+        .bounds
+        .map_or(1.0, |(lo, hi)| (hi - lo).length().max(f64::MIN_POSITIVE))
+}
+
+/// The shadow maps of a scene's lights: a depth texture array with [`GpuScene::shadow_layers`]
+/// layers of `size`², rendered once (lights and geometry do not move), read through a
+/// comparison sampler.
+pub struct ShadowMaps {
+    size: u32,
+    views: Vec<ShadowView>,
+    lookup_layout: wgpu::BindGroupLayout,
+    lookup: wgpu::BindGroup,
+}
+
+impl ShadowMaps {
+    /// The layers' views: for a point light, its six faces in [`FACES`] order (world axes) as
+    /// 90° perspectives; for a directional light, an orthographic view along it that covers
+    /// the scene's bounding box.
+    fn layer_views(scene: &GpuScene, size: u32) -> Vec<ShadowView> {
+        let near = NEAR * extent(scene);
+        let mut out = Vec::new();
+        for light in &scene.lights {
+            let vector = DVec3::from(light.vector.map(f64::from));
+            if light.kind == LIGHT_KINDS[0].1 {
+                for face in &FACES {
+                    out.push(ShadowView {
+                        clip: columns(perspective(1.0, near) * view(face.rotation(), vector)),
+                        texel: [2.0 / size as f32, 0.0, 0.0, 0.0],
+                    });
+                }
+            } else {
+                out.push(Self::directional(scene, vector, size));
+            }
+        }
+        out
+    }
+
+    /// An orthographic map looking along `travel` over the scene's bounds, square texels,
+    /// depth 1 nearest the light.
+    fn directional(scene: &GpuScene, travel: DVec3, size: u32) -> ShadowView {
+        let forward = travel.normalize();
+        let right = forward.any_orthonormal_vector();
+        let rotation = DMat3::from_cols(right, forward.cross(right), forward);
+        let to_light = view(rotation, DVec3::ZERO);
+        let (lo, hi) = scene.bounds.unwrap_or((DVec3::ZERO, DVec3::ZERO));
+        let (mut a, mut b) = (DVec3::MAX, DVec3::MIN);
+        for i in 0..8 {
+            let corner = DVec3::new(
+                if i & 1 == 0 { lo.x } else { hi.x },
+                if i & 2 == 0 { lo.y } else { hi.y },
+                if i & 4 == 0 { lo.z } else { hi.z },
+            );
+            let p = to_light.transform_point3(corner);
+            (a, b) = (a.min(p), b.max(p));
+        }
+        // A margin, so that nothing on the bounds is clipped.
+        let margin = 0.01 * (b - a).max_element() + f64::MIN_POSITIVE;
+        let (a, b) = (a - margin, b + margin);
+        let half = 0.5 * (b.x - a.x).max(b.y - a.y);
+        let centre = 0.5 * (a + b);
+        let ortho = DMat4::from_cols(
+            DVec4::new(1.0 / half, 0.0, 0.0, 0.0),
+            DVec4::new(0.0, -1.0 / half, 0.0, 0.0),
+            DVec4::new(0.0, 0.0, -1.0 / (b.z - a.z), 0.0),
+            DVec4::new(-centre.x / half, centre.y / half, b.z / (b.z - a.z), 1.0),
+        );
+        ShadowView {
+            clip: columns(ortho * to_light),
+            texel: [(2.0 * half / f64::from(size)) as f32, 0.0, 0.0, 0.0],
+        }
+    }
+
+    /// Renders the shadow maps of `scene`'s lights at `size`² texels per layer.
+    pub fn new(ctx: &GpuContext, scene: &GpuScene, size: u32) -> Result<Self> {
+        let limits = ctx.device.limits();
+        if size == 0 || size > limits.max_texture_dimension_2d {
+            return Err(Error::Scene(format!(
+                "shadow map size {size}: must be between 1 and the adapter's limit of {}",
+                limits.max_texture_dimension_2d
+            )));
+        }
+        if scene.shadow_layers > limits.max_texture_array_layers {
+            return Err(Error::Scene(format!(
+                "{} lights need {} shadow-map layers (6 per point light, 1 per sun); the \
+                 adapter allows {}",
+                scene.lights.len(),
+                scene.shadow_layers,
+                limits.max_texture_array_layers
+            )));
+        }
+        let views = Self::layer_views(scene, size);
+        ctx.checked("rendering the shadow maps", || {
+            let device = &ctx.device;
+            let layers = scene.shadow_layers.max(1);
+            let texture = device.create_texture(&wgpu::TextureDescriptor {
+                label: Some("fisheye.raster.shadow_map"),
+                size: wgpu::Extent3d {
+                    width: size,
+                    height: size,
+                    depth_or_array_layers: layers,
+                },
+                mip_level_count: 1,
+                sample_count: 1,
+                dimension: wgpu::TextureDimension::D2,
+                format: wgpu::TextureFormat::Depth32Float,
+                usage: wgpu::TextureUsages::RENDER_ATTACHMENT
+                    | wgpu::TextureUsages::TEXTURE_BINDING,
+                view_formats: &[],
+            });
+            let placeholder = [ShadowView::zeroed()];
+            let data = if views.is_empty() {
+                &placeholder[..]
+            } else {
+                &views[..]
+            };
+            let buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some("fisheye.raster.shadow_views"),
+                contents: bytemuck::cast_slice(data),
+                usage: wgpu::BufferUsages::STORAGE,
+            });
+            let views_entry = wgpu::BindGroupLayoutEntry {
+                binding: 0,
+                visibility: crate::gpu::ALL_STAGES,
+                ty: wgpu::BindingType::Buffer {
+                    ty: wgpu::BufferBindingType::Storage { read_only: true },
+                    has_dynamic_offset: false,
+                    min_binding_size: None,
+                },
+                count: None,
+            };
+            let lookup_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+                label: Some("fisheye.raster.shadow_lookup"),
+                entries: &[
+                    views_entry,
+                    wgpu::BindGroupLayoutEntry {
+                        binding: 1,
+                        visibility: crate::gpu::ALL_STAGES,
+                        ty: wgpu::BindingType::Texture {
+                            sample_type: wgpu::TextureSampleType::Depth,
+                            view_dimension: wgpu::TextureViewDimension::D2Array,
+                            multisampled: false,
+                        },
+                        count: None,
+                    },
+                    wgpu::BindGroupLayoutEntry {
+                        binding: 2,
+                        visibility: crate::gpu::ALL_STAGES,
+                        ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Comparison),
+                        count: None,
+                    },
+                ],
+            });
+            let sampler = device.create_sampler(&wgpu::SamplerDescriptor {
+                label: Some("fisheye.raster.shadow_sampler"),
+                mag_filter: wgpu::FilterMode::Linear,
+                min_filter: wgpu::FilterMode::Linear,
+                // Reversed depth: lit where the point is at least as near the light as the map.
+                compare: Some(wgpu::CompareFunction::GreaterEqual),
+                ..Default::default()
+            });
+            let array = texture.create_view(&wgpu::TextureViewDescriptor {
+                dimension: Some(wgpu::TextureViewDimension::D2Array),
+                ..Default::default()
+            });
+            let lookup = device.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some("fisheye.raster.shadow_lookup"),
+                layout: &lookup_layout,
+                entries: &[
+                    wgpu::BindGroupEntry {
+                        binding: 0,
+                        resource: buffer.as_entire_binding(),
+                    },
+                    wgpu::BindGroupEntry {
+                        binding: 1,
+                        resource: wgpu::BindingResource::TextureView(&array),
+                    },
+                    wgpu::BindGroupEntry {
+                        binding: 2,
+                        resource: wgpu::BindingResource::Sampler(&sampler),
+                    },
+                ],
+            });
+            // The depth pass sees the views only (the map is its attachment).
+            let render_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+                label: Some("fisheye.raster.shadow_render"),
+                entries: &[views_entry],
+            });
+            let render_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some("fisheye.raster.shadow_render"),
+                layout: &render_layout,
+                entries: &[wgpu::BindGroupEntry {
+                    binding: 0,
+                    resource: buffer.as_entire_binding(),
+                }],
+            });
+            let empty = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+                label: Some("fisheye.raster.empty"),
+                entries: &[],
+            });
+            let pipeline = raster_pipeline(
+                device,
+                scene,
+                &[&empty, &scene.layout, &render_layout],
+                "raster",
+                ("shadow_vs", None),
+                None,
+            );
+            let no_bindings = device.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some("fisheye.raster.empty"),
+                layout: &empty,
+                entries: &[],
+            });
+            let mut encoder = device.create_command_encoder(&Default::default());
+            for layer in 0..scene.shadow_layers {
+                let target = texture.create_view(&wgpu::TextureViewDescriptor {
+                    dimension: Some(wgpu::TextureViewDimension::D2),
+                    base_array_layer: layer,
+                    array_layer_count: Some(1),
+                    ..Default::default()
+                });
+                let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+                    label: Some("fisheye.raster.shadow"),
+                    color_attachments: &[],
+                    depth_stencil_attachment: Some(depth_attachment(&target)),
+                    ..Default::default()
+                });
+                pass.set_pipeline(&pipeline);
+                pass.set_bind_group(0, &no_bindings, &[]);
+                pass.set_bind_group(1, &scene.bind_group, &[]);
+                pass.set_bind_group(2, &render_group, &[]);
+                pass.draw(0..3 * scene.triangles, layer..layer + 1);
+            }
+            ctx.queue.submit([encoder.finish()]);
+            Self {
+                size,
+                views,
+                lookup_layout,
+                lookup,
+            }
+        })
+    }
+
+    /// Texels per side of each layer.
+    pub fn size(&self) -> u32 {
+        self.size
+    }
+
+    /// The layers' views (tests check them against the lights).
+    pub fn views(&self) -> &[ShadowView] {
+        &self.views
+    }
+}
+
+/// A depth attachment cleared to 0 (reversed depth: 0 is infinitely far).
+fn depth_attachment(view: &wgpu::TextureView) -> wgpu::RenderPassDepthStencilAttachment<'_> {
+    wgpu::RenderPassDepthStencilAttachment {
+        view,
+        depth_ops: Some(wgpu::Operations {
+            load: wgpu::LoadOp::Clear(0.0),
+            store: wgpu::StoreOp::Store,
+        }),
+        stencil_ops: None,
+    }
+}
+
+/// A render pipeline over the scene's triangles (no vertex buffers, no culling: the tracer
+/// sees both sides), with reversed depth, specialised to the scene's features. `fragment` is
+/// the entry point and colour format, `None` for depth only.
+fn raster_pipeline(
+    device: &wgpu::Device,
+    scene: &GpuScene,
+    layouts: &[&wgpu::BindGroupLayout],
+    file: &str,
+    (vertex, multiview_mask): (&str, Option<NonZeroU32>),
+    fragment: Option<(&str, wgpu::TextureFormat)>,
+) -> wgpu::RenderPipeline {
+    let module = shader::module(device, file);
+    let f = scene.features;
+    let flag = |b: bool| if b { 1.0 } else { 0.0 };
+    let constants = [
+        ("HAS_MIRRORS", flag(f.mirrors)),
+        ("HAS_GLASS", flag(f.glass)),
+        ("HAS_TEXTURES", flag(f.textures)),
+        ("SMOOTH_NORMALS", flag(f.smooth_normals)),
+    ];
+    let options = wgpu::PipelineCompilationOptions {
+        constants: &constants,
+        ..Default::default()
+    };
+    let label = format!("fisheye.{file}.{vertex}");
+    let groups: Vec<Option<&wgpu::BindGroupLayout>> = layouts.iter().map(|l| Some(*l)).collect();
+    let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+        label: Some(&label),
+        bind_group_layouts: &groups,
+        immediate_size: 0,
+    });
+    let targets = fragment.map(|(_, format)| [Some(wgpu::ColorTargetState::from(format))]);
+    device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+        label: Some(&label),
+        layout: Some(&layout),
+        vertex: wgpu::VertexState {
+            module: &module,
+            entry_point: Some(vertex),
+            compilation_options: options.clone(),
+            buffers: &[],
+        },
+        primitive: wgpu::PrimitiveState::default(),
+        depth_stencil: Some(wgpu::DepthStencilState {
+            format: wgpu::TextureFormat::Depth32Float,
+            depth_write_enabled: Some(true),
+            depth_compare: Some(wgpu::CompareFunction::Greater),
+            stencil: Default::default(),
+            bias: Default::default(),
+        }),
+        multisample: Default::default(),
+        fragment: fragment.map(|(entry, _)| wgpu::FragmentState {
+            module: &module,
+            entry_point: Some(entry),
+            compilation_options: options,
+            targets: targets.as_ref().expect("a colour target"),
+        }),
+        multiview_mask,
+        cache: None,
+    })
+}
+
+/// The rasterizer's half of the cube-map path: draws the faces that the lens reaches (only
+/// their reachable regions, by scissor) and writes them, bordered, into the cube's texel
+/// buffer that `wgsl/cube_sample.wgsl` resamples.
+pub struct RasterFaces {
+    method: RasterMethod,
+    regions: [Option<Region>; 6],
+    triangles: u32,
+    sky: wgpu::Color,
+    views: wgpu::Buffer,
+    draw: wgpu::RenderPipeline,
+    /// Per face (forward and deferred), or all faces (single pass): colour or G-buffer, depth.
+    targets: Vec<(wgpu::TextureView, wgpu::TextureView)>,
+    draw_group: wgpu::BindGroup,
+    finish: wgpu::ComputePipeline,
+    finish_group: wgpu::BindGroup,
+    side: u32,
+    shadows: ShadowMaps,
+    multiview_mask: Option<NonZeroU32>,
+}
+
+impl RasterFaces {
+    /// Faces of `size` texels (plus the border), rendered by `method` where `regions` says,
+    /// into `texels` (six bordered faces of `vec4<f32>`); shadow maps of `shadow_size`².
+    pub fn new(
+        ctx: &GpuContext,
+        scene: &GpuScene,
+        size: u32,
+        regions: [Option<Region>; 6],
+        method: RasterMethod,
+        shadow_size: u32,
+        texels: &wgpu::Buffer,
+    ) -> Result<Self> {
+        let mut multiview_mask = None;
+        if method == RasterMethod::SinglePass {
+            if !ctx.has(wgpu::Features::MULTIVIEW) {
+                return Err(Error::MissingFeature {
+                    what: "the single-pass cube (wgpu has no geometry shaders)",
+                    feature: "MULTIVIEW",
+                    adapter: ctx.adapter.get_info().name,
+                });
+            }
+            let views = ctx.device.limits().max_multiview_view_count;
+            if views < 6 {
+                return Err(Error::Gpu {
+                    during: "creating the single-pass cube".into(),
+                    message: format!("multiview allows {views} views here, and a cube has 6"),
+                });
+            }
+            // Only the faces the lens reaches, where the adapter can skip views.
+            let mut mask = 0b11_1111;
+            if ctx.has(wgpu::Features::SELECTIVE_MULTIVIEW) {
+                mask = regions
+                    .iter()
+                    .enumerate()
+                    .filter(|(_, r)| r.is_some())
+                    .fold(0, |m, (i, _)| m | 1 << i);
+            }
+            multiview_mask = NonZeroU32::new(mask);
+        }
+        let shadows = ShadowMaps::new(ctx, scene, shadow_size)?;
+        let side = bordered(size);
+        ctx.checked("creating the rasterized cube faces", || {
+            let device = &ctx.device;
+            let texture = |label: &str, format: wgpu::TextureFormat| {
+                device.create_texture(&wgpu::TextureDescriptor {
+                    label: Some(label),
+                    size: wgpu::Extent3d {
+                        width: side,
+                        height: side,
+                        depth_or_array_layers: 6,
+                    },
+                    mip_level_count: 1,
+                    sample_count: 1,
+                    dimension: wgpu::TextureDimension::D2,
+                    format,
+                    usage: wgpu::TextureUsages::RENDER_ATTACHMENT
+                        | wgpu::TextureUsages::TEXTURE_BINDING,
+                    view_formats: &[],
+                })
+            };
+            let format = if method == RasterMethod::Deferred {
+                wgpu::TextureFormat::Rgba32Uint
+            } else {
+                wgpu::TextureFormat::Rgba32Float
+            };
+            let colour = texture("fisheye.raster.target", format);
+            let depth = texture("fisheye.raster.depth", wgpu::TextureFormat::Depth32Float);
+            let layer_views = |t: &wgpu::Texture, layer: Option<u32>| {
+                t.create_view(&wgpu::TextureViewDescriptor {
+                    dimension: Some(match layer {
+                        Some(_) => wgpu::TextureViewDimension::D2,
+                        None => wgpu::TextureViewDimension::D2Array,
+                    }),
+                    base_array_layer: layer.unwrap_or(0),
+                    array_layer_count: Some(if layer.is_some() { 1 } else { 6 }),
+                    ..Default::default()
+                })
+            };
+            let targets = match method {
+                RasterMethod::SinglePass => {
+                    vec![(layer_views(&colour, None), layer_views(&depth, None))]
+                }
+                _ => (0..6)
+                    .map(|f| (layer_views(&colour, Some(f)), layer_views(&depth, Some(f))))
+                    .collect(),
+            };
+            let views = device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("fisheye.raster.views"),
+                size: std::mem::size_of::<Views>() as u64,
+                usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+                mapped_at_creation: false,
+            });
+            let entry = |binding: u32, ty: wgpu::BindingType| wgpu::BindGroupLayoutEntry {
+                binding,
+                visibility: crate::gpu::ALL_STAGES,
+                ty,
+                count: None,
+            };
+            let buffer_type = |ty| wgpu::BindingType::Buffer {
+                ty,
+                has_dynamic_offset: false,
+                min_binding_size: None,
+            };
+            let views_entry = entry(0, buffer_type(wgpu::BufferBindingType::Uniform));
+            let draw_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+                label: Some("fisheye.raster.draw"),
+                entries: &[views_entry],
+            });
+            let draw_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some("fisheye.raster.draw"),
+                layout: &draw_layout,
+                entries: &[wgpu::BindGroupEntry {
+                    binding: 0,
+                    resource: views.as_entire_binding(),
+                }],
+            });
+            // The compute pass reads the drawn texture (binding 1 or 2 by its sample type)
+            // and writes the cube's texels.
+            let (texture_binding, sample_type) = match method {
+                RasterMethod::Deferred => (1, wgpu::TextureSampleType::Uint),
+                _ => (2, wgpu::TextureSampleType::Float { filterable: false }),
+            };
+            let finish_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+                label: Some("fisheye.raster.finish"),
+                entries: &[
+                    views_entry,
+                    entry(
+                        texture_binding,
+                        wgpu::BindingType::Texture {
+                            sample_type,
+                            view_dimension: wgpu::TextureViewDimension::D2Array,
+                            multisampled: false,
+                        },
+                    ),
+                    wgpu::BindGroupLayoutEntry {
+                        visibility: wgpu::ShaderStages::COMPUTE,
+                        ..entry(
+                            3,
+                            buffer_type(wgpu::BufferBindingType::Storage { read_only: false }),
+                        )
+                    },
+                ],
+            });
+            let whole = layer_views(&colour, None);
+            let finish_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some("fisheye.raster.finish"),
+                layout: &finish_layout,
+                entries: &[
+                    wgpu::BindGroupEntry {
+                        binding: 0,
+                        resource: views.as_entire_binding(),
+                    },
+                    wgpu::BindGroupEntry {
+                        binding: texture_binding,
+                        resource: wgpu::BindingResource::TextureView(&whole),
+                    },
+                    wgpu::BindGroupEntry {
+                        binding: 3,
+                        resource: texels.as_entire_binding(),
+                    },
+                ],
+            });
+            let lit = [&draw_layout, &scene.layout, &shadows.lookup_layout];
+            let draw = match method {
+                RasterMethod::Forward => raster_pipeline(
+                    device,
+                    scene,
+                    &lit,
+                    "raster",
+                    ("face_vs", None),
+                    Some(("forward_fs", format)),
+                ),
+                RasterMethod::Deferred => raster_pipeline(
+                    device,
+                    scene,
+                    &lit[..2],
+                    "raster",
+                    ("face_vs", None),
+                    Some(("gbuffer_fs", format)),
+                ),
+                RasterMethod::SinglePass => raster_pipeline(
+                    device,
+                    scene,
+                    &lit,
+                    "raster_multiview",
+                    ("multiview_vs", multiview_mask),
+                    Some(("multiview_fs", format)),
+                ),
+            };
+            let f = scene.features;
+            let flag = |b: bool| if b { 1.0 } else { 0.0 };
+            let finish = shader::compute_pipeline(
+                device,
+                "raster",
+                match method {
+                    RasterMethod::Deferred => "deferred_lighting",
+                    _ => "resolve",
+                },
+                &[
+                    ("HAS_MIRRORS", flag(f.mirrors)),
+                    ("HAS_GLASS", flag(f.glass)),
+                    ("HAS_TEXTURES", flag(f.textures)),
+                    ("SMOOTH_NORMALS", flag(f.smooth_normals)),
+                ],
+                &[&finish_layout, &scene.layout, &shadows.lookup_layout],
+            );
+            Self {
+                method,
+                regions,
+                triangles: scene.triangles,
+                sky: scene_sky(scene),
+                views,
+                draw,
+                targets,
+                draw_group,
+                finish,
+                finish_group,
+                side,
+                shadows,
+                multiview_mask,
+            }
+        })
+    }
+
+    /// The shadow maps in use.
+    pub fn shadows(&self) -> &ShadowMaps {
+        &self.shadows
+    }
+
+    /// Points the faces at `pose` (the cube's orientation follows the camera's) for the frames
+    /// encoded from now on.
+    pub fn set_pose(&self, ctx: &GpuContext, scene: &GpuScene, pose: &Camera) {
+        let size = self.side - 2;
+        let near = NEAR * extent(scene);
+        let eye = pose.position - scene.origin;
+        let projection = perspective(bordered_focal(size), near);
+        let rotation = pose.rotation();
+        let mut views = Views::zeroed();
+        for (i, face) in FACES.iter().enumerate() {
+            views.clip[i] = columns(projection * view(rotation * face.rotation(), eye));
+            if let Some(r) = self.regions[i] {
+                views.regions[i] = [r.x0, r.y0, r.x1, r.y1];
+            }
+        }
+        let e = eye.as_vec3();
+        views.eye = [e.x, e.y, e.z, 1.0];
+        ctx.queue
+            .write_buffer(&self.views, 0, bytemuck::bytes_of(&views));
+    }
+
+    /// Begins a render pass into `colour` and `depth` with the pipeline and its bind groups.
+    fn begin<'e>(
+        &self,
+        encoder: &'e mut wgpu::CommandEncoder,
+        (colour, depth): &(wgpu::TextureView, wgpu::TextureView),
+        scene: &GpuScene,
+    ) -> wgpu::RenderPass<'e> {
+        let lit = self.method != RasterMethod::Deferred;
+        // The G-buffer clears to 0 (no surface), colour to the sky.
+        let clear = if lit {
+            self.sky
+        } else {
+            wgpu::Color::TRANSPARENT
+        };
+        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some("fisheye.raster.faces"),
+            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                view: colour,
+                depth_slice: None,
+                resolve_target: None,
+                ops: wgpu::Operations {
+                    load: wgpu::LoadOp::Clear(clear),
+                    store: wgpu::StoreOp::Store,
+                },
+            })],
+            depth_stencil_attachment: Some(depth_attachment(depth)),
+            multiview_mask: self.multiview_mask,
+            ..Default::default()
+        });
+        pass.set_pipeline(&self.draw);
+        pass.set_bind_group(0, &self.draw_group, &[]);
+        pass.set_bind_group(1, &scene.bind_group, &[]);
+        if lit {
+            pass.set_bind_group(2, &self.shadows.lookup, &[]);
+        }
+        pass
+    }
+
+    /// Records the faces' render passes and the compute pass that writes the cube's texels.
+    pub fn encode(&self, encoder: &mut wgpu::CommandEncoder, scene: &GpuScene) {
+        let reached = || {
+            self.regions
+                .iter()
+                .enumerate()
+                .filter_map(|(i, r)| r.map(|r| (i as u32, r)))
+        };
+        let vertices = 0..3 * self.triangles;
+        let scissor = |pass: &mut wgpu::RenderPass<'_>, r: Region| {
+            pass.set_scissor_rect(r.x0, r.y0, r.x1 - r.x0, r.y1 - r.y0);
+        };
+        if self.method == RasterMethod::SinglePass {
+            let mut pass = self.begin(encoder, &self.targets[0], scene);
+            let union = reached().map(|(_, r)| r).reduce(|a, b| Region {
+                x0: a.x0.min(b.x0),
+                y0: a.y0.min(b.y0),
+                x1: a.x1.max(b.x1),
+                y1: a.y1.max(b.y1),
+            });
+            if let Some(r) = union {
+                scissor(&mut pass, r);
+                pass.draw(vertices.clone(), 0..1);
+            }
+        } else {
+            for (face, r) in reached() {
+                let mut pass = self.begin(encoder, &self.targets[face as usize], scene);
+                scissor(&mut pass, r);
+                pass.draw(vertices.clone(), face..face + 1);
+            }
+        }
+        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+            label: Some("fisheye.raster.finish"),
+            timestamp_writes: None,
+        });
+        pass.set_pipeline(&self.finish);
+        pass.set_bind_group(0, &self.finish_group, &[]);
+        pass.set_bind_group(1, &scene.bind_group, &[]);
+        pass.set_bind_group(2, &self.shadows.lookup, &[]);
+        let tiles = self.side.div_ceil(shader::WORKGROUP_2D);
+        pass.dispatch_workgroups(tiles, tiles, 6);
+    }
+}
+
+fn scene_sky(scene: &GpuScene) -> wgpu::Color {
+    let [r, g, b] = scene.sky.to_array().map(f64::from);
+    wgpu::Color { r, g, b, a: 1.0 }
+}
+
+#[cfg(test)]
+mod tests {
+    use std::mem::{offset_of, size_of};
+
+    use super::*;
+    use crate::shader::assert_wgsl_layout;
+
+    #[test]
+    fn raster_structs_match_their_wgsl_twins() {
+        assert_wgsl_layout(
+            "raster",
+            "Views",
+            size_of::<Views>(),
+            &[
+                ("clip", offset_of!(Views, clip)),
+                ("regions", offset_of!(Views, regions)),
+                ("eye", offset_of!(Views, eye)),
+            ],
+        );
+        assert_wgsl_layout(
+            "raster",
+            "ShadowView",
+            size_of::<ShadowView>(),
+            &[
+                ("clip", offset_of!(ShadowView, clip)),
+                ("texel", offset_of!(ShadowView, texel)),
+            ],
+        );
+    }
+
+    #[test]
+    fn face_views_put_texel_centres_where_the_tracer_does() {
+        // The bordered face camera of the tracer: pixel (i, j) of side N + 2 looks along
+        // ((2 (i + 0.5) / (N + 2) - 1) / f, (2 (j + 0.5) / (N + 2) - 1) / f, 1) with
+        // f = N / (N + 2). The raster view must put that direction at the same pixel centre.
+        let size = 6;
+        let side = f64::from(bordered(size));
+        let f = bordered_focal(size);
+        let m = perspective(f, 1e-3);
+        for (i, j) in [(0.0, 0.0), (3.0, 5.0), (7.0, 7.0)] {
+            let n = |k: f64| (2.0 * (k + 0.5) / side - 1.0) / f;
+            let d = DVec3::new(n(i), n(j), 1.0) * 2.5;
+            let clip = m * d.extend(1.0);
+            let ndc = clip.truncate() / clip.w;
+            // wgpu's viewport: x right, y up in NDC, rows down in the framebuffer.
+            let px = (ndc.x + 1.0) * 0.5 * side - 0.5;
+            let py = (1.0 - ndc.y) * 0.5 * side - 0.5;
+            assert!(
+                (px - i).abs() < 1e-12 && (py - j).abs() < 1e-12,
+                "{px} {py}"
+            );
+            // Reversed depth: near / z, in (0, 1].
+            assert!((ndc.z - 1e-3 / 2.5).abs() < 1e-15);
+        }
+        // A view's camera space: the eye maps to the origin, its forward axis to +z.
+        let rotation = FACES[0].rotation();
+        let eye = DVec3::new(1.0, 2.0, 3.0);
+        let v = view(rotation, eye);
+        assert!(v.transform_point3(eye).length() < 1e-15);
+        let ahead = v.transform_point3(eye + FACES[0].forward.as_dvec3());
+        assert!((ahead - DVec3::Z).length() < 1e-15);
+    }
+}

@@ -1,0 +1,182 @@
+// The rasterized cube faces: the scene's triangles drawn by vertex pulling (three vertices per
+// BVH slot, no vertex buffer), shaded forward in the fragment shader or deferred through a
+// G-buffer and a compute pass, and the shadow maps that stand in for shadow rays.
+//
+// Shading is `surface.wgsl`'s, as the tracer's. What a rasterizer cannot do, it does not:
+// lights are seen through shadow maps (filtered 2×2, so shadow edges are softened by about a
+// texel), mirrors and glass reflect and transmit the sky instead of casting rays, and partially
+// transparent surfaces are drawn opaque.
+#import surface
+#import cube
+
+// Mirrors `fisheye_rt::raster::Views` (496 bytes).
+struct Views {
+    // Per face: scene space (relative to the scene's origin) to clip space, depth reversed.
+    clip: array<mat4x4<f32>, 6>,
+    // Per face: the texels x0, y0 (inclusive), x1, y1 (exclusive) of the bordered face that are
+    // rendered; empty for faces that are not.
+    regions: array<vec4<u32>, 6>,
+    // The eye in scene space (xyz).
+    eye: vec4<f32>,
+}
+
+// Mirrors `fisheye_rt::raster::ShadowView` (80 bytes): one layer of the shadow maps.
+struct ShadowView {
+    // Scene space to the layer's clip space; depth is reversed (larger is nearer the light).
+    clip: mat4x4<f32>,
+    // x: a texel's width in scene units, at unit distance from a point light (whose faces
+    // span 90°) or anywhere in a directional light's orthographic map.
+    texel: vec4<f32>,
+}
+
+@group(0) @binding(0) var<uniform> views: Views;
+// The deferred G-buffer: BVH slot + 1 (0 where nothing was drawn) and the barycentrics u, v
+// as bits.
+@group(0) @binding(1) var gbuffer: texture_2d_array<u32>;
+// The forward passes' colour.
+@group(0) @binding(2) var forward_colour: texture_2d_array<f32>;
+// The bordered faces, as `cube_sample.wgsl` reads them.
+@group(0) @binding(3) var<storage, read_write> cube_out: array<vec4<f32>>;
+
+@group(2) @binding(0) var<storage, read> shadow_views: array<ShadowView>;
+@group(2) @binding(1) var shadow_map: texture_depth_2d_array;
+@group(2) @binding(2) var shadow_sampler: sampler_comparison;
+
+struct Varyings {
+    @builtin(position) position: vec4<f32>,
+    @location(0) @interpolate(flat) slot: u32,
+    // The barycentric weights of the triangle's v1 and v2 (perspective-correct).
+    @location(1) bary: vec2<f32>,
+    @location(2) world: vec3<f32>,
+}
+
+// Vertex `vertex` of a draw of the whole scene: corner `vertex % 3` of BVH slot `vertex / 3`.
+fn corner(vertex: u32) -> vec3<f32> {
+    let tri = bvh_triangles[vertex / 3u];
+    switch vertex % 3u {
+        case 0u: {
+            return tri.v0;
+        }
+        case 1u: {
+            return tri.v1;
+        }
+        default: {
+            return tri.v2;
+        }
+    }
+}
+
+fn face_vertex(vertex: u32, face: u32) -> Varyings {
+    let p = corner(vertex);
+    let c = vertex % 3u;
+    let bary = vec2<f32>(f32(c == 1u), f32(c == 2u));
+    return Varyings(views.clip[face] * vec4<f32>(p, 1.0), vertex / 3u, bary, p);
+}
+
+fn in_region(face: u32, texel: vec2<u32>) -> bool {
+    let r = views.regions[face];
+    return all(texel >= r.xy) && all(texel < r.zw);
+}
+
+// One face per draw: the instance index is the face.
+@vertex
+fn face_vs(@builtin(vertex_index) vertex: u32, @builtin(instance_index) face: u32) -> Varyings {
+    return face_vertex(vertex, face);
+}
+
+// Shadow maps, depth only: one layer per draw, the instance index is the layer.
+@vertex
+fn shadow_vs(@builtin(vertex_index) vertex: u32, @builtin(instance_index) layer: u32) -> @builtin(position) vec4<f32> {
+    return shadow_views[layer].clip * vec4<f32>(corner(vertex), 1.0);
+}
+
+// The fraction of `light` (arriving along `to_light`) that reaches `s`, from the shadow maps,
+// filtered over 2×2 texels by the comparison sampler. The point is first moved off its surface
+// along the normal by its texel's footprint, more where the light grazes the surface (normal
+// offset, Holbein 2011), so that a lit surface does not shadow itself.
+fn shadow_visibility(light: Light, s: Surface, to_light: vec3<f32>) -> f32 {
+    var texel = shadow_views[light.shadow_layer].texel.x;
+    if light.kind == LIGHT_POINT {
+        let d = abs(s.position - light.vector);
+        texel *= max(d.x, max(d.y, d.z));
+    }
+    let cos_l = clamp(dot(s.geometric, to_light), 0.05, 1.0);
+    let tan_l = sqrt(1.0 - cos_l * cos_l) / cos_l;
+    let p = s.position + s.geometric * (texel * (1.0 + min(tan_l, 4.0)));
+    var layer = light.shadow_layer;
+    if light.kind == LIGHT_POINT {
+        layer += cube_face_uv(p - light.vector).face;
+    }
+    let clip = shadow_views[layer].clip * vec4<f32>(p, 1.0);
+    let ndc = clip.xyz / clip.w;
+    let uv = vec2<f32>(0.5 + 0.5 * ndc.x, 0.5 - 0.5 * ndc.y);
+    return textureSampleCompareLevel(shadow_map, shadow_sampler, uv, layer, ndc.z);
+}
+
+// The radiance the eye sees at the barycentrics `bary` of BVH slot `slot`, at `world`.
+fn raster_shade(slot: u32, bary: vec2<f32>, world: vec3<f32>) -> vec3<f32> {
+    let dir = normalize(world - views.eye.xyz);
+    let s = surface_at(Ray(views.eye.xyz, dir, 0.0, 3.0e38), Hit(0.0, bary.x, bary.y, slot));
+    var colour = s.material.emission;
+    if HAS_MIRRORS && s.material.surface == SURFACE_MIRROR {
+        return colour + s.material.specular * shading.sky;
+    }
+    if HAS_GLASS && s.material.surface == SURFACE_GLASS {
+        let r = glass_interface(s, dir).reflectance;
+        return colour + (r + (1.0 - r) * s.material.transmission) * shading.sky;
+    }
+    colour += s.material.diffuse * shading.ambient;
+    for (var i = 0u; i < shading.light_count; i++) {
+        let light = incident(s, s.position, lights[i]);
+        if !light.lit {
+            continue;
+        }
+        let visible = shadow_visibility(lights[i], s, light.to_light);
+        if visible > 0.0 {
+            colour += reflected(s, dir, light, visible);
+        }
+    }
+    return colour;
+}
+
+// Forward: lighting in the fragment shader.
+@fragment
+fn forward_fs(in: Varyings) -> @location(0) vec4<f32> {
+    return vec4<f32>(raster_shade(in.slot, in.bary, in.world), 1.0);
+}
+
+// Deferred, first pass: what each texel sees, to be lit in `deferred_lighting`.
+@fragment
+fn gbuffer_fs(in: Varyings) -> @location(0) vec4<u32> {
+    return vec4<u32>(in.slot + 1u, bitcast<u32>(in.bary.x), bitcast<u32>(in.bary.y), 0u);
+}
+
+fn cube_index(face: u32, texel: vec2<u32>, side: u32) -> u32 {
+    return (face * side + texel.y) * side + texel.x;
+}
+
+// Deferred, second pass: lights the visible surface of every rendered texel (the sky where
+// nothing was drawn) into the cube's faces. One invocation per texel, z is the face.
+@compute @workgroup_size(WORKGROUP_2D, WORKGROUP_2D)
+fn deferred_lighting(@builtin(global_invocation_id) id: vec3<u32>) {
+    if !in_region(id.z, id.xy) {
+        return;
+    }
+    let g = textureLoad(gbuffer, id.xy, id.z, 0);
+    var colour = shading.sky;
+    if g.x != 0u {
+        let hit = Hit(0.0, bitcast<f32>(g.y), bitcast<f32>(g.z), g.x - 1u);
+        colour = raster_shade(hit.slot, vec2<f32>(hit.u, hit.v), hit_position(hit));
+    }
+    cube_out[cube_index(id.z, id.xy, textureDimensions(gbuffer).x)] = vec4<f32>(colour, 1.0);
+}
+
+// After forward shading: copies the rendered texels into the cube's faces.
+@compute @workgroup_size(WORKGROUP_2D, WORKGROUP_2D)
+fn resolve(@builtin(global_invocation_id) id: vec3<u32>) {
+    if !in_region(id.z, id.xy) {
+        return;
+    }
+    let side = textureDimensions(forward_colour).x;
+    cube_out[cube_index(id.z, id.xy, side)] = textureLoad(forward_colour, id.xy, id.z, 0);
+}

@@ -1,0 +1,203 @@
+// Surfaces and their lighting, shared by the tracer (`shade.wgsl`) and the rasterizer
+// (`raster.wgsl`): materials, textures, lights, the surface at a hit, Blinn-Phong reflection of
+// one light and the Fresnel split at glass. How light reaches a point (shadow rays or shadow
+// maps) and what mirrors and glass see are the callers'.
+#import triangles
+
+// Mirrors `fisheye_rt::trace::GpuMaterial` (80 bytes).
+struct Material {
+    diffuse: vec3<f32>,
+    surface: u32,
+    specular: vec3<f32>,
+    shininess: f32,
+    emission: vec3<f32>,
+    ior: f32,
+    transmission: vec3<f32>,
+    // Index into texture_info, NO_TEXTURE if none.
+    texture: u32,
+    // The fraction of light a diffuse surface stops (MTL `d`); the rest passes straight on.
+    opacity: f32,
+    pad: array<u32, 3>,
+}
+
+// Mirrors `fisheye_rt::trace::GpuLight` (32 bytes): a point light (position) or a directional
+// one (the direction light travels); colour is intensity or irradiance.
+struct Light {
+    vector: vec3<f32>,
+    kind: u32,
+    colour: vec3<f32>,
+    // The light's first layer in the rasterizer's shadow maps (six for a point light).
+    shadow_layer: u32,
+}
+
+// Mirrors `fisheye_rt::trace::Shading` (32 bytes).
+struct Shading {
+    // Radiance of escaping rays.
+    sky: vec3<f32>,
+    light_count: u32,
+    // Whitted's ambient term.
+    ambient: vec3<f32>,
+    // Secondary rays nest at most this deep (≤ MAX_DEPTH_LIMIT).
+    max_depth: u32,
+}
+
+@group(1) @binding(2) var<storage, read> materials: array<Material>;
+@group(1) @binding(3) var<storage, read> lights: array<Light>;
+// Per scene triangle: three vertex normals (xyz) when SMOOTH_NORMALS, then three UV pairs
+// packed in two vec4 when TEXTURES; see `fisheye_rt::trace::shading_vertices`.
+@group(1) @binding(4) var<storage, read> vertex_data: array<vec4<f32>>;
+// Per texture: first texel, width, height, unused.
+@group(1) @binding(5) var<storage, read> texture_info: array<vec4<u32>>;
+// RGBA8 sRGB texels of every texture.
+@group(1) @binding(6) var<storage, read> texels: array<u32>;
+@group(1) @binding(7) var<uniform> shading: Shading;
+
+override HAS_MIRRORS: bool;
+override HAS_GLASS: bool;
+override HAS_TEXTURES: bool;
+override SMOOTH_NORMALS: bool;
+
+fn srgb_to_linear(c: vec3<f32>) -> vec3<f32> {
+    return select(pow((c + 0.055) / 1.055, vec3<f32>(2.4)), c / 12.92, c <= vec3<f32>(0.04045));
+}
+
+fn texel(info: vec4<u32>, x: i32, y: i32) -> vec3<f32> {
+    // Repeat wrapping.
+    let w = i32(info.y);
+    let h = i32(info.z);
+    let xi = u32(((x % w) + w) % w);
+    let yi = u32(((y % h) + h) % h);
+    return srgb_to_linear(unpack4x8unorm(texels[info.x + yi * info.y + xi]).rgb);
+}
+
+// Bilinear filtering in linear space, repeat wrapping, v = 0 at the bottom (OBJ convention).
+fn sample_texture(index: u32, uv: vec2<f32>) -> vec3<f32> {
+    let info = texture_info[index];
+    let size = vec2<f32>(f32(info.y), f32(info.z));
+    let st = vec2<f32>(uv.x, 1.0 - uv.y) * size - 0.5;
+    let base = floor(st);
+    let f = st - base;
+    let x = i32(base.x);
+    let y = i32(base.y);
+    let top = mix(texel(info, x, y), texel(info, x + 1, y), f.x);
+    let bottom = mix(texel(info, x, y + 1), texel(info, x + 1, y + 1), f.x);
+    return mix(top, bottom, f.y);
+}
+
+// Everything shading needs about a hit.
+struct Surface {
+    position: vec3<f32>,
+    // Geometric normal, facing the incoming ray.
+    geometric: vec3<f32>,
+    // Shading normal, on the same side as `geometric`.
+    normal: vec3<f32>,
+    // Whether the ray hit the triangle's front (counter-clockwise) side.
+    front: bool,
+    material: Material,
+    triangle: u32,
+}
+
+fn surface_at(ray: Ray, hit: Hit) -> Surface {
+    let tri = bvh_triangles[hit.slot];
+    let triangle = tri.triangle;
+    var material = materials[tri.material];
+    let w = 1.0 - hit.u - hit.v;
+    let position = hit_position(hit);
+    var geometric = normalize(cross(tri.v1 - tri.v0, tri.v2 - tri.v0));
+    let front = dot(geometric, ray.dir) < 0.0;
+    if !front {
+        geometric = -geometric;
+    }
+    var normal = geometric;
+    var stride = 0u;
+    if SMOOTH_NORMALS {
+        stride = 3u;
+    }
+    if HAS_TEXTURES {
+        stride += 2u;
+    }
+    let base = triangle * stride;
+    if SMOOTH_NORMALS {
+        let n = normalize(w * vertex_data[base].xyz + hit.u * vertex_data[base + 1u].xyz
+            + hit.v * vertex_data[base + 2u].xyz);
+        // Keep the interpolated normal on the side the ray came from.
+        normal = select(-n, n, dot(n, geometric) >= 0.0);
+    }
+    if HAS_TEXTURES && material.texture != NO_TEXTURE {
+        var uv_base = base;
+        if SMOOTH_NORMALS {
+            uv_base += 3u;
+        }
+        let a = vertex_data[uv_base];
+        let b = vertex_data[uv_base + 1u];
+        let uv = w * a.xy + hit.u * a.zw + hit.v * b.xy;
+        material.diffuse *= sample_texture(material.texture, uv);
+    }
+    return Surface(position, geometric, normal, front, material, triangle);
+}
+
+// A light as it arrives at a point: the unit vector towards it, its distance (3e38 for a
+// directional light) and its irradiance there if nothing is in the way. `lit` is false where it
+// arrives from behind the surface (by the shading or the geometric normal).
+struct Incident {
+    to_light: vec3<f32>,
+    distance: f32,
+    irradiance: vec3<f32>,
+    lit: bool,
+}
+
+fn incident(s: Surface, origin: vec3<f32>, light: Light) -> Incident {
+    var i: Incident;
+    if light.kind == LIGHT_POINT {
+        let d = light.vector - origin;
+        i.distance = length(d);
+        i.to_light = d / i.distance;
+        i.irradiance = light.colour / (i.distance * i.distance);
+    } else {
+        i.to_light = -light.vector;
+        i.distance = 3.0e38;
+        i.irradiance = light.colour;
+    }
+    i.lit = dot(s.normal, i.to_light) > 0.0 && dot(s.geometric, i.to_light) > 0.0;
+    return i;
+}
+
+// Blinn-Phong: the radiance towards a viewer looking along `view` of a lit surface, scaled by
+// the fraction `visible` of the light that reaches it.
+fn reflected(s: Surface, view: vec3<f32>, light: Incident, visible: f32) -> vec3<f32> {
+    let irradiance = light.irradiance * visible;
+    let half_vector = normalize(light.to_light - view);
+    let highlight = s.material.specular
+        * pow(max(dot(s.normal, half_vector), 0.0), s.material.shininess);
+    return irradiance * (s.material.diffuse * dot(s.normal, light.to_light) + highlight);
+}
+
+// Unpolarised Fresnel reflectance of a dielectric interface.
+fn fresnel(cos_i: f32, cos_t: f32, eta: f32) -> f32 {
+    let rs = (eta * cos_i - cos_t) / (eta * cos_i + cos_t);
+    let rp = (cos_i - eta * cos_t) / (cos_i + eta * cos_t);
+    return 0.5 * (rs * rs + rp * rp);
+}
+
+// A ray along `dir` meeting glass: the Fresnel reflectance and the refracted direction
+// (zero under total internal reflection, where the reflectance is 1). Entering through the
+// front face, or leaving through the back.
+struct Interface {
+    reflectance: f32,
+    refracted: vec3<f32>,
+}
+
+fn glass_interface(s: Surface, dir: vec3<f32>) -> Interface {
+    var eta = 1.0 / s.material.ior;
+    if !s.front {
+        eta = s.material.ior;
+    }
+    let cos_i = -dot(dir, s.normal);
+    let sin2_t = eta * eta * max(1.0 - cos_i * cos_i, 0.0);
+    if sin2_t >= 1.0 {
+        return Interface(1.0, vec3<f32>(0.0));
+    }
+    let cos_t = sqrt(1.0 - sin2_t);
+    let refracted = normalize(eta * dir + (eta * cos_i - cos_t) * s.normal);
+    return Interface(fresnel(cos_i, cos_t, 1.0 / eta), refracted);
+}
