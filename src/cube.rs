@@ -282,17 +282,105 @@ pub fn face_camera(size: u32) -> Result<LensCamera> {
 }
 
 enum Faces {
-    Traced(TracePass),
+    Traced(TracedFaces),
     Raster(RasterFaces),
+}
+
+/// The tracer's half of the cube-map path: one bordered face at a time through the face
+/// camera, each copied into its layer of the cube.
+struct TracedFaces {
+    pass: TracePass,
+    store: wgpu::ComputePipeline,
+    /// Per face: the trace pass's colour output and that face's layer of the cube.
+    store_groups: Vec<wgpu::BindGroup>,
+    side: u32,
+}
+
+impl TracedFaces {
+    fn new(ctx: &GpuContext, scene: &GpuScene, size: u32, cube: &wgpu::Texture) -> Result<Self> {
+        let pass = TracePass::new(ctx, &face_camera(size)?, scene, DirectionSource::Computed)?;
+        ctx.checked("creating the traced cube faces", || {
+            let device = &ctx.device;
+            let store = shader::compute_pipeline(device, "cube_store", "main", &[], &[]);
+            let layout = store.get_bind_group_layout(0);
+            let store_groups = (0..6)
+                .map(|face| {
+                    let layer = cube.create_view(&wgpu::TextureViewDescriptor {
+                        dimension: Some(wgpu::TextureViewDimension::D2),
+                        base_array_layer: face,
+                        array_layer_count: Some(1),
+                        ..Default::default()
+                    });
+                    device.create_bind_group(&wgpu::BindGroupDescriptor {
+                        label: Some("fisheye.cube_store"),
+                        layout: &layout,
+                        entries: &[
+                            wgpu::BindGroupEntry {
+                                binding: 0,
+                                resource: pass.colour_buffer().as_entire_binding(),
+                            },
+                            wgpu::BindGroupEntry {
+                                binding: 1,
+                                resource: wgpu::BindingResource::TextureView(&layer),
+                            },
+                        ],
+                    })
+                })
+                .collect();
+            Self {
+                pass,
+                store,
+                store_groups,
+                side: bordered(size),
+            }
+        })
+    }
+
+    /// Renders the faces' regions from `pose`, one submission each since each moves the
+    /// face camera.
+    fn render(
+        &self,
+        ctx: &GpuContext,
+        scene: &GpuScene,
+        pose: &Camera,
+        regions: &[Option<Region>; 6],
+    ) -> Result<()> {
+        let rotation = pose.rotation();
+        for (i, face) in FACES.iter().enumerate() {
+            let Some(r) = regions[i] else { continue };
+            self.pass.set_view(
+                ctx,
+                scene,
+                pose.position,
+                rotation * face.rotation(),
+                [r.x0, r.y0],
+            );
+            ctx.checked("rendering a cube face", || {
+                let mut encoder = ctx.device.create_command_encoder(&Default::default());
+                let extent = ImageSize::new(r.x1 - r.x0, r.y1 - r.y0).expect("a non-empty region");
+                self.pass.encode_region(&mut encoder, scene, extent, None);
+                let side = ImageSize::new(self.side, self.side).expect("a face");
+                dispatch_over_image(
+                    &mut encoder,
+                    "fisheye.cube_store",
+                    &self.store,
+                    &[&self.store_groups[i]],
+                    side,
+                    None,
+                );
+                ctx.queue.submit([encoder.finish()]);
+            })?;
+        }
+        Ok(())
+    }
 }
 
 /// The cube-map path: renders each face the lens can reach (by the tracer or the rasterizer,
 /// plus a one-texel border), then a compute pass resamples the cube into the lens image.
 pub struct CubeMap {
-    size: u32,
     regions: [Option<Region>; 6],
     faces: Faces,
-    texels: wgpu::Buffer,
+    cube: wgpu::Texture,
     sampler: wgpu::ComputePipeline,
     bind_group: wgpu::BindGroup,
     colour: wgpu::Buffer,
@@ -317,8 +405,6 @@ impl CubeMap {
             )));
         }
         let side = bordered(size);
-        let texel_bytes = 16 * 6 * u64::from(side) * u64::from(side);
-        ctx.check_binding("the cube faces", texel_bytes)?;
         ctx.check_binding(
             "the cube-map colour output",
             16 * camera.size.pixels() as u64,
@@ -334,23 +420,28 @@ impl CubeMap {
                 };
             }
         }
-        let texels = ctx.checked("creating the cube faces", || {
-            ctx.device.create_buffer(&wgpu::BufferDescriptor {
-                label: Some("fisheye.cube.texels"),
-                size: texel_bytes,
-                usage: wgpu::BufferUsages::STORAGE
-                    | wgpu::BufferUsages::COPY_DST
-                    | wgpu::BufferUsages::COPY_SRC,
-                mapped_at_creation: false,
+        // A texture array, not a storage buffer: no binding-size limit on the faces.
+        let cube = ctx.checked("creating the cube faces", || {
+            ctx.device.create_texture(&wgpu::TextureDescriptor {
+                label: Some("fisheye.cube.faces"),
+                size: wgpu::Extent3d {
+                    width: side,
+                    height: side,
+                    depth_or_array_layers: 6,
+                },
+                mip_level_count: 1,
+                sample_count: 1,
+                dimension: wgpu::TextureDimension::D2,
+                format: wgpu::TextureFormat::Rgba32Float,
+                usage: wgpu::TextureUsages::TEXTURE_BINDING
+                    | wgpu::TextureUsages::STORAGE_BINDING
+                    | wgpu::TextureUsages::RENDER_ATTACHMENT
+                    | wgpu::TextureUsages::COPY_SRC,
+                view_formats: &[],
             })
         })?;
         let faces = match settings.method {
-            CubeMethod::Traced => Faces::Traced(TracePass::new(
-                ctx,
-                &face_camera(size)?,
-                scene,
-                DirectionSource::Computed,
-            )?),
+            CubeMethod::Traced => Faces::Traced(TracedFaces::new(ctx, scene, size, &cube)?),
             CubeMethod::Raster(method) => Faces::Raster(RasterFaces::new(
                 ctx,
                 scene,
@@ -358,7 +449,7 @@ impl CubeMap {
                 regions,
                 method,
                 settings.shadow_size,
-                &texels,
+                &cube,
             )?),
         };
         ctx.checked("creating the cube-map sampler", || {
@@ -369,18 +460,24 @@ impl CubeMap {
                 entries: &[
                     uniform_entry(0),
                     storage_entry(1, true),
-                    storage_entry(2, true),
+                    wgpu::BindGroupLayoutEntry {
+                        binding: 2,
+                        visibility: wgpu::ShaderStages::COMPUTE,
+                        ty: wgpu::BindingType::Texture {
+                            sample_type: wgpu::TextureSampleType::Float { filterable: false },
+                            view_dimension: wgpu::TextureViewDimension::D2Array,
+                            multisampled: false,
+                        },
+                        count: None,
+                    },
                     storage_entry(3, false),
                 ],
             });
             let mut constants = lens_constants(camera).to_vec();
-            constants.extend([
-                (
-                    "DIRECTION_SOURCE",
-                    f64::from(DirectionSource::Computed as u32),
-                ),
-                ("CUBE_SIZE", f64::from(size)),
-            ]);
+            constants.push((
+                "DIRECTION_SOURCE",
+                f64::from(DirectionSource::Computed as u32),
+            ));
             let sampler =
                 shader::compute_pipeline(device, "cube_sample", "main", &constants, &[&layout]);
             let buffer = |label: &str, bytes: u64, usage: wgpu::BufferUsages| {
@@ -399,17 +496,36 @@ impl CubeMap {
             );
             let no_table = buffer("fisheye.cube.no_table", 16, U::STORAGE);
             let lens = params_buffer(device, camera);
-            let bind_group = bind_buffers(
-                device,
-                "fisheye.cube_sample",
-                &layout,
-                &[&lens, &no_table, &texels, &colour],
-            );
+            let faces_view = cube.create_view(&wgpu::TextureViewDescriptor {
+                dimension: Some(wgpu::TextureViewDimension::D2Array),
+                ..Default::default()
+            });
+            let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some("fisheye.cube_sample"),
+                layout: &layout,
+                entries: &[
+                    wgpu::BindGroupEntry {
+                        binding: 0,
+                        resource: lens.as_entire_binding(),
+                    },
+                    wgpu::BindGroupEntry {
+                        binding: 1,
+                        resource: no_table.as_entire_binding(),
+                    },
+                    wgpu::BindGroupEntry {
+                        binding: 2,
+                        resource: wgpu::BindingResource::TextureView(&faces_view),
+                    },
+                    wgpu::BindGroupEntry {
+                        binding: 3,
+                        resource: colour.as_entire_binding(),
+                    },
+                ],
+            });
             Self {
-                size,
                 regions,
                 faces,
-                texels,
+                cube,
                 sampler,
                 bind_group,
                 colour,
@@ -442,7 +558,7 @@ impl CubeMap {
         pose: &Camera,
     ) -> Result<Vec<[f32; 4]>> {
         match &self.faces {
-            Faces::Traced(pass) => self.trace_faces(ctx, scene, pose, pass)?,
+            Faces::Traced(faces) => faces.render(ctx, scene, pose, &self.regions)?,
             Faces::Raster(faces) => {
                 faces.set_pose(ctx, scene, pose);
                 ctx.checked("rasterizing the cube faces", || {
@@ -467,47 +583,10 @@ impl CubeMap {
         ctx.read_buffer(&self.colour)
     }
 
-    /// Traced faces, one submission each since each moves the face camera.
-    fn trace_faces(
-        &self,
-        ctx: &GpuContext,
-        scene: &GpuScene,
-        pose: &Camera,
-        pass: &TracePass,
-    ) -> Result<()> {
-        let rotation = pose.rotation();
-        let side = u64::from(bordered(self.size));
-        for (i, face) in FACES.iter().enumerate() {
-            let Some(r) = self.regions[i] else { continue };
-            pass.set_view(
-                ctx,
-                scene,
-                pose.position,
-                rotation * face.rotation(),
-                [r.x0, r.y0],
-            );
-            ctx.checked("rendering a cube face", || {
-                let mut encoder = ctx.device.create_command_encoder(&Default::default());
-                let extent = ImageSize::new(r.x1 - r.x0, r.y1 - r.y0).expect("a non-empty region");
-                pass.encode_region(&mut encoder, scene, extent, None);
-                let bytes = 16 * side * side;
-                encoder.copy_buffer_to_buffer(
-                    pass.colour_buffer(),
-                    0,
-                    &self.texels,
-                    bytes * i as u64,
-                    bytes,
-                );
-                ctx.queue.submit([encoder.finish()]);
-            })?;
-        }
-        Ok(())
-    }
-
     /// The faces of the last render: `6 × (size + 2)²` texels, row-major per face (texels
     /// outside the regions hold nothing meaningful).
     pub fn texels(&self, ctx: &GpuContext) -> Result<Vec<[f32; 4]>> {
-        ctx.read_buffer(&self.texels)
+        ctx.read_texture(&self.cube)
     }
 }
 

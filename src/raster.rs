@@ -30,7 +30,7 @@ use crate::error::{Error, Result};
 use crate::gpu::GpuContext;
 use crate::scene::Camera;
 use crate::shader;
-use crate::trace::{GpuScene, LIGHT_KINDS};
+use crate::trace::{GpuScene, LIGHT_KINDS, surface_constants};
 
 /// How [`RasterFaces`] renders the faces.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -296,7 +296,7 @@ impl ShadowMaps {
             });
             let pipeline = raster_pipeline(
                 device,
-                scene,
+                &surface_constants(scene.features),
                 &[&empty, &scene.layout, &render_layout],
                 "raster",
                 ("shadow_vs", None),
@@ -361,27 +361,19 @@ fn depth_attachment(view: &wgpu::TextureView) -> wgpu::RenderPassDepthStencilAtt
 }
 
 /// A render pipeline over the scene's triangles (no vertex buffers, no culling: the tracer
-/// sees both sides), with reversed depth, specialised to the scene's features. `fragment` is
-/// the entry point and colour format, `None` for depth only.
+/// sees both sides), with reversed depth, specialised by `constants` (the scene's features).
+/// `fragment` is the entry point and colour format, `None` for depth only.
 fn raster_pipeline(
     device: &wgpu::Device,
-    scene: &GpuScene,
+    constants: &[(&str, f64)],
     layouts: &[&wgpu::BindGroupLayout],
     file: &str,
     (vertex, multiview_mask): (&str, Option<NonZeroU32>),
     fragment: Option<(&str, wgpu::TextureFormat)>,
 ) -> wgpu::RenderPipeline {
     let module = shader::module(device, file);
-    let f = scene.features;
-    let flag = |b: bool| if b { 1.0 } else { 0.0 };
-    let constants = [
-        ("HAS_MIRRORS", flag(f.mirrors)),
-        ("HAS_GLASS", flag(f.glass)),
-        ("HAS_TEXTURES", flag(f.textures)),
-        ("SMOOTH_NORMALS", flag(f.smooth_normals)),
-    ];
     let options = wgpu::PipelineCompilationOptions {
-        constants: &constants,
+        constants,
         ..Default::default()
     };
     let label = format!("fisheye.{file}.{vertex}");
@@ -431,11 +423,12 @@ pub struct RasterFaces {
     sky: wgpu::Color,
     views: wgpu::Buffer,
     draw: wgpu::RenderPipeline,
-    /// Per face (forward and deferred), or all faces (single pass): colour or G-buffer, depth.
+    /// Per face (forward and deferred), or all faces (single pass): the cube or the G-buffer,
+    /// and depth.
     targets: Vec<(wgpu::TextureView, wgpu::TextureView)>,
     draw_group: wgpu::BindGroup,
-    finish: wgpu::ComputePipeline,
-    finish_group: wgpu::BindGroup,
+    /// The deferred lighting pass and its bind group.
+    lighting: Option<(wgpu::ComputePipeline, wgpu::BindGroup)>,
     side: u32,
     shadows: ShadowMaps,
     multiview_mask: Option<NonZeroU32>,
@@ -443,7 +436,8 @@ pub struct RasterFaces {
 
 impl RasterFaces {
     /// Faces of `size` texels (plus the border), rendered by `method` where `regions` says,
-    /// into `texels` (six bordered faces of `vec4<f32>`); shadow maps of `shadow_size`².
+    /// into `cube` (an `Rgba32Float` array of six bordered faces); shadow maps of
+    /// `shadow_size`².
     pub fn new(
         ctx: &GpuContext,
         scene: &GpuScene,
@@ -451,7 +445,7 @@ impl RasterFaces {
         regions: [Option<Region>; 6],
         method: RasterMethod,
         shadow_size: u32,
-        texels: &wgpu::Buffer,
+        cube: &wgpu::Texture,
     ) -> Result<Self> {
         let mut multiview_mask = None;
         if method == RasterMethod::SinglePass {
@@ -501,14 +495,12 @@ impl RasterFaces {
                     view_formats: &[],
                 })
             };
-            let format = if method == RasterMethod::Deferred {
-                wgpu::TextureFormat::Rgba32Uint
-            } else {
-                wgpu::TextureFormat::Rgba32Float
-            };
-            let colour = texture("fisheye.raster.target", format);
             let depth = texture("fisheye.raster.depth", wgpu::TextureFormat::Depth32Float);
-            let layer_views = |t: &wgpu::Texture, layer: Option<u32>| {
+            // Forward passes draw into the cube itself; the deferred G-buffer is its own.
+            let gbuffer = (method == RasterMethod::Deferred)
+                .then(|| texture("fisheye.raster.gbuffer", wgpu::TextureFormat::Rgba32Uint));
+            let colour = gbuffer.as_ref().unwrap_or(cube);
+            let layer_view = |t: &wgpu::Texture, layer: Option<u32>| {
                 t.create_view(&wgpu::TextureViewDescriptor {
                     dimension: Some(match layer {
                         Some(_) => wgpu::TextureViewDimension::D2,
@@ -521,10 +513,10 @@ impl RasterFaces {
             };
             let targets = match method {
                 RasterMethod::SinglePass => {
-                    vec![(layer_views(&colour, None), layer_views(&depth, None))]
+                    vec![(layer_view(colour, None), layer_view(&depth, None))]
                 }
                 _ => (0..6)
-                    .map(|f| (layer_views(&colour, Some(f)), layer_views(&depth, Some(f))))
+                    .map(|f| (layer_view(colour, Some(f)), layer_view(&depth, Some(f))))
                     .collect(),
             };
             let views = device.create_buffer(&wgpu::BufferDescriptor {
@@ -539,113 +531,95 @@ impl RasterFaces {
                 ty,
                 count: None,
             };
-            let buffer_type = |ty| wgpu::BindingType::Buffer {
-                ty,
-                has_dynamic_offset: false,
-                min_binding_size: None,
-            };
-            let views_entry = entry(0, buffer_type(wgpu::BufferBindingType::Uniform));
+            let views_entry = entry(
+                0,
+                wgpu::BindingType::Buffer {
+                    ty: wgpu::BufferBindingType::Uniform,
+                    has_dynamic_offset: false,
+                    min_binding_size: None,
+                },
+            );
             let draw_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
                 label: Some("fisheye.raster.draw"),
                 entries: &[views_entry],
             });
+            let views_binding = wgpu::BindGroupEntry {
+                binding: 0,
+                resource: views.as_entire_binding(),
+            };
             let draw_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
                 label: Some("fisheye.raster.draw"),
                 layout: &draw_layout,
-                entries: &[wgpu::BindGroupEntry {
-                    binding: 0,
-                    resource: views.as_entire_binding(),
-                }],
+                entries: std::slice::from_ref(&views_binding),
             });
-            // The compute pass reads the drawn texture (binding 1 or 2 by its sample type)
-            // and writes the cube's texels.
-            let (texture_binding, sample_type) = match method {
-                RasterMethod::Deferred => (1, wgpu::TextureSampleType::Uint),
-                _ => (2, wgpu::TextureSampleType::Float { filterable: false }),
-            };
-            let finish_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-                label: Some("fisheye.raster.finish"),
-                entries: &[
-                    views_entry,
-                    entry(
-                        texture_binding,
-                        wgpu::BindingType::Texture {
-                            sample_type,
-                            view_dimension: wgpu::TextureViewDimension::D2Array,
-                            multisampled: false,
+            let constants = surface_constants(scene.features);
+            // Deferred lighting: reads the G-buffer, writes the cube.
+            let lighting = gbuffer.as_ref().map(|gbuffer| {
+                let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+                    label: Some("fisheye.raster.lighting"),
+                    entries: &[
+                        views_entry,
+                        entry(
+                            1,
+                            wgpu::BindingType::Texture {
+                                sample_type: wgpu::TextureSampleType::Uint,
+                                view_dimension: wgpu::TextureViewDimension::D2Array,
+                                multisampled: false,
+                            },
+                        ),
+                        wgpu::BindGroupLayoutEntry {
+                            visibility: wgpu::ShaderStages::COMPUTE,
+                            ..entry(
+                                2,
+                                wgpu::BindingType::StorageTexture {
+                                    access: wgpu::StorageTextureAccess::WriteOnly,
+                                    format: wgpu::TextureFormat::Rgba32Float,
+                                    view_dimension: wgpu::TextureViewDimension::D2Array,
+                                },
+                            )
                         },
-                    ),
-                    wgpu::BindGroupLayoutEntry {
-                        visibility: wgpu::ShaderStages::COMPUTE,
-                        ..entry(
-                            3,
-                            buffer_type(wgpu::BufferBindingType::Storage { read_only: false }),
-                        )
-                    },
-                ],
-            });
-            let whole = layer_views(&colour, None);
-            let finish_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-                label: Some("fisheye.raster.finish"),
-                layout: &finish_layout,
-                entries: &[
-                    wgpu::BindGroupEntry {
-                        binding: 0,
-                        resource: views.as_entire_binding(),
-                    },
-                    wgpu::BindGroupEntry {
-                        binding: texture_binding,
-                        resource: wgpu::BindingResource::TextureView(&whole),
-                    },
-                    wgpu::BindGroupEntry {
-                        binding: 3,
-                        resource: texels.as_entire_binding(),
-                    },
-                ],
+                    ],
+                });
+                let (read, write) = (layer_view(gbuffer, None), layer_view(cube, None));
+                let group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+                    label: Some("fisheye.raster.lighting"),
+                    layout: &layout,
+                    entries: &[
+                        views_binding.clone(),
+                        wgpu::BindGroupEntry {
+                            binding: 1,
+                            resource: wgpu::BindingResource::TextureView(&read),
+                        },
+                        wgpu::BindGroupEntry {
+                            binding: 2,
+                            resource: wgpu::BindingResource::TextureView(&write),
+                        },
+                    ],
+                });
+                let pipeline = shader::compute_pipeline(
+                    device,
+                    "raster",
+                    "deferred_lighting",
+                    &constants,
+                    &[&layout, &scene.layout, &shadows.lookup_layout],
+                );
+                (pipeline, group)
             });
             let lit = [&draw_layout, &scene.layout, &shadows.lookup_layout];
-            let draw = match method {
-                RasterMethod::Forward => raster_pipeline(
-                    device,
-                    scene,
-                    &lit,
-                    "raster",
-                    ("face_vs", None),
-                    Some(("forward_fs", format)),
-                ),
-                RasterMethod::Deferred => raster_pipeline(
-                    device,
-                    scene,
-                    &lit[..2],
-                    "raster",
-                    ("face_vs", None),
-                    Some(("gbuffer_fs", format)),
-                ),
-                RasterMethod::SinglePass => raster_pipeline(
-                    device,
-                    scene,
-                    &lit,
-                    "raster_multiview",
-                    ("multiview_vs", multiview_mask),
-                    Some(("multiview_fs", format)),
-                ),
+            let (file, vertex, fragment, layouts) = match method {
+                RasterMethod::Forward => ("raster", "face_vs", "forward_fs", &lit[..]),
+                RasterMethod::Deferred => ("raster", "face_vs", "gbuffer_fs", &lit[..2]),
+                RasterMethod::SinglePass => {
+                    ("raster_multiview", "multiview_vs", "multiview_fs", &lit[..])
+                }
             };
-            let f = scene.features;
-            let flag = |b: bool| if b { 1.0 } else { 0.0 };
-            let finish = shader::compute_pipeline(
+            let draw = raster_pipeline(
                 device,
-                "raster",
-                match method {
-                    RasterMethod::Deferred => "deferred_lighting",
-                    _ => "resolve",
-                },
-                &[
-                    ("HAS_MIRRORS", flag(f.mirrors)),
-                    ("HAS_GLASS", flag(f.glass)),
-                    ("HAS_TEXTURES", flag(f.textures)),
-                    ("SMOOTH_NORMALS", flag(f.smooth_normals)),
-                ],
-                &[&finish_layout, &scene.layout, &shadows.lookup_layout],
+                &constants,
+                layouts,
+                file,
+                (vertex, multiview_mask),
+                Some((fragment, colour.format())),
             );
             Self {
                 method,
@@ -656,8 +630,7 @@ impl RasterFaces {
                 draw,
                 targets,
                 draw_group,
-                finish,
-                finish_group,
+                lighting,
                 side,
                 shadows,
                 multiview_mask,
@@ -729,7 +702,7 @@ impl RasterFaces {
         pass
     }
 
-    /// Records the faces' render passes and the compute pass that writes the cube's texels.
+    /// Records the faces' render passes (and for deferred faces, the lighting pass).
     pub fn encode(&self, encoder: &mut wgpu::CommandEncoder, scene: &GpuScene) {
         let reached = || {
             self.regions
@@ -760,16 +733,18 @@ impl RasterFaces {
                 pass.draw(vertices.clone(), face..face + 1);
             }
         }
-        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
-            label: Some("fisheye.raster.finish"),
-            timestamp_writes: None,
-        });
-        pass.set_pipeline(&self.finish);
-        pass.set_bind_group(0, &self.finish_group, &[]);
-        pass.set_bind_group(1, &scene.bind_group, &[]);
-        pass.set_bind_group(2, &self.shadows.lookup, &[]);
-        let tiles = self.side.div_ceil(shader::WORKGROUP_2D);
-        pass.dispatch_workgroups(tiles, tiles, 6);
+        if let Some((pipeline, group)) = &self.lighting {
+            let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some("fisheye.raster.lighting"),
+                timestamp_writes: None,
+            });
+            pass.set_pipeline(pipeline);
+            pass.set_bind_group(0, group, &[]);
+            pass.set_bind_group(1, &scene.bind_group, &[]);
+            pass.set_bind_group(2, &self.shadows.lookup, &[]);
+            let tiles = self.side.div_ceil(shader::WORKGROUP_2D);
+            pass.dispatch_workgroups(tiles, tiles, 6);
+        }
     }
 }
 

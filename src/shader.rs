@@ -11,7 +11,7 @@ use crate::scene::Surface;
 use crate::trace;
 
 /// Every WGSL file of the project, by name (its file stem under `wgsl/`).
-pub const FILES: [(&str, &str); 17] = [
+pub const FILES: [(&str, &str); 18] = [
     ("math", include_str!("../wgsl/math.wgsl")),
     ("triangles", include_str!("../wgsl/triangles.wgsl")),
     ("bvh", include_str!("../wgsl/bvh.wgsl")),
@@ -27,6 +27,7 @@ pub const FILES: [(&str, &str); 17] = [
     ("cube", include_str!("../wgsl/cube.wgsl")),
     ("cube_probe", include_str!("../wgsl/cube_probe.wgsl")),
     ("cube_sample", include_str!("../wgsl/cube_sample.wgsl")),
+    ("cube_store", include_str!("../wgsl/cube_store.wgsl")),
     ("raster", include_str!("../wgsl/raster.wgsl")),
     (
         "raster_multiview",

@@ -33,10 +33,9 @@ struct ShadowView {
 // The deferred G-buffer: BVH slot + 1 (0 where nothing was drawn) and the barycentrics u, v
 // as bits.
 @group(0) @binding(1) var gbuffer: texture_2d_array<u32>;
-// The forward passes' colour.
-@group(0) @binding(2) var forward_colour: texture_2d_array<f32>;
-// The bordered faces, as `cube_sample.wgsl` reads them.
-@group(0) @binding(3) var<storage, read_write> cube_out: array<vec4<f32>>;
+// The cube's bordered faces, which the deferred lighting writes (forward passes draw into
+// them as colour attachments).
+@group(0) @binding(2) var cube_out: texture_storage_2d_array<rgba32float, write>;
 
 @group(2) @binding(0) var<storage, read> shadow_views: array<ShadowView>;
 @group(2) @binding(1) var shadow_map: texture_depth_2d_array;
@@ -151,10 +150,6 @@ fn gbuffer_fs(in: Varyings) -> @location(0) vec4<u32> {
     return vec4<u32>(in.slot + 1u, bitcast<u32>(in.bary.x), bitcast<u32>(in.bary.y), 0u);
 }
 
-fn cube_index(face: u32, texel: vec2<u32>, side: u32) -> u32 {
-    return (face * side + texel.y) * side + texel.x;
-}
-
 // Deferred, second pass: lights the visible surface of every rendered texel (the sky where
 // nothing was drawn) into the cube's faces. One invocation per texel, z is the face.
 @compute @workgroup_size(WORKGROUP_2D, WORKGROUP_2D)
@@ -168,15 +163,5 @@ fn deferred_lighting(@builtin(global_invocation_id) id: vec3<u32>) {
         let hit = Hit(0.0, bitcast<f32>(g.y), bitcast<f32>(g.z), g.x - 1u);
         colour = raster_shade(hit.slot, vec2<f32>(hit.u, hit.v), hit_position(hit));
     }
-    cube_out[cube_index(id.z, id.xy, textureDimensions(gbuffer).x)] = vec4<f32>(colour, 1.0);
-}
-
-// After forward shading: copies the rendered texels into the cube's faces.
-@compute @workgroup_size(WORKGROUP_2D, WORKGROUP_2D)
-fn resolve(@builtin(global_invocation_id) id: vec3<u32>) {
-    if !in_region(id.z, id.xy) {
-        return;
-    }
-    let side = textureDimensions(forward_colour).x;
-    cube_out[cube_index(id.z, id.xy, side)] = textureLoad(forward_colour, id.xy, id.z, 0);
+    textureStore(cube_out, id.xy, id.z, vec4<f32>(colour, 1.0));
 }

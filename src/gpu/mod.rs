@@ -316,7 +316,47 @@ impl GpuContext {
 
     /// Copies `buffer` (which must have `COPY_SRC`) to the CPU as `T`s.
     pub fn read_buffer<T: bytemuck::Pod>(&self, buffer: &wgpu::Buffer) -> Result<Vec<T>> {
-        let size = buffer.size();
+        let bytes = self.read_back(buffer.size(), |encoder, staging| {
+            encoder.copy_buffer_to_buffer(buffer, 0, staging, 0, buffer.size());
+        })?;
+        Ok(bytemuck::pod_collect_to_vec(&bytes))
+    }
+
+    /// Copies every layer of a 2D (array) texture of 16-byte texels (`Rgba32Float`, which must
+    /// have `COPY_SRC`) to the CPU: layer by layer, rows top first.
+    pub fn read_texture(&self, texture: &wgpu::Texture) -> Result<Vec<[f32; 4]>> {
+        assert_eq!(texture.format().block_copy_size(None), Some(16));
+        let size = texture.size();
+        let row = 16 * size.width as usize;
+        // Copies pad each row to a multiple of 256 bytes.
+        let padded = row.next_multiple_of(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT as usize);
+        let rows = (size.height * size.depth_or_array_layers) as usize;
+        let bytes = self.read_back((padded * rows) as u64, |encoder, staging| {
+            encoder.copy_texture_to_buffer(
+                texture.as_image_copy(),
+                wgpu::TexelCopyBufferInfo {
+                    buffer: staging,
+                    layout: wgpu::TexelCopyBufferLayout {
+                        offset: 0,
+                        bytes_per_row: Some(padded as u32),
+                        rows_per_image: Some(size.height),
+                    },
+                },
+                size,
+            );
+        })?;
+        Ok(bytes
+            .chunks_exact(padded)
+            .flat_map(|r| bytemuck::pod_collect_to_vec::<u8, [f32; 4]>(&r[..row]))
+            .collect())
+    }
+
+    /// Records `copy` into a staging buffer of `size` bytes, runs it and maps the result.
+    fn read_back(
+        &self,
+        size: u64,
+        copy: impl FnOnce(&mut wgpu::CommandEncoder, &wgpu::Buffer),
+    ) -> Result<Vec<u8>> {
         let staging = self.device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("fisheye.readback"),
             size,
@@ -328,7 +368,7 @@ impl GpuContext {
             .create_command_encoder(&wgpu::CommandEncoderDescriptor {
                 label: Some("fisheye.readback"),
             });
-        encoder.copy_buffer_to_buffer(buffer, 0, &staging, 0, size);
+        copy(&mut encoder, &staging);
         self.queue.submit([encoder.finish()]);
         let (sender, receiver) = std::sync::mpsc::channel();
         staging.map_async(wgpu::MapMode::Read, .., move |r| {
@@ -339,14 +379,14 @@ impl GpuContext {
             .recv()
             .map_err(|_| Error::DeviceLost("the readback was never answered".into()))?;
         let map_error = |message: String| Error::Gpu {
-            during: "reading a buffer back".into(),
+            during: "reading back from the GPU".into(),
             message,
         };
         mapped.map_err(|e| map_error(e.to_string()))?;
         let view = staging
             .get_mapped_range(..)
             .map_err(|e| map_error(e.to_string()))?;
-        let out = bytemuck::cast_slice(&view).to_vec();
+        let out = view.to_vec();
         drop(view);
         staging.unmap();
         Ok(out)

@@ -155,6 +155,18 @@ pub fn shading_vertices(scene: &Scene, features: Features) -> Vec<[f32; 4]> {
     out
 }
 
+/// The overrides of `wgsl/surface.wgsl` for a scene's features: code for what the scene does
+/// not use is dead.
+pub fn surface_constants(f: Features) -> [(&'static str, f64); 4] {
+    let flag = |b: bool| f64::from(u8::from(b));
+    [
+        ("HAS_MIRRORS", flag(f.mirrors)),
+        ("HAS_GLASS", flag(f.glass)),
+        ("HAS_TEXTURES", flag(f.textures)),
+        ("SMOOTH_NORMALS", flag(f.smooth_normals)),
+    ]
+}
+
 /// The frame of `pose` for a scene uploaded relative to `origin`.
 fn frame_for(origin: DVec3, pose: &Camera) -> Frame {
     view_frame(origin, pose.position, pose.rotation(), [0, 0])
@@ -382,16 +394,14 @@ impl TracePass {
                     storage_entry(5, false),
                 ],
             });
-            let f = scene.features;
-            let flag = |b: bool| if b { 1.0 } else { 0.0 };
             let mut constants = lens_constants(camera).to_vec();
+            constants.extend(surface_constants(scene.features));
             constants.extend([
                 ("DIRECTION_SOURCE", f64::from(source as u32)),
-                ("HAS_MIRRORS", flag(f.mirrors)),
-                ("HAS_GLASS", flag(f.glass)),
-                ("HAS_TEXTURES", flag(f.textures)),
-                ("SMOOTH_NORMALS", flag(f.smooth_normals)),
-                ("HAS_TRANSLUCENT", flag(f.translucent)),
+                (
+                    "HAS_TRANSLUCENT",
+                    f64::from(u8::from(scene.features.translucent)),
+                ),
             ]);
             let pipeline = shader::compute_pipeline(
                 device,
