@@ -2,7 +2,9 @@
 //! shared real scenes, through the default 180° fisheye and a pinhole of the same image size,
 //! the camera moving along each scene file's path (built-in scenes: their fixed camera).
 //! GPU time from timestamp queries, median of `FRAMES` frames after one warm-up, one run.
-//! A second table traces two scenes with each BVH preset, to choose the default by measurement.
+//! A second table compares the software traversal with hardware ray queries (where the
+//! adapter has them), with both build times; a third traces two scenes with each BVH preset,
+//! to choose the default by measurement.
 //!
 //! `cargo bench --bench trace` (`FRAMES`, default 8; `SIZE`, default 1024x768).
 
@@ -11,7 +13,7 @@ use fisheye_rt::gpu::{GpuContext, Queries, median};
 use fisheye_rt::lens::gpu::DirectionSource;
 use fisheye_rt::lens::{ImageSize, LensCamera, parse_spec};
 use fisheye_rt::scene::{self, Scene};
-use fisheye_rt::trace::{GpuScene, RenderOptions, TracePass};
+use fisheye_rt::trace::{GpuScene, RenderOptions, TracePass, Traversal};
 
 const SCENES: [&str; 7] = [
     "builtin:default",
@@ -114,6 +116,36 @@ fn main() {
             );
         }
         loaded.push((spec, scene));
+    }
+
+    if ctx.has(wgpu::Features::EXPERIMENTAL_RAY_QUERY) {
+        println!(
+            "\nTraversal: the software CWBVH against hardware ray queries, fisheye, same run\n"
+        );
+        println!(
+            "| scene | obvhs build ms | AS build ms | software M rays/s | ray query M rays/s | ray query / software |"
+        );
+        println!("|---|---:|---:|---:|---:|---:|");
+        for (spec, scene) in &loaded {
+            let software = GpuScene::new(&ctx, scene, &options).unwrap();
+            let rq_options = RenderOptions {
+                traversal: Traversal::RayQuery,
+                ..options
+            };
+            let hardware = GpuScene::new(&ctx, scene, &rq_options).unwrap();
+            let rate = |gpu_scene: &GpuScene| {
+                let m = measure(&ctx, &queries, scene, gpu_scene, LENSES[0].1, size, frames);
+                m.rays as f64 / m.ms * 1e-3
+            };
+            let (a, b) = (rate(&software), rate(&hardware));
+            let built = hardware.ray_query.as_ref().expect("built").build_time;
+            println!(
+                "| {spec} | {:.0} | {:.0} | {a:.2} | {b:.2} | {:.2} |",
+                software.bvh_build_time.as_secs_f64() * 1e3,
+                built.as_secs_f64() * 1e3,
+                b / a
+            );
+        }
     }
 
     println!("\nBVH presets: build time (CPU) and fisheye frame time (GPU)\n");

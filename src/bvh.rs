@@ -110,6 +110,19 @@ impl SceneBvh {
             .iter()
             .map(|t| t.map(|p| (p - origin).as_vec3().into()))
             .collect();
+        // Finite in f64 is not enough: the GPU's f32 (and an acceleration structure, where a
+        // non-finite vertex is undefined behaviour) must hold every corner too.
+        if let Some(i) = rounded
+            .iter()
+            .position(|t| !t.iter().all(|p| p.is_finite()))
+        {
+            return Err(Error::Scene(format!(
+                "triangle {i} has a corner at {:?}, {:?} from the camera: beyond the f32 range \
+                 the GPU computes in",
+                scene.triangles[i],
+                scene.triangles[i].map(|p| p - origin)
+            )));
+        }
         if rounded.is_empty() {
             return Ok(Self {
                 nodes: vec![CwBvhNode::default()],
@@ -171,4 +184,41 @@ fn node_depth(nodes: &[CwBvhNode], index: usize) -> u32 {
         .max()
         .unwrap_or(0)
         + 1
+}
+
+#[cfg(test)]
+mod tests {
+    use glam::Vec3;
+
+    use super::*;
+    use crate::scene::{Camera, Material, MeshBuilder};
+
+    /// A corner that f64 holds but f32 cannot is refused with the triangle named, before it
+    /// could reach the GPU (or an acceleration structure, where it is undefined behaviour).
+    #[test]
+    fn corners_beyond_f32_are_refused() {
+        let mut b = MeshBuilder::new();
+        let m = b.material(Material::diffuse("grey", Vec3::ONE));
+        b.triangle([DVec3::ZERO, DVec3::X, DVec3::Y], None, None, m);
+        b.triangle(
+            [DVec3::ZERO, DVec3::X, DVec3::new(0.0, 1e39, 0.0)],
+            None,
+            None,
+            m,
+        );
+        let camera = Camera {
+            position: DVec3::new(0.0, 0.0, -1.0),
+            look_at: DVec3::ZERO,
+            up: DVec3::Y,
+        };
+        let scene = b.finish(Vec::new(), Vec3::ZERO, Vec3::ZERO, camera);
+        let message = SceneBvh::build(&scene, scene.camera.position, BvhQuality::Fast)
+            .err()
+            .expect("refused")
+            .to_string();
+        assert!(
+            message.contains("triangle 1") && message.contains("f32 range"),
+            "{message}"
+        );
+    }
 }

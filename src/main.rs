@@ -17,7 +17,7 @@ use fisheye_rt::lens::{
 use fisheye_rt::raster::RasterMethod;
 use fisheye_rt::scene::{Scene, builtin};
 use fisheye_rt::trace::{
-    Channel, GpuScene, RenderOptions, TracePass, colour_image, world_directions,
+    Channel, GpuScene, RenderOptions, TracePass, Traversal, colour_image, world_directions,
 };
 use glam::{DVec2, DVec3};
 
@@ -65,7 +65,9 @@ struct RenderArgs {
     /// or `path:S` for the point S ∈ [0, 1] along the scene file's camera path.
     #[arg(long)]
     camera: Option<String>,
-    /// How to make the image: `rt` traces the lens's rays directly; the `cube-*` methods render
+    /// How to make the image: `rt` traces the lens's rays directly, `rq` does too with the
+    /// adapter's hardware ray queries in place of the software BVH traversal (same lens and
+    /// shading code; an error where the adapter lacks them); the `cube-*` methods render
     /// the faces of a cube map (those the lens reaches, and of them only the parts it reaches)
     /// and resample it: `cube-rt` traces them; `cube-forward` (a render pass per face),
     /// `cube-deferred` (G-buffer, then lighting in a compute pass) and `cube-single` (one
@@ -102,6 +104,7 @@ struct RenderArgs {
 #[derive(Clone, Copy, PartialEq, Eq, ValueEnum)]
 enum Method {
     Rt,
+    Rq,
     CubeRt,
     CubeForward,
     CubeDeferred,
@@ -113,7 +116,7 @@ impl Method {
     fn cube(self) -> Option<CubeMethod> {
         let raster = |m| Some(CubeMethod::Raster(m));
         match self {
-            Self::Rt => None,
+            Self::Rt | Self::Rq => None,
             Self::CubeRt => Some(CubeMethod::Traced),
             Self::CubeForward => raster(RasterMethod::Forward),
             Self::CubeDeferred => raster(RasterMethod::Deferred),
@@ -329,6 +332,11 @@ fn render(args: &RenderArgs) -> Result<()> {
         max_depth: args.max_depth,
         bvh: args.bvh.into(),
         directions: args.directions.into(),
+        traversal: if args.method == Method::Rq {
+            Traversal::RayQuery
+        } else {
+            Traversal::Software
+        },
     };
     let (size, out) = (args.size, &args.out);
     let scene_spec = &args.scene;
@@ -348,6 +356,12 @@ fn render(args: &RenderArgs) -> Result<()> {
         gpu_scene.bvh_depth,
         gpu_scene.bvh_build_time.as_secs_f64() * 1e3
     );
+    if let Some(rq) = &gpu_scene.ray_query {
+        println!(
+            "ray queries: acceleration structure built by the driver in {:.1} ms",
+            rq.build_time.as_secs_f64() * 1e3
+        );
+    }
     println!(
         "lens: {} at {size}; compiling the trace kernel...",
         camera.lens

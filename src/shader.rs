@@ -11,13 +11,15 @@ use crate::scene::Surface;
 use crate::trace;
 
 /// Every WGSL file of the project, by name (its file stem under `wgsl/`).
-pub const FILES: [(&str, &str); 18] = [
+pub const FILES: [(&str, &str); 20] = [
     ("math", include_str!("../wgsl/math.wgsl")),
     ("triangles", include_str!("../wgsl/triangles.wgsl")),
     ("bvh", include_str!("../wgsl/bvh.wgsl")),
+    ("bvh_rq", include_str!("../wgsl/bvh_rq.wgsl")),
     ("surface", include_str!("../wgsl/surface.wgsl")),
     ("shade", include_str!("../wgsl/shade.wgsl")),
     ("trace", include_str!("../wgsl/trace.wgsl")),
+    ("trace_rq", include_str!("../wgsl/trace_rq.wgsl")),
     ("lens", include_str!("../wgsl/lens.wgsl")),
     ("primary", include_str!("../wgsl/primary.wgsl")),
     ("lens_rays", include_str!("../wgsl/lens_rays.wgsl")),
@@ -83,32 +85,68 @@ fn file(name: &str) -> &'static str {
         .unwrap_or_else(|| panic!("#import {name}: no such file in wgsl/ (see shader::FILES)"))
 }
 
-fn append(name: &str, seen: &mut Vec<String>, out: &mut String) {
-    if seen.iter().any(|s| s == name) {
-        return;
-    }
-    seen.push(name.to_string());
-    let text = file(name);
-    for line in text.lines() {
-        if let Some(dep) = line.trim().strip_prefix("#import ") {
-            append(dep.trim(), seen, out);
+/// What composing a module has gathered: the files already appended, `#swap`s in force, and
+/// the `enable` directives (which WGSL wants before any declaration).
+#[derive(Default)]
+struct Composition {
+    seen: Vec<String>,
+    swaps: Vec<(String, String)>,
+    enables: Vec<String>,
+    body: String,
+}
+
+impl Composition {
+    fn append(&mut self, name: &str) {
+        let name = self
+            .swaps
+            .iter()
+            .find(|(from, _)| from == name)
+            .map_or(name, |(_, to)| to.as_str())
+            .to_string();
+        if self.seen.contains(&name) {
+            return;
         }
-    }
-    writeln!(out, "// ---- wgsl/{name}.wgsl").unwrap();
-    for line in text.lines().filter(|l| !l.trim().starts_with("#import ")) {
-        out.push_str(line);
-        out.push('\n');
+        self.seen.push(name.clone());
+        let text = file(&name);
+        for line in text.lines().map(str::trim) {
+            if let Some((from, to)) = line.strip_prefix("#swap ").and_then(|s| s.split_once(' ')) {
+                self.swaps.push((from.trim().into(), to.trim().into()));
+            } else if let Some(dep) = line.strip_prefix("#import ") {
+                self.append(dep.trim());
+            } else if line.starts_with("enable ") && !self.enables.iter().any(|e| e == line) {
+                self.enables.push(line.into());
+            }
+        }
+        writeln!(self.body, "// ---- wgsl/{name}.wgsl").unwrap();
+        for line in text.lines() {
+            let directive = line.trim();
+            if !["#import ", "#swap ", "enable "]
+                .iter()
+                .any(|d| directive.starts_with(d))
+            {
+                self.body.push_str(line);
+                self.body.push('\n');
+            }
+        }
     }
 }
 
-/// The complete WGSL source of the module whose entry file is `entry`.
+/// The complete WGSL source of the module whose entry file is `entry`: its `enable`
+/// directives, the constants, then every file it imports (dependencies first, each once; a
+/// `#swap A B` line makes later `#import A`s pull in `B` instead), then the entry file.
 pub fn compose(entry: &str) -> String {
-    let mut out = String::from("// ---- constants from fisheye_rt::shader::constants()\n");
+    let mut c = Composition::default();
+    c.append(entry);
+    let mut out = String::new();
+    for enable in &c.enables {
+        writeln!(out, "{enable}").unwrap();
+    }
+    out.push_str("// ---- constants from fisheye_rt::shader::constants()\n");
     for (name, value) in constants() {
         writeln!(out, "const {name}: u32 = {value}u;").unwrap();
     }
     out.push_str(&crate::cube::wgsl_faces());
-    append(entry, &mut Vec::new(), &mut out);
+    out.push_str(&c.body);
     out
 }
 
@@ -212,6 +250,20 @@ mod tests {
         let mut listed: Vec<String> = FILES.iter().map(|(n, _)| n.to_string()).collect();
         listed.sort();
         assert_eq!(on_disk, listed, "wgsl/ and shader::FILES disagree");
+    }
+
+    #[test]
+    fn a_swap_replaces_an_import_and_enables_come_first() {
+        let source = compose("trace_rq");
+        assert!(source.starts_with("enable wgpu_ray_query;\n"));
+        assert_eq!(source.matches("enable ").count(), 1);
+        assert!(source.contains("// ---- wgsl/bvh_rq.wgsl"));
+        assert!(!source.contains("// ---- wgsl/bvh.wgsl"));
+        // Everything else of the software kernel is there, once.
+        for shared in ["trace", "shade", "surface", "triangles", "primary", "lens"] {
+            let header = format!("// ---- wgsl/{shared}.wgsl\n");
+            assert_eq!(source.matches(&header).count(), 1, "{shared}");
+        }
     }
 
     #[test]

@@ -475,3 +475,45 @@ fn render_through_a_cube_map() {
     );
     std::fs::remove_dir_all(dir).unwrap();
 }
+
+/// `--method rq` traces with hardware ray queries: it reports the acceleration structure's
+/// build and gives the software traversal's image but at a few edge pixels.
+#[test]
+fn render_with_ray_queries() {
+    let dir = std::env::temp_dir().join(format!("fisheye-rq-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let (software, hardware) = (dir.join("rt.png"), dir.join("rq.png"));
+    for (method, out) in [("rt", &software), ("rq", &hardware)] {
+        let text = stdout(&fisheye(
+            &[
+                "render",
+                "--size",
+                "64x48",
+                "--method",
+                method,
+                "-o",
+                out.to_str().unwrap(),
+            ],
+            "",
+        ));
+        assert_eq!(
+            text.contains("acceleration structure built by the driver in"),
+            method == "rq",
+            "{text}"
+        );
+    }
+    let (a, b) = (
+        image::open(&software).unwrap().to_rgba8(),
+        image::open(&hardware).unwrap().to_rgba8(),
+    );
+    let differing = a
+        .pixels()
+        .zip(b.pixels())
+        .filter(|(p, q)| (0..4).any(|k| p[k].abs_diff(q[k]) > 2))
+        .count();
+    assert!(
+        differing * 50 < a.pixels().len(),
+        "{differing} pixels differ"
+    );
+    std::fs::remove_dir_all(dir).unwrap();
+}

@@ -151,6 +151,12 @@ impl GpuContext {
     /// a software one. Requests the adapter's own limits and every feature of
     /// [`OPTIONAL_FEATURES`] it has.
     pub fn new() -> Result<Self> {
+        Self::without(wgpu::Features::empty())
+    }
+
+    /// As [`GpuContext::new`], but never enabling `features`: what an adapter without them
+    /// gives (tests use it to check the errors such users see).
+    pub fn without(features: wgpu::Features) -> Result<Self> {
         let instance =
             wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle_from_env());
         let backends = wgpu::Backends::from_env().unwrap_or_default();
@@ -183,14 +189,19 @@ impl GpuContext {
                 adapters.swap_remove(0)
             }
         };
-        Self::with_adapter(adapter)
+        Self::with_adapter_without(adapter, features)
     }
 
     /// Creates the device on a given adapter (as [`GpuContext::new`] does once it has chosen).
     pub fn with_adapter(adapter: wgpu::Adapter) -> Result<Self> {
+        Self::with_adapter_without(adapter, wgpu::Features::empty())
+    }
+
+    fn with_adapter_without(adapter: wgpu::Adapter, left_out: wgpu::Features) -> Result<Self> {
         let wanted = OPTIONAL_FEATURES
             .iter()
-            .fold(wgpu::Features::empty(), |all, (f, _)| all | *f);
+            .fold(wgpu::Features::empty(), |all, (f, _)| all | *f)
+            - left_out;
         let features = adapter.features() & wanted;
         let mut limits = adapter.limits();
         let mut experimental = wgpu::ExperimentalFeatures::disabled();

@@ -4,12 +4,14 @@
 
 pub mod cpu;
 mod output;
+mod ray_query;
 
 use bytemuck::{Pod, Zeroable};
 use glam::{DMat3, DVec3};
 use wgpu::util::DeviceExt;
 
 pub use output::{Channel, RenderOutput, colour_image, linear_to_srgb};
+pub use ray_query::RayQueryScene;
 
 use crate::bvh::{BvhQuality, SceneBvh};
 use crate::error::{Error, Result};
@@ -122,6 +124,19 @@ pub struct RenderOptions {
     pub bvh: BvhQuality,
     /// Where primary ray directions come from.
     pub directions: DirectionSource,
+    /// How rays find their hits.
+    pub traversal: Traversal,
+}
+
+/// How the tracer's rays find their hits; lens and shading code are the same for both.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Traversal {
+    /// The obvhs CWBVH, traversed in WGSL (`wgsl/bvh.wgsl`): runs on any adapter.
+    #[default]
+    Software,
+    /// Hardware ray queries over an acceleration structure built by the driver
+    /// (`wgsl/bvh_rq.wgsl`); needs `Features::EXPERIMENTAL_RAY_QUERY`.
+    RayQuery,
 }
 
 impl Default for RenderOptions {
@@ -130,6 +145,7 @@ impl Default for RenderOptions {
             max_depth: 5,
             bvh: BvhQuality::default(),
             directions: DirectionSource::Computed,
+            traversal: Traversal::Software,
         }
     }
 }
@@ -191,6 +207,16 @@ fn view_frame(origin: DVec3, eye: DVec3, rotation: DMat3, offset: [u32; 2]) -> F
 /// A storage buffer holding `data`, or one zero element where `data` is empty (bindings may
 /// not be empty), checked against the binding limit.
 fn storage<T: Pod>(ctx: &GpuContext, label: &str, data: &[T]) -> Result<wgpu::Buffer> {
+    storage_for(ctx, label, data, wgpu::BufferUsages::empty())
+}
+
+/// As [`storage`], with `extra` usages.
+fn storage_for<T: Pod>(
+    ctx: &GpuContext,
+    label: &str,
+    data: &[T],
+    extra: wgpu::BufferUsages,
+) -> Result<wgpu::Buffer> {
     let zero = [T::zeroed()];
     let data = if data.is_empty() { &zero[..] } else { data };
     let bytes: &[u8] = bytemuck::cast_slice(data);
@@ -200,7 +226,7 @@ fn storage<T: Pod>(ctx: &GpuContext, label: &str, data: &[T]) -> Result<wgpu::Bu
         .create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some(label),
             contents: bytes,
-            usage: wgpu::BufferUsages::STORAGE,
+            usage: wgpu::BufferUsages::STORAGE | extra,
         }))
 }
 
@@ -213,7 +239,7 @@ pub struct GpuScene {
     pub features: Features,
     /// The world position the scene was made relative to (the camera's).
     pub origin: DVec3,
-    /// Triangles, in BVH order: the rasterizer draws `3 × triangles` vertices.
+    /// Triangles (in BVH order on the GPU): the rasterizer draws `3 × triangles` vertices.
     pub triangles: u32,
     /// The lights as uploaded.
     pub lights: Vec<GpuLight>,
@@ -229,6 +255,8 @@ pub struct GpuScene {
     pub bvh_depth: u32,
     /// obvhs's build time.
     pub bvh_build_time: std::time::Duration,
+    /// The acceleration structure, with [`Traversal::RayQuery`].
+    pub ray_query: Option<RayQueryScene>,
     /// The camera-to-world rotation.
     frame: Frame,
 }
@@ -241,6 +269,9 @@ impl GpuScene {
                 "max depth {} is above the limit of {MAX_DEPTH_LIMIT}",
                 options.max_depth
             )));
+        }
+        if options.traversal == Traversal::RayQuery {
+            RayQueryScene::check(ctx, scene.len() as u64)?;
         }
         let origin = scene.camera.position;
         let bvh = SceneBvh::build(scene, origin, options.bvh)?;
@@ -299,7 +330,16 @@ impl GpuScene {
 
         let buffers = [
             storage(ctx, "fisheye.scene.bvh_nodes", &bvh.nodes)?,
-            storage(ctx, "fisheye.scene.triangles", &bvh.triangles)?,
+            storage_for(
+                ctx,
+                "fisheye.scene.triangles",
+                &bvh.triangles,
+                if options.traversal == Traversal::RayQuery {
+                    wgpu::BufferUsages::BLAS_INPUT
+                } else {
+                    wgpu::BufferUsages::empty()
+                },
+            )?,
             storage(ctx, "fisheye.scene.materials", &materials)?,
             storage(ctx, "fisheye.scene.lights", &lights)?,
             storage(
@@ -310,7 +350,7 @@ impl GpuScene {
             storage(ctx, "fisheye.scene.texture_info", &texture_info)?,
             storage(ctx, "fisheye.scene.texels", &texels)?,
         ];
-        ctx.checked("uploading the scene", || {
+        let scene = ctx.checked("uploading the scene", || {
             let device = &ctx.device;
             let uniform = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
                 label: Some("fisheye.scene.shading"),
@@ -331,14 +371,17 @@ impl GpuScene {
             let mut resources: Vec<&wgpu::Buffer> = buffers.iter().collect();
             resources.push(&uniform);
             let bind_group = bind_buffers(device, "fisheye.scene", &layout, &resources);
+            let ray_query = (options.traversal == Traversal::RayQuery)
+                .then(|| RayQueryScene::new(ctx, &buffers[1], scene.len() as u32));
             Self {
                 layout,
                 bind_group,
                 features,
-                triangles: bvh.triangles.len() as u32,
+                triangles: scene.len() as u32,
                 lights,
                 shadow_layers,
                 sky: scene.sky,
+                ray_query,
                 bounds: scene.bounds().map(|(lo, hi)| (lo - origin, hi - origin)),
                 origin,
                 bvh_nodes: bvh.nodes.len(),
@@ -346,7 +389,10 @@ impl GpuScene {
                 bvh_build_time: bvh.build_time,
                 frame,
             }
-        })
+        })?;
+        // Surfaces a failed acceleration-structure build here rather than at the first frame.
+        ctx.wait()?;
+        Ok(scene)
     }
 }
 
@@ -403,13 +449,15 @@ impl TracePass {
                     f64::from(u8::from(scene.features.translucent)),
                 ),
             ]);
-            let pipeline = shader::compute_pipeline(
-                device,
-                "trace",
-                "main",
-                &constants,
-                &[&layout, &scene.layout],
-            );
+            let mut layouts = vec![&layout, &scene.layout];
+            let file = match &scene.ray_query {
+                Some(rq) => {
+                    layouts.push(&rq.layout);
+                    "trace_rq"
+                }
+                None => "trace",
+            };
+            let pipeline = shader::compute_pipeline(device, file, "main", &constants, &layouts);
             let output = |label: &str, bytes: u64| {
                 device.create_buffer(&wgpu::BufferDescriptor {
                     label: Some(label),
@@ -496,11 +544,15 @@ impl TracePass {
         extent: crate::lens::ImageSize,
         timestamp_writes: Option<wgpu::ComputePassTimestampWrites<'_>>,
     ) {
+        let mut groups = vec![&self.bind_group, &scene.bind_group];
+        if let Some(rq) = &scene.ray_query {
+            groups.push(&rq.bind_group);
+        }
         dispatch_over_image(
             encoder,
             "fisheye.trace",
             &self.pipeline,
-            &[&self.bind_group, &scene.bind_group],
+            &groups,
             extent,
             timestamp_writes,
         );

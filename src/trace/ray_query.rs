@@ -1,0 +1,129 @@
+//! The scene as a hardware acceleration structure, for [`Traversal::RayQuery`]: one bottom
+//! level over the BVH's own triangle buffer (its corners are the vertices, three per slot, so a
+//! hit's primitive index is its slot) and a top level with that one instance.
+//!
+//! [`Traversal::RayQuery`]: super::Traversal::RayQuery
+
+use std::time::{Duration, Instant};
+
+use crate::error::{Error, Result};
+use crate::gpu::GpuContext;
+
+/// A scene's acceleration structure and the bind group (`@group(2)` of `wgsl/bvh_rq.wgsl`)
+/// that exposes it.
+pub struct RayQueryScene {
+    pub(crate) layout: wgpu::BindGroupLayout,
+    pub(crate) bind_group: wgpu::BindGroup,
+    /// Wall time of the driver's build (bottom and top level), submission to completion.
+    pub build_time: Duration,
+    _structures: (Option<wgpu::Blas>, wgpu::Tlas),
+}
+
+impl RayQueryScene {
+    /// Whether the device can hold `triangles` in one bottom level, with a clear error if not.
+    pub(crate) fn check(ctx: &GpuContext, triangles: u64) -> Result<()> {
+        if !ctx.has(wgpu::Features::EXPERIMENTAL_RAY_QUERY) {
+            return Err(Error::MissingFeature {
+                what: "ray-query traversal (--method rq)",
+                feature: "EXPERIMENTAL_RAY_QUERY",
+                adapter: ctx.adapter.get_info().name,
+            });
+        }
+        let limit = ctx.device.limits().max_blas_primitive_count;
+        if triangles > u64::from(limit) {
+            return Err(Error::Scene(format!(
+                "{triangles} triangles: this adapter's acceleration structures hold at most \
+                 {limit} per bottom level"
+            )));
+        }
+        Ok(())
+    }
+
+    /// Builds the structures over `triangles` (the scene's triangle buffer, with
+    /// `BLAS_INPUT`, holding `count` triangles) and waits for the build.
+    pub(crate) fn new(ctx: &GpuContext, triangles: &wgpu::Buffer, count: u32) -> Self {
+        let device = &ctx.device;
+        let size = wgpu::BlasTriangleGeometrySizeDescriptor {
+            vertex_format: wgpu::VertexFormat::Float32x3,
+            vertex_count: 3 * count,
+            index_format: None,
+            index_count: None,
+            flags: wgpu::AccelerationStructureGeometryFlags::OPAQUE,
+        };
+        let flags = wgpu::AccelerationStructureFlags::PREFER_FAST_TRACE;
+        let mut tlas = device.create_tlas(&wgpu::CreateTlasDescriptor {
+            label: Some("fisheye.scene.tlas"),
+            max_instances: 1,
+            flags,
+            update_mode: wgpu::AccelerationStructureUpdateMode::Build,
+        });
+        // An empty scene has no bottom level, and an empty top level.
+        let blas = (count > 0).then(|| {
+            device.create_blas(
+                &wgpu::CreateBlasDescriptor {
+                    label: Some("fisheye.scene.blas"),
+                    flags,
+                    update_mode: wgpu::AccelerationStructureUpdateMode::Build,
+                },
+                wgpu::BlasGeometrySizeDescriptors::Triangles {
+                    descriptors: vec![size.clone()],
+                },
+            )
+        });
+        let identity = [1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0];
+        if let Some(blas) = &blas {
+            tlas[0] = Some(wgpu::TlasInstance::new(blas, identity, 0, 0xff));
+        }
+        let started = Instant::now();
+        let mut encoder = device.create_command_encoder(&Default::default());
+        let entries: Vec<wgpu::BlasBuildEntry<'_>> = blas
+            .iter()
+            .map(|blas| wgpu::BlasBuildEntry {
+                blas,
+                geometry: wgpu::BlasGeometries::TriangleGeometries(vec![
+                    wgpu::BlasTriangleGeometry {
+                        size: &size,
+                        vertex_buffer: triangles,
+                        first_vertex: 0,
+                        // `GpuTriangle` is three vec4s whose xyz are the corners.
+                        vertex_stride: 16,
+                        index_buffer: None,
+                        first_index: None,
+                        transform_buffer: None,
+                        transform_buffer_offset: None,
+                    },
+                ]),
+            })
+            .collect();
+        encoder.build_acceleration_structures(&entries, [&tlas]);
+        ctx.queue.submit([encoder.finish()]);
+        // Errors (a lost device) surface at the caller's next wait.
+        let _ = device.poll(wgpu::PollType::wait_indefinitely());
+        let build_time = started.elapsed();
+        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("fisheye.scene.acceleration"),
+            entries: &[wgpu::BindGroupLayoutEntry {
+                binding: 0,
+                visibility: wgpu::ShaderStages::COMPUTE,
+                ty: wgpu::BindingType::AccelerationStructure {
+                    vertex_return: false,
+                },
+                count: None,
+            }],
+        });
+        let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("fisheye.scene.acceleration"),
+            layout: &layout,
+            entries: &[wgpu::BindGroupEntry {
+                binding: 0,
+                resource: tlas.as_binding(),
+            }],
+        });
+        Self {
+            layout,
+            bind_group,
+            build_time,
+            _structures: (blas, tlas),
+        }
+    }
+}
