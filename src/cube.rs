@@ -11,7 +11,9 @@ use glam::{DMat3, DVec3, Vec2, Vec3};
 use wgpu::util::DeviceExt;
 
 use crate::error::{Error, Result};
-use crate::gpu::{GpuContext, bind_buffers, dispatch_over_image, storage_entry, uniform_entry};
+use crate::gpu::{
+    GpuContext, bind_buffers, bind_group, dispatch_over_image, storage_entry, uniform_entry,
+};
 use crate::lens::gpu::{DirectionSource, lens_constants, params_buffer};
 use crate::lens::{ImageSize, Lens, LensCamera, LensModel};
 use crate::raster::{RasterFaces, RasterMethod};
@@ -311,20 +313,15 @@ impl TracedFaces {
                         array_layer_count: Some(1),
                         ..Default::default()
                     });
-                    device.create_bind_group(&wgpu::BindGroupDescriptor {
-                        label: Some("fisheye.cube_store"),
-                        layout: &layout,
-                        entries: &[
-                            wgpu::BindGroupEntry {
-                                binding: 0,
-                                resource: pass.colour_buffer().as_entire_binding(),
-                            },
-                            wgpu::BindGroupEntry {
-                                binding: 1,
-                                resource: wgpu::BindingResource::TextureView(&layer),
-                            },
+                    bind_group(
+                        device,
+                        "fisheye.cube_store",
+                        &layout,
+                        [
+                            pass.colour_buffer().as_entire_binding(),
+                            wgpu::BindingResource::TextureView(&layer),
                         ],
-                    })
+                    )
                 })
                 .collect();
             Self {
@@ -500,28 +497,17 @@ impl CubeMap {
                 dimension: Some(wgpu::TextureViewDimension::D2Array),
                 ..Default::default()
             });
-            let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-                label: Some("fisheye.cube_sample"),
-                layout: &layout,
-                entries: &[
-                    wgpu::BindGroupEntry {
-                        binding: 0,
-                        resource: lens.as_entire_binding(),
-                    },
-                    wgpu::BindGroupEntry {
-                        binding: 1,
-                        resource: no_table.as_entire_binding(),
-                    },
-                    wgpu::BindGroupEntry {
-                        binding: 2,
-                        resource: wgpu::BindingResource::TextureView(&faces_view),
-                    },
-                    wgpu::BindGroupEntry {
-                        binding: 3,
-                        resource: colour.as_entire_binding(),
-                    },
+            let bind_group = bind_group(
+                device,
+                "fisheye.cube_sample",
+                &layout,
+                [
+                    lens.as_entire_binding(),
+                    no_table.as_entire_binding(),
+                    wgpu::BindingResource::TextureView(&faces_view),
+                    colour.as_entire_binding(),
                 ],
-            });
+            );
             Self {
                 regions,
                 faces,

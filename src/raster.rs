@@ -27,7 +27,7 @@ use wgpu::util::DeviceExt;
 
 use crate::cube::{FACES, Region, bordered, bordered_focal};
 use crate::error::{Error, Result};
-use crate::gpu::GpuContext;
+use crate::gpu::{GpuContext, bind_group};
 use crate::scene::Camera;
 use crate::shader;
 use crate::trace::{GpuScene, LIGHT_KINDS, surface_constants};
@@ -259,37 +259,27 @@ impl ShadowMaps {
                 dimension: Some(wgpu::TextureViewDimension::D2Array),
                 ..Default::default()
             });
-            let lookup = device.create_bind_group(&wgpu::BindGroupDescriptor {
-                label: Some("fisheye.raster.shadow_lookup"),
-                layout: &lookup_layout,
-                entries: &[
-                    wgpu::BindGroupEntry {
-                        binding: 0,
-                        resource: buffer.as_entire_binding(),
-                    },
-                    wgpu::BindGroupEntry {
-                        binding: 1,
-                        resource: wgpu::BindingResource::TextureView(&array),
-                    },
-                    wgpu::BindGroupEntry {
-                        binding: 2,
-                        resource: wgpu::BindingResource::Sampler(&sampler),
-                    },
+            let lookup = bind_group(
+                device,
+                "fisheye.raster.shadow_lookup",
+                &lookup_layout,
+                [
+                    buffer.as_entire_binding(),
+                    wgpu::BindingResource::TextureView(&array),
+                    wgpu::BindingResource::Sampler(&sampler),
                 ],
-            });
+            );
             // The depth pass sees the views only (the map is its attachment).
             let render_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
                 label: Some("fisheye.raster.shadow_render"),
                 entries: &[views_entry],
             });
-            let render_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-                label: Some("fisheye.raster.shadow_render"),
-                layout: &render_layout,
-                entries: &[wgpu::BindGroupEntry {
-                    binding: 0,
-                    resource: buffer.as_entire_binding(),
-                }],
-            });
+            let render_group = bind_group(
+                device,
+                "fisheye.raster.shadow_render",
+                &render_layout,
+                [buffer.as_entire_binding()],
+            );
             let empty = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
                 label: Some("fisheye.raster.empty"),
                 entries: &[],
@@ -302,11 +292,7 @@ impl ShadowMaps {
                 ("shadow_vs", None),
                 None,
             );
-            let no_bindings = device.create_bind_group(&wgpu::BindGroupDescriptor {
-                label: Some("fisheye.raster.empty"),
-                layout: &empty,
-                entries: &[],
-            });
+            let no_bindings = bind_group(device, "fisheye.raster.empty", &empty, []);
             let mut encoder = device.create_command_encoder(&Default::default());
             for layer in 0..scene.shadow_layers {
                 let target = texture.create_view(&wgpu::TextureViewDescriptor {
@@ -543,15 +529,12 @@ impl RasterFaces {
                 label: Some("fisheye.raster.draw"),
                 entries: &[views_entry],
             });
-            let views_binding = wgpu::BindGroupEntry {
-                binding: 0,
-                resource: views.as_entire_binding(),
-            };
-            let draw_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-                label: Some("fisheye.raster.draw"),
-                layout: &draw_layout,
-                entries: std::slice::from_ref(&views_binding),
-            });
+            let draw_group = bind_group(
+                device,
+                "fisheye.raster.draw",
+                &draw_layout,
+                [views.as_entire_binding()],
+            );
             let constants = surface_constants(scene.features);
             // Deferred lighting: reads the G-buffer, writes the cube.
             let lighting = gbuffer.as_ref().map(|gbuffer| {
@@ -581,21 +564,16 @@ impl RasterFaces {
                     ],
                 });
                 let (read, write) = (layer_view(gbuffer, None), layer_view(cube, None));
-                let group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-                    label: Some("fisheye.raster.lighting"),
-                    layout: &layout,
-                    entries: &[
-                        views_binding.clone(),
-                        wgpu::BindGroupEntry {
-                            binding: 1,
-                            resource: wgpu::BindingResource::TextureView(&read),
-                        },
-                        wgpu::BindGroupEntry {
-                            binding: 2,
-                            resource: wgpu::BindingResource::TextureView(&write),
-                        },
+                let group = bind_group(
+                    device,
+                    "fisheye.raster.lighting",
+                    &layout,
+                    [
+                        views.as_entire_binding(),
+                        wgpu::BindingResource::TextureView(&read),
+                        wgpu::BindingResource::TextureView(&write),
                     ],
-                });
+                );
                 let pipeline = shader::compute_pipeline(
                     device,
                     "raster",

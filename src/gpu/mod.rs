@@ -31,12 +31,23 @@ pub fn bind_buffers(
     layout: &wgpu::BindGroupLayout,
     buffers: &[&wgpu::Buffer],
 ) -> wgpu::BindGroup {
-    let entries: Vec<_> = buffers
-        .iter()
+    let resources: Vec<_> = buffers.iter().map(|b| b.as_entire_binding()).collect();
+    bind_group(device, label, layout, resources)
+}
+
+/// A bind group of any resources, bound at 0, 1, 2, ... in the order given.
+pub fn bind_group<'a>(
+    device: &wgpu::Device,
+    label: &str,
+    layout: &wgpu::BindGroupLayout,
+    resources: impl IntoIterator<Item = wgpu::BindingResource<'a>>,
+) -> wgpu::BindGroup {
+    let entries: Vec<_> = resources
+        .into_iter()
         .enumerate()
-        .map(|(b, buffer)| wgpu::BindGroupEntry {
+        .map(|(b, resource)| wgpu::BindGroupEntry {
             binding: b as u32,
-            resource: buffer.as_entire_binding(),
+            resource,
         })
         .collect();
     device.create_bind_group(&wgpu::BindGroupDescriptor {

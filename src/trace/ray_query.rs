@@ -7,7 +7,7 @@
 use std::time::{Duration, Instant};
 
 use crate::error::{Error, Result};
-use crate::gpu::GpuContext;
+use crate::gpu::{GpuContext, bind_group};
 
 /// A scene's acceleration structure and the bind group (`@group(2)` of `wgsl/bvh_rq.wgsl`)
 /// that exposes it.
@@ -111,14 +111,12 @@ impl RayQueryScene {
                 count: None,
             }],
         });
-        let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("fisheye.scene.acceleration"),
-            layout: &layout,
-            entries: &[wgpu::BindGroupEntry {
-                binding: 0,
-                resource: tlas.as_binding(),
-            }],
-        });
+        let bind_group = bind_group(
+            device,
+            "fisheye.scene.acceleration",
+            &layout,
+            [tlas.as_binding()],
+        );
         Self {
             layout,
             bind_group,
