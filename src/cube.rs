@@ -12,7 +12,8 @@ use wgpu::util::DeviceExt;
 
 use crate::error::{Error, Result};
 use crate::gpu::{
-    GpuContext, bind_buffers, bind_group, dispatch_over_image, storage_entry, uniform_entry,
+    GpuContext, bind_buffers, bind_group, dispatch_over_image, storage_entry, texture_array,
+    uniform_entry,
 };
 use crate::lens::gpu::{DirectionSource, lens_constants, params_buffer};
 use crate::lens::{ImageSize, Lens, LensCamera, LensModel};
@@ -419,23 +420,17 @@ impl CubeMap {
         }
         // A texture array, not a storage buffer: no binding-size limit on the faces.
         let cube = ctx.checked("creating the cube faces", || {
-            ctx.device.create_texture(&wgpu::TextureDescriptor {
-                label: Some("fisheye.cube.faces"),
-                size: wgpu::Extent3d {
-                    width: side,
-                    height: side,
-                    depth_or_array_layers: 6,
-                },
-                mip_level_count: 1,
-                sample_count: 1,
-                dimension: wgpu::TextureDimension::D2,
-                format: wgpu::TextureFormat::Rgba32Float,
-                usage: wgpu::TextureUsages::TEXTURE_BINDING
+            texture_array(
+                &ctx.device,
+                "fisheye.cube.faces",
+                side,
+                6,
+                wgpu::TextureFormat::Rgba32Float,
+                wgpu::TextureUsages::TEXTURE_BINDING
                     | wgpu::TextureUsages::STORAGE_BINDING
                     | wgpu::TextureUsages::RENDER_ATTACHMENT
                     | wgpu::TextureUsages::COPY_SRC,
-                view_formats: &[],
-            })
+            )
         })?;
         let faces = match settings.method {
             CubeMethod::Traced => Faces::Traced(TracedFaces::new(ctx, scene, size, &cube)?),

@@ -27,7 +27,7 @@ use wgpu::util::DeviceExt;
 
 use crate::cube::{FACES, Region, bordered, bordered_focal};
 use crate::error::{Error, Result};
-use crate::gpu::{GpuContext, bind_group};
+use crate::gpu::{GpuContext, bind_group, texture_array};
 use crate::scene::Camera;
 use crate::shader;
 use crate::trace::{GpuScene, LIGHT_KINDS, surface_constants};
@@ -189,21 +189,14 @@ impl ShadowMaps {
         ctx.checked("rendering the shadow maps", || {
             let device = &ctx.device;
             let layers = scene.shadow_layers.max(1);
-            let texture = device.create_texture(&wgpu::TextureDescriptor {
-                label: Some("fisheye.raster.shadow_map"),
-                size: wgpu::Extent3d {
-                    width: size,
-                    height: size,
-                    depth_or_array_layers: layers,
-                },
-                mip_level_count: 1,
-                sample_count: 1,
-                dimension: wgpu::TextureDimension::D2,
-                format: wgpu::TextureFormat::Depth32Float,
-                usage: wgpu::TextureUsages::RENDER_ATTACHMENT
-                    | wgpu::TextureUsages::TEXTURE_BINDING,
-                view_formats: &[],
-            });
+            let texture = texture_array(
+                device,
+                "fisheye.raster.shadow_map",
+                size,
+                layers,
+                wgpu::TextureFormat::Depth32Float,
+                wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING,
+            );
             let placeholder = [ShadowView::zeroed()];
             let data = if views.is_empty() {
                 &placeholder[..]
@@ -400,8 +393,8 @@ fn raster_pipeline(
 }
 
 /// The rasterizer's half of the cube-map path: draws the faces that the lens reaches (only
-/// their reachable regions, by scissor) and writes them, bordered, into the cube's texel
-/// buffer that `wgsl/cube_sample.wgsl` resamples.
+/// their reachable regions, by scissor) into the cube's texture array of bordered faces, which
+/// `wgsl/cube_sample.wgsl` resamples.
 pub struct RasterFaces {
     method: RasterMethod,
     regions: [Option<Region>; 6],
@@ -465,21 +458,14 @@ impl RasterFaces {
         ctx.checked("creating the rasterized cube faces", || {
             let device = &ctx.device;
             let texture = |label: &str, format: wgpu::TextureFormat| {
-                device.create_texture(&wgpu::TextureDescriptor {
-                    label: Some(label),
-                    size: wgpu::Extent3d {
-                        width: side,
-                        height: side,
-                        depth_or_array_layers: 6,
-                    },
-                    mip_level_count: 1,
-                    sample_count: 1,
-                    dimension: wgpu::TextureDimension::D2,
+                texture_array(
+                    device,
+                    label,
+                    side,
+                    6,
                     format,
-                    usage: wgpu::TextureUsages::RENDER_ATTACHMENT
-                        | wgpu::TextureUsages::TEXTURE_BINDING,
-                    view_formats: &[],
-                })
+                    wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING,
+                )
             };
             let depth = texture("fisheye.raster.depth", wgpu::TextureFormat::Depth32Float);
             // Forward passes draw into the cube itself; the deferred G-buffer is its own.
