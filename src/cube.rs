@@ -12,8 +12,8 @@ use wgpu::util::DeviceExt;
 
 use crate::error::{Error, Result};
 use crate::gpu::{
-    GpuContext, bind_buffers, bind_group, dispatch_over_image, storage_entry, texture_array,
-    uniform_entry,
+    GpuContext, bind_buffers, bind_group, dispatch_over_image, layer_view, storage_entry,
+    texture_array, uniform_entry,
 };
 use crate::lens::gpu::{DirectionSource, lens_constants, params_buffer};
 use crate::lens::{ImageSize, Lens, LensCamera, LensModel};
@@ -308,12 +308,7 @@ impl TracedFaces {
             let layout = store.get_bind_group_layout(0);
             let store_groups = (0..6)
                 .map(|face| {
-                    let layer = cube.create_view(&wgpu::TextureViewDescriptor {
-                        dimension: Some(wgpu::TextureViewDimension::D2),
-                        base_array_layer: face,
-                        array_layer_count: Some(1),
-                        ..Default::default()
-                    });
+                    let layer = layer_view(cube, Some(face));
                     bind_group(
                         device,
                         "fisheye.cube_store",
@@ -488,10 +483,7 @@ impl CubeMap {
             );
             let no_table = buffer("fisheye.cube.no_table", 16, U::STORAGE);
             let lens = params_buffer(device, camera);
-            let faces_view = cube.create_view(&wgpu::TextureViewDescriptor {
-                dimension: Some(wgpu::TextureViewDimension::D2Array),
-                ..Default::default()
-            });
+            let faces_view = layer_view(&cube, None);
             let bind_group = bind_group(
                 device,
                 "fisheye.cube_sample",

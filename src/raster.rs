@@ -27,7 +27,7 @@ use wgpu::util::DeviceExt;
 
 use crate::cube::{FACES, Region, bordered, bordered_focal};
 use crate::error::{Error, Result};
-use crate::gpu::{GpuContext, bind_group, texture_array};
+use crate::gpu::{GpuContext, bind_group, layer_view, texture_array};
 use crate::scene::Camera;
 use crate::shader;
 use crate::trace::{GpuScene, LIGHT_KINDS, surface_constants};
@@ -248,10 +248,7 @@ impl ShadowMaps {
                 compare: Some(wgpu::CompareFunction::GreaterEqual),
                 ..Default::default()
             });
-            let array = texture.create_view(&wgpu::TextureViewDescriptor {
-                dimension: Some(wgpu::TextureViewDimension::D2Array),
-                ..Default::default()
-            });
+            let array = layer_view(&texture, None);
             let lookup = bind_group(
                 device,
                 "fisheye.raster.shadow_lookup",
@@ -288,12 +285,7 @@ impl ShadowMaps {
             let no_bindings = bind_group(device, "fisheye.raster.empty", &empty, []);
             let mut encoder = device.create_command_encoder(&Default::default());
             for layer in 0..scene.shadow_layers {
-                let target = texture.create_view(&wgpu::TextureViewDescriptor {
-                    dimension: Some(wgpu::TextureViewDimension::D2),
-                    base_array_layer: layer,
-                    array_layer_count: Some(1),
-                    ..Default::default()
-                });
+                let target = layer_view(&texture, Some(layer));
                 let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
                     label: Some("fisheye.raster.shadow"),
                     color_attachments: &[],
@@ -472,17 +464,6 @@ impl RasterFaces {
             let gbuffer = (method == RasterMethod::Deferred)
                 .then(|| texture("fisheye.raster.gbuffer", wgpu::TextureFormat::Rgba32Uint));
             let colour = gbuffer.as_ref().unwrap_or(cube);
-            let layer_view = |t: &wgpu::Texture, layer: Option<u32>| {
-                t.create_view(&wgpu::TextureViewDescriptor {
-                    dimension: Some(match layer {
-                        Some(_) => wgpu::TextureViewDimension::D2,
-                        None => wgpu::TextureViewDimension::D2Array,
-                    }),
-                    base_array_layer: layer.unwrap_or(0),
-                    array_layer_count: Some(if layer.is_some() { 1 } else { 6 }),
-                    ..Default::default()
-                })
-            };
             let targets = match method {
                 RasterMethod::SinglePass => {
                     vec![(layer_view(colour, None), layer_view(&depth, None))]

@@ -82,6 +82,20 @@ pub fn texture_array(
     })
 }
 
+/// A view of one layer of a texture array as a 2D texture, or with `None` of all its layers
+/// as an array.
+pub fn layer_view(texture: &wgpu::Texture, layer: Option<u32>) -> wgpu::TextureView {
+    texture.create_view(&wgpu::TextureViewDescriptor {
+        dimension: Some(match layer {
+            Some(_) => wgpu::TextureViewDimension::D2,
+            None => wgpu::TextureViewDimension::D2Array,
+        }),
+        base_array_layer: layer.unwrap_or(0),
+        array_layer_count: layer.map(|_| 1),
+        ..Default::default()
+    })
+}
+
 fn buffer_entry(binding: u32, ty: wgpu::BufferBindingType) -> wgpu::BindGroupLayoutEntry {
     wgpu::BindGroupLayoutEntry {
         binding,
