@@ -12,7 +12,7 @@ use wgpu::util::DeviceExt;
 
 use crate::error::{Error, Result};
 use crate::gpu::{
-    GpuContext, bind_buffers, bind_group, dispatch_over_image, layer_view, storage_entry,
+    GpuContext, Span, bind_buffers, bind_group, dispatch_over_image, layer_view, storage_entry,
     texture_array, uniform_entry,
 };
 use crate::lens::gpu::{DirectionSource, lens_constants, params_buffer};
@@ -301,7 +301,8 @@ struct TracedFaces {
 
 impl TracedFaces {
     fn new(ctx: &GpuContext, scene: &GpuScene, size: u32, cube: &wgpu::Texture) -> Result<Self> {
-        let pass = TracePass::new(ctx, &face_camera(size)?, scene, DirectionSource::Computed)?;
+        let camera = face_camera(size)?;
+        let pass = TracePass::with_views(ctx, &camera, scene, DirectionSource::Computed, 6)?;
         ctx.checked("creating the traced cube faces", || {
             let device = &ctx.device;
             let store = shader::compute_pipeline(device, "cube_store", "main", &[], &[]);
@@ -329,43 +330,56 @@ impl TracedFaces {
         })
     }
 
-    /// Renders the faces' regions from `pose`, one submission each since each moves the
-    /// face camera.
-    fn render(
+    /// Points each face's view at `pose` and records, face after face, the trace of its
+    /// region and the copy into its layer (one span over all of them).
+    fn encode(
         &self,
         ctx: &GpuContext,
+        encoder: &mut wgpu::CommandEncoder,
         scene: &GpuScene,
         pose: &Camera,
         regions: &[Option<Region>; 6],
-    ) -> Result<()> {
+        span: Option<Span<'_>>,
+    ) {
         let rotation = pose.rotation();
-        for (i, face) in FACES.iter().enumerate() {
-            let Some(r) = regions[i] else { continue };
-            self.pass.set_view(
-                ctx,
-                scene,
-                pose.position,
-                rotation * face.rotation(),
-                [r.x0, r.y0],
+        let reached: Vec<(usize, Region)> = regions
+            .iter()
+            .enumerate()
+            .filter_map(|(i, r)| r.map(|r| (i, r)))
+            .collect();
+        let side = ImageSize::new(self.side, self.side).expect("a face");
+        for (k, &(i, r)) in reached.iter().enumerate() {
+            let view = i as u32;
+            let face = rotation * FACES[i].rotation();
+            self.pass
+                .set_view(ctx, scene, view, pose.position, face, [r.x0, r.y0]);
+            let extent = ImageSize::new(r.x1 - r.x0, r.y1 - r.y0).expect("a non-empty region");
+            let (first, last) = (k == 0, k + 1 == reached.len());
+            let writes = span.and_then(|s| s.compute(first, false));
+            self.pass
+                .encode_region(encoder, scene, view, extent, writes);
+            dispatch_over_image(
+                encoder,
+                "fisheye.cube_store",
+                &self.store,
+                &[&self.store_groups[i]],
+                side,
+                span.and_then(|s| s.compute(false, last)),
             );
-            ctx.checked("rendering a cube face", || {
-                let mut encoder = ctx.device.create_command_encoder(&Default::default());
-                let extent = ImageSize::new(r.x1 - r.x0, r.y1 - r.y0).expect("a non-empty region");
-                self.pass.encode_region(&mut encoder, scene, extent, None);
-                let side = ImageSize::new(self.side, self.side).expect("a face");
-                dispatch_over_image(
-                    &mut encoder,
-                    "fisheye.cube_store",
-                    &self.store,
-                    &[&self.store_groups[i]],
-                    side,
-                    None,
-                );
-                ctx.queue.submit([encoder.finish()]);
-            })?;
         }
-        Ok(())
     }
+}
+
+/// Timestamp spans of a cube-map frame (see [`CubeMap::encode`]); any may be `None`.
+#[derive(Clone, Copy, Default)]
+pub struct CubeSpans<'a> {
+    /// Rendering the faces: tracing them, or their raster passes (for deferred faces, the
+    /// G-buffer passes).
+    pub faces: Option<Span<'a>>,
+    /// The deferred faces' lighting pass (written only by [`RasterMethod::Deferred`]).
+    pub lighting: Option<Span<'a>>,
+    /// Resampling the cube into the lens image.
+    pub sampler: Option<Span<'a>>,
 }
 
 /// The cube-map path: renders each face the lens can reach (by the tracer or the rasterizer,
@@ -521,39 +535,60 @@ impl CubeMap {
         }
     }
 
-    /// Renders the reachable faces (or parts) from `pose`, then resamples them into the lens
-    /// image. Returns the lens image's colours (as
+    /// Whether a frame has a deferred lighting pass (timed by [`CubeSpans::lighting`]).
+    pub fn has_lighting_pass(&self) -> bool {
+        matches!(&self.faces, Faces::Raster(r) if r.method() == RasterMethod::Deferred)
+    }
+
+    /// Points the cube at `pose` and records a frame into `encoder`: the reachable faces (or
+    /// parts), then the resampling into the lens image. Submit `encoder` before the next call.
+    pub fn encode(
+        &self,
+        ctx: &GpuContext,
+        encoder: &mut wgpu::CommandEncoder,
+        scene: &GpuScene,
+        pose: &Camera,
+        spans: CubeSpans<'_>,
+    ) {
+        match &self.faces {
+            Faces::Traced(faces) => {
+                faces.encode(ctx, encoder, scene, pose, &self.regions, spans.faces)
+            }
+            Faces::Raster(faces) => {
+                faces.set_pose(ctx, scene, pose);
+                faces.encode(encoder, scene, spans.faces, spans.lighting);
+            }
+        }
+        dispatch_over_image(
+            encoder,
+            "fisheye.cube_sample",
+            &self.sampler,
+            &[&self.bind_group],
+            self.camera.size,
+            spans.sampler.and_then(|s| s.compute(true, true)),
+        );
+    }
+
+    /// The lens image's colours of the last submitted frame (as
     /// [`RenderOutput::colour`](crate::trace::RenderOutput::colour)).
+    pub fn read(&self, ctx: &GpuContext) -> Result<Vec<[f32; 4]>> {
+        ctx.read_buffer(&self.colour)
+    }
+
+    /// Renders one frame from `pose` in one submission and reads the lens image back (as
+    /// [`CubeMap::read`]).
     pub fn render(
         &self,
         ctx: &GpuContext,
         scene: &GpuScene,
         pose: &Camera,
     ) -> Result<Vec<[f32; 4]>> {
-        match &self.faces {
-            Faces::Traced(faces) => faces.render(ctx, scene, pose, &self.regions)?,
-            Faces::Raster(faces) => {
-                faces.set_pose(ctx, scene, pose);
-                ctx.checked("rasterizing the cube faces", || {
-                    let mut encoder = ctx.device.create_command_encoder(&Default::default());
-                    faces.encode(&mut encoder, scene);
-                    ctx.queue.submit([encoder.finish()]);
-                })?;
-            }
-        }
-        ctx.checked("resampling the cube", || {
+        ctx.checked("rendering the cube map", || {
             let mut encoder = ctx.device.create_command_encoder(&Default::default());
-            dispatch_over_image(
-                &mut encoder,
-                "fisheye.cube_sample",
-                &self.sampler,
-                &[&self.bind_group],
-                self.camera.size,
-                None,
-            );
+            self.encode(ctx, &mut encoder, scene, pose, CubeSpans::default());
             ctx.queue.submit([encoder.finish()]);
         })?;
-        ctx.read_buffer(&self.colour)
+        self.read(ctx)
     }
 
     /// The faces of the last render: `6 × (size + 2)²` texels, row-major per face (texels

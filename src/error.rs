@@ -123,6 +123,14 @@ pub enum Error {
         /// The OS's reason.
         source: std::io::Error,
     },
+    /// A plot could not be drawn.
+    #[error("{path}: {message}")]
+    Plot {
+        /// The plot's file.
+        path: std::path::PathBuf,
+        /// What went wrong.
+        message: String,
+    },
     /// An image could not be encoded or written.
     #[error("{path}: {source}")]
     Image {

@@ -34,14 +34,18 @@
 //! # Ok(()) }
 //! ```
 
+pub mod bench;
 pub mod bvh;
+pub mod compare;
 pub mod cube;
 pub mod demo;
 mod error;
 pub mod gpu;
 pub mod lens;
+pub mod plot;
 pub mod precision;
 pub mod raster;
+pub mod report;
 pub mod scene;
 pub mod shader;
 pub mod trace;

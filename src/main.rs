@@ -6,6 +6,7 @@ use std::time::Instant;
 
 use anyhow::{Context, Result, bail};
 use clap::{Parser, Subcommand, ValueEnum};
+use fisheye_rt::bench::{self, PathKind, SceneSet, Setup};
 use fisheye_rt::bvh::BvhQuality;
 use fisheye_rt::cube::{CubeMap, CubeMethod, CubeSettings, FACES};
 use fisheye_rt::demo::{LensDemo, save_png};
@@ -15,6 +16,7 @@ use fisheye_rt::lens::{
     DirectionFormula, ImageSize, LensCamera, LensModel, PRESET_FOV_DEGREES, PRESETS, parse_spec,
 };
 use fisheye_rt::raster::RasterMethod;
+use fisheye_rt::report::{self, LensRun, Progress, Study};
 use fisheye_rt::scene::{Scene, builtin};
 use fisheye_rt::trace::{
     Channel, GpuScene, RenderOptions, TracePass, Traversal, colour_image, world_directions,
@@ -37,6 +39,14 @@ enum Command {
     /// Render a scene through a lens by ray tracing; with no arguments, the built-in default
     /// scene through a 180° fisheye to fisheye.png.
     Render(RenderArgs),
+    /// Time every method (direct RT, ray queries, cube maps at several face sizes) along a
+    /// camera path, fisheye and pinhole: fps statistics and per-pass GPU times, as JSON, a
+    /// Markdown table and a PNG of fps along the path, in the --out folder.
+    Bench(BenchArgs),
+    /// Measure every method's error against direct ray tracing and a supersampled reference,
+    /// with its time per frame: JSON, a Markdown table, error maps and a time-against-error
+    /// PNG with the Pareto front, in the --out folder.
+    Compare(CompareArgs),
     /// List the built-in scenes.
     Scenes,
     /// Show the GPU adapter, its optional features and limits, and measure the precision of
@@ -101,6 +111,84 @@ struct RenderArgs {
     format: ArrayFormat,
 }
 
+/// The scene, lenses, setups and outputs `bench` and `compare` share with `render`.
+#[derive(clap::Args)]
+struct StudyArgs {
+    /// The scene, as for `render`.
+    #[arg(default_value = "builtin:default")]
+    scene: String,
+    /// Lens specs to measure (repeatable).
+    #[arg(long, default_value = "canon-8-15mm@8mm")]
+    lens: Vec<String>,
+    /// The pinhole baseline measured beside the lenses, at the same image size.
+    #[arg(long, default_value = "rectilinear:f=1")]
+    pinhole: String,
+    /// Leave the pinhole baseline out.
+    #[arg(long)]
+    no_pinhole: bool,
+    /// Image size in pixels, WIDTHxHEIGHT.
+    #[arg(long, default_value = "1024x768")]
+    size: ImageSize,
+    /// Camera pose instead of the scene's (as for `render`); the orbit path circles its
+    /// look-at point.
+    #[arg(long)]
+    camera: Option<String>,
+    /// Methods to measure (comma-separated); by default every one the adapter has.
+    #[arg(long, value_enum, value_delimiter = ',')]
+    method: Vec<Method>,
+    /// Cube face sizes to measure the cube-map methods at (comma-separated).
+    #[arg(long, value_delimiter = ',', default_value = "512,1024,1920")]
+    cube_size: Vec<u32>,
+    /// Shadow-map size of rasterized faces.
+    #[arg(long, default_value_t = 2048)]
+    shadow_size: u32,
+    /// Deepest reflection/refraction bounce.
+    #[arg(long, default_value_t = 5)]
+    max_depth: u32,
+    /// BVH build preset.
+    #[arg(long, value_enum, default_value = "fast")]
+    bvh: Quality,
+    /// Folder for the results; by default a new folder `fisheye-COMMAND-N` here.
+    #[arg(long, short)]
+    out: Option<PathBuf>,
+}
+
+#[derive(clap::Args)]
+struct BenchArgs {
+    #[command(flatten)]
+    study: StudyArgs,
+    /// Timed frames per setup along the path.
+    #[arg(long, default_value_t = 60)]
+    frames: usize,
+    /// Untimed frames first, per setup.
+    #[arg(long, default_value_t = 3)]
+    warmup: usize,
+    /// Camera path: `walk` (the scene's keyframes; every built-in scene but `grid` has them)
+    /// or `orbit` (a circle around the camera's look-at point, for open scenes). Default:
+    /// walk where the scene has keyframes.
+    #[arg(long, value_enum)]
+    path: Option<PathArg>,
+}
+
+#[derive(clap::Args)]
+struct CompareArgs {
+    #[command(flatten)]
+    study: StudyArgs,
+    /// Timed frames per setup at the pose (the median is reported), after one untimed.
+    #[arg(long, default_value_t = 5)]
+    frames: usize,
+    /// Rays per pixel side of the supersampled reference (1 to 8); by default the most, up to
+    /// 4, whose image fits one storage binding.
+    #[arg(long)]
+    supersample: Option<u32>,
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+enum PathArg {
+    Walk,
+    Orbit,
+}
+
 #[derive(Clone, Copy, PartialEq, Eq, ValueEnum)]
 enum Method {
     Rt,
@@ -112,15 +200,24 @@ enum Method {
 }
 
 impl Method {
-    /// The cube-map method, `None` for direct ray tracing.
-    fn cube(self) -> Option<CubeMethod> {
-        let raster = |m| Some(CubeMethod::Raster(m));
+    /// The library's method.
+    fn method(self) -> bench::Method {
+        let raster = |m| bench::Method::Cube(CubeMethod::Raster(m));
         match self {
-            Self::Rt | Self::Rq => None,
-            Self::CubeRt => Some(CubeMethod::Traced),
+            Self::Rt => bench::Method::Rt,
+            Self::Rq => bench::Method::Rq,
+            Self::CubeRt => bench::Method::Cube(CubeMethod::Traced),
             Self::CubeForward => raster(RasterMethod::Forward),
             Self::CubeDeferred => raster(RasterMethod::Deferred),
             Self::CubeSingle => raster(RasterMethod::SinglePass),
+        }
+    }
+
+    /// The cube-map method, `None` for direct ray tracing.
+    fn cube(self) -> Option<CubeMethod> {
+        match self.method() {
+            bench::Method::Cube(m) => Some(m),
+            _ => None,
         }
     }
 }
@@ -298,6 +395,8 @@ impl From<Directions> for DirectionSource {
 fn run(cli: Cli) -> Result<()> {
     match cli.command {
         Command::Render(args) => render(&args),
+        Command::Bench(args) => run_bench(&args),
+        Command::Compare(args) => run_compare(&args),
         Command::Scenes => {
             for (name, what) in builtin::SCENES {
                 println!("builtin:{name:<14} {what}");
@@ -617,17 +716,7 @@ fn demo(lenses: Vec<String>, size: ImageSize, out: PathBuf) -> Result<()> {
             None => "no timestamps".into(),
         };
         let image = demo.render(&ctx)?;
-        let name: String = spec
-            .chars()
-            .map(|c| {
-                if c.is_ascii_alphanumeric() || "-.@".contains(c) {
-                    c
-                } else {
-                    '_'
-                }
-            })
-            .collect();
-        let path = out.join(format!("{name}.png"));
+        let path = out.join(format!("{}.png", report::file_stem(spec)));
         save_png(&image, &path)?;
         println!(
             "{:<36} -> {} ({gpu_ms}, {:.0} ms in all)",
@@ -636,5 +725,170 @@ fn demo(lenses: Vec<String>, size: ImageSize, out: PathBuf) -> Result<()> {
             started.elapsed().as_secs_f64() * 1e3
         );
     }
+    Ok(())
+}
+
+/// What `bench` and `compare` set up from their shared arguments.
+struct Prepared {
+    ctx: GpuContext,
+    scene: Scene,
+    scenes: SceneSet,
+    lenses: Vec<LensRun>,
+    setups: Vec<Setup>,
+    out: PathBuf,
+}
+
+/// Checks the arguments, loads the scene, makes the output folder and uploads the scene.
+fn prepare(args: &StudyArgs, command: &str) -> Result<Prepared> {
+    let mut specs = args.lens.clone();
+    if !args.no_pinhole {
+        specs.push(args.pinhole.clone());
+    }
+    let lenses = specs
+        .iter()
+        .map(|spec| {
+            Ok(LensRun {
+                name: spec.clone(),
+                camera: LensCamera::new(parse_spec(spec)?, args.size),
+            })
+        })
+        .collect::<Result<Vec<_>>>()?;
+    if let Some(&bad) = args.cube_size.iter().find(|&&s| s == 0) {
+        bail!("--cube-size {bad}: face sizes must be at least 1");
+    }
+    let methods: Vec<bench::Method> = if args.method.is_empty() {
+        bench::Method::ALL.to_vec()
+    } else {
+        args.method.iter().map(|m| m.method()).collect()
+    };
+    let setups = Setup::all(&methods, &args.cube_size);
+    let mut scene = load_scene(&args.scene)?;
+    if let Some(text) = &args.camera {
+        scene.camera = parse_camera(text, &scene)?;
+    }
+    let out = match &args.out {
+        Some(out) => out.clone(),
+        None => (1..)
+            .map(|n| PathBuf::from(format!("fisheye-{command}-{n}")))
+            .find(|p| !p.exists())
+            .expect("a free folder name"),
+    };
+    std::fs::create_dir_all(&out).with_context(|| format!("creating {}", out.display()))?;
+    let ctx = GpuContext::new()?;
+    println!("adapter: {}", ctx.adapter_name());
+    let options = RenderOptions {
+        max_depth: args.max_depth,
+        bvh: args.bvh.into(),
+        ..RenderOptions::default()
+    };
+    let scenes = SceneSet::new(&ctx, &scene, &options, &setups)?;
+    println!(
+        "scene: {}, {} triangles; {} setups on {} lenses at {}",
+        args.scene,
+        scene.len(),
+        setups.len(),
+        lenses.len(),
+        args.size
+    );
+    Ok(Prepared {
+        ctx,
+        scene,
+        scenes,
+        lenses,
+        setups,
+        out,
+    })
+}
+
+/// A progress bar on stderr when it is a terminal, else a line per new setup.
+fn progress_bar() -> impl FnMut(Progress<'_>) {
+    use std::io::IsTerminal;
+    let terminal = std::io::stderr().is_terminal();
+    let mut last = String::new();
+    move |p: Progress<'_>| {
+        if terminal {
+            let width = 30;
+            let filled = (width * p.done / p.total.max(1)).min(width);
+            eprint!(
+                "\r[{}{}] {:>5}/{} frames  {:<40}",
+                "#".repeat(filled),
+                ".".repeat(width - filled),
+                p.done,
+                p.total,
+                p.what
+            );
+            if p.done == p.total {
+                eprintln!();
+            }
+        } else if p.what != last {
+            eprintln!("[{}/{} frames] {}", p.done, p.total, p.what);
+        }
+        last = p.what.to_string();
+    }
+}
+
+/// Prints the table lines of a report's Markdown and where the files went.
+fn finish(markdown: &str, out: &std::path::Path, plot_warning: Option<String>) {
+    println!();
+    for line in markdown.lines().filter(|l| !l.starts_with('#')) {
+        println!("{line}");
+    }
+    if let Some(why) = plot_warning {
+        eprintln!("warning: no plots: {why}");
+    }
+    println!("\nwrote {}", out.display());
+}
+
+fn run_bench(args: &BenchArgs) -> Result<()> {
+    let p = prepare(&args.study, "bench")?;
+    let path = match args.path {
+        Some(PathArg::Walk) => PathKind::Walk,
+        Some(PathArg::Orbit) => PathKind::Orbit,
+        None if p.scene.camera_path.is_empty() => PathKind::Orbit,
+        None => PathKind::Walk,
+    };
+    let study = Study {
+        ctx: &p.ctx,
+        scene: &p.scene,
+        scene_name: args.study.scene.clone(),
+        scenes: &p.scenes,
+        lenses: &p.lenses,
+        setups: &p.setups,
+        shadow_size: args.study.shadow_size,
+    };
+    let report = report::bench(&study, path, args.frames, args.warmup, &mut progress_bar())?;
+    let warning = report.write(&p.out)?;
+    finish(&report.markdown(), &p.out, warning);
+    Ok(())
+}
+
+fn run_compare(args: &CompareArgs) -> Result<()> {
+    if let Some(s) = args.supersample.filter(|s| !(1..=8).contains(s)) {
+        bail!("--supersample {s}: must be 1 to 8");
+    }
+    let p = prepare(&args.study, "compare")?;
+    let supersample = args
+        .supersample
+        .unwrap_or_else(|| fisheye_rt::compare::supersample_factor(&p.ctx, args.study.size));
+    let study = Study {
+        ctx: &p.ctx,
+        scene: &p.scene,
+        scene_name: args.study.scene.clone(),
+        scenes: &p.scenes,
+        lenses: &p.lenses,
+        setups: &p.setups,
+        shadow_size: args.study.shadow_size,
+    };
+    let pose = p.scene.camera;
+    let report = report::compare(
+        &study,
+        &pose,
+        args.frames,
+        supersample,
+        &p.out,
+        &mut progress_bar(),
+    )?;
+    let warning = report.write(&p.out)?;
+    finish(&report.markdown(), &p.out, warning);
     Ok(())
 }

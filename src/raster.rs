@@ -27,7 +27,7 @@ use wgpu::util::DeviceExt;
 
 use crate::cube::{FACES, Region, bordered, bordered_focal};
 use crate::error::{Error, Result};
-use crate::gpu::{GpuContext, bind_group, layer_view, texture_array};
+use crate::gpu::{GpuContext, Span, bind_group, layer_view, texture_array};
 use crate::scene::Camera;
 use crate::shader;
 use crate::trace::{GpuScene, LIGHT_KINDS, surface_constants};
@@ -588,6 +588,11 @@ impl RasterFaces {
         &self.shadows
     }
 
+    /// How the faces are drawn.
+    pub fn method(&self) -> RasterMethod {
+        self.method
+    }
+
     /// Points the faces at `pose` (the cube's orientation follows the camera's) for the frames
     /// encoded from now on.
     pub fn set_pose(&self, ctx: &GpuContext, scene: &GpuScene, pose: &Camera) {
@@ -615,6 +620,7 @@ impl RasterFaces {
         encoder: &'e mut wgpu::CommandEncoder,
         (colour, depth): &(wgpu::TextureView, wgpu::TextureView),
         scene: &GpuScene,
+        timestamp_writes: Option<wgpu::RenderPassTimestampWrites<'_>>,
     ) -> wgpu::RenderPass<'e> {
         let lit = self.method != RasterMethod::Deferred;
         // The G-buffer clears to 0 (no surface), colour to the sky.
@@ -636,6 +642,7 @@ impl RasterFaces {
             })],
             depth_stencil_attachment: Some(depth_attachment(depth)),
             multiview_mask: self.multiview_mask,
+            timestamp_writes,
             ..Default::default()
         });
         pass.set_pipeline(&self.draw);
@@ -647,8 +654,15 @@ impl RasterFaces {
         pass
     }
 
-    /// Records the faces' render passes (and for deferred faces, the lighting pass).
-    pub fn encode(&self, encoder: &mut wgpu::CommandEncoder, scene: &GpuScene) {
+    /// Records the faces' render passes, timed as one span by `faces`, and for deferred faces
+    /// the lighting pass, timed by `lighting`.
+    pub fn encode(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        scene: &GpuScene,
+        faces: Option<Span<'_>>,
+        lighting: Option<Span<'_>>,
+    ) {
         let reached = || {
             self.regions
                 .iter()
@@ -660,7 +674,19 @@ impl RasterFaces {
             pass.set_scissor_rect(r.x0, r.y0, r.x1 - r.x0, r.y1 - r.y0);
         };
         if self.method == RasterMethod::SinglePass {
-            let mut pass = self.begin(encoder, &self.targets[0], scene);
+            // Timestamps inside a multiview pass take one query per view (Vulkan's
+            // vkCmdWriteTimestamp), which wgpu does not allow for, so empty compute passes
+            // around it take them.
+            let marker = |encoder: &mut wgpu::CommandEncoder, first: bool| {
+                if let Some(writes) = faces.and_then(|s| s.compute(first, !first)) {
+                    encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                        label: Some("fisheye.raster.timestamp"),
+                        timestamp_writes: Some(writes),
+                    });
+                }
+            };
+            marker(encoder, true);
+            let mut pass = self.begin(encoder, &self.targets[0], scene, None);
             let union = reached().map(|(_, r)| r).reduce(|a, b| Region {
                 x0: a.x0.min(b.x0),
                 y0: a.y0.min(b.y0),
@@ -671,9 +697,14 @@ impl RasterFaces {
                 scissor(&mut pass, r);
                 pass.draw(vertices.clone(), 0..1);
             }
+            drop(pass);
+            marker(encoder, false);
         } else {
-            for (face, r) in reached() {
-                let mut pass = self.begin(encoder, &self.targets[face as usize], scene);
+            let count = reached().count();
+            for (k, (face, r)) in reached().enumerate() {
+                let writes = faces.and_then(|s| s.render(k == 0, k + 1 == count));
+                let target = &self.targets[face as usize];
+                let mut pass = self.begin(encoder, target, scene, writes);
                 scissor(&mut pass, r);
                 pass.draw(vertices.clone(), face..face + 1);
             }
@@ -681,7 +712,7 @@ impl RasterFaces {
         if let Some((pipeline, group)) = &self.lighting {
             let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
                 label: Some("fisheye.raster.lighting"),
-                timestamp_writes: None,
+                timestamp_writes: lighting.and_then(|s| s.compute(true, true)),
             });
             pass.set_pipeline(pipeline);
             pass.set_bind_group(0, group, &[]);

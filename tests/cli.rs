@@ -517,3 +517,72 @@ fn render_with_ray_queries() {
     );
     std::fs::remove_dir_all(dir).unwrap();
 }
+
+#[test]
+fn bench_and_compare_write_their_reports_into_a_new_folder() {
+    let dir = std::env::temp_dir().join("fisheye-cli-study");
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    let run = |args: &[&str]| {
+        let output = Command::new(env!("CARGO_BIN_EXE_fisheye"))
+            .args(args)
+            .current_dir(&dir)
+            .output()
+            .unwrap();
+        let text = String::from_utf8_lossy(&output.stdout).into_owned();
+        let errors = String::from_utf8_lossy(&output.stderr).into_owned();
+        (output.status.success(), text, errors)
+    };
+    let common = [
+        "--size",
+        "32x24",
+        "--method",
+        "rt,cube-forward",
+        "--cube-size",
+        "16",
+    ];
+    // No --out: a new numbered folder each time.
+    let mut args = vec!["bench", "builtin:few-detailed", "--frames", "2"];
+    args.extend(common);
+    let (ok, text, errors) = run(&args);
+    assert!(ok, "{errors}");
+    assert!(text.contains("| rectilinear:f=1 | rt |"), "{text}");
+    assert!(text.contains("Fisheye overhead"), "{text}");
+    for file in ["bench.json", "bench.md", "fps.canon-8-15mm@8mm.png"] {
+        assert!(dir.join("fisheye-bench-1").join(file).is_file(), "{file}");
+    }
+    let (ok, _, errors) = run(&args);
+    assert!(ok && dir.join("fisheye-bench-2").is_dir(), "{errors}");
+
+    let mut args = vec![
+        "compare",
+        "--frames",
+        "1",
+        "--supersample",
+        "2",
+        "-o",
+        "cmp",
+    ];
+    args.extend(common);
+    let (ok, text, errors) = run(&args);
+    assert!(ok, "{errors}");
+    assert!(text.contains("MSE vs supersampled"), "{text}");
+    for file in [
+        "compare.json",
+        "compare.md",
+        "tradeoff.canon-8-15mm@8mm.png",
+        "canon-8-15mm@8mm.cube-forward@16.error.png",
+        "rectilinear_f_1.reference.png",
+    ] {
+        assert!(dir.join("cmp").join(file).is_file(), "{file}");
+    }
+
+    // Bad input names the problem.
+    let (ok, _, errors) = run(&["bench", "builtin:grid", "--path", "walk", "--frames", "1"]);
+    assert!(!ok && errors.contains("no camera path"), "{errors}");
+    let (ok, _, errors) = run(&["compare", "--cube-size", "0"]);
+    assert!(!ok && errors.contains("--cube-size 0"), "{errors}");
+    let (ok, _, errors) = run(&["compare", "--supersample", "9"]);
+    assert!(!ok && errors.contains("--supersample 9"), "{errors}");
+    std::fs::remove_dir_all(dir).unwrap();
+}

@@ -30,6 +30,7 @@ fn traced_faces(gpu_scene: &GpuScene, pose: &Camera, size: u32) -> Vec<RenderOut
             pass.set_view(
                 ctx(),
                 gpu_scene,
+                0,
                 pose.position,
                 pose.rotation() * face.rotation(),
                 [0, 0],

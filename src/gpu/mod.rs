@@ -5,7 +5,7 @@ mod timing;
 
 use std::sync::{Arc, Mutex};
 
-pub use timing::{Queries, median};
+pub use timing::{Queries, Span, median};
 
 use crate::error::{Error, Result};
 

@@ -34,13 +34,19 @@ impl Queries {
         })
     }
 
-    /// The timestamp writes that time compute pass number `pass`.
+    /// The timestamp writes that time compute pass number `pass` on its own.
     pub fn writes(&self, pass: u32) -> wgpu::ComputePassTimestampWrites<'_> {
-        assert!(pass < self.passes, "timed pass {pass} of {}", self.passes);
-        wgpu::ComputePassTimestampWrites {
-            query_set: &self.set,
-            beginning_of_pass_write_index: Some(2 * pass),
-            end_of_pass_write_index: Some(2 * pass + 1),
+        self.span(pass)
+            .compute(true, true)
+            .expect("a pass that begins and ends the span")
+    }
+
+    /// Timed span number `span`, which may cover several passes.
+    pub fn span(&self, span: u32) -> Span<'_> {
+        assert!(span < self.passes, "timed span {span} of {}", self.passes);
+        Span {
+            set: &self.set,
+            index: span,
         }
     }
 
@@ -80,6 +86,46 @@ impl Queries {
             }
         }
         Ok(samples)
+    }
+}
+
+/// One timed span of consecutive passes, compute or render: its first pass writes the
+/// beginning timestamp and its last pass the end, so the span's time includes any gaps between
+/// its passes.
+#[derive(Clone, Copy)]
+pub struct Span<'a> {
+    set: &'a wgpu::QuerySet,
+    index: u32,
+}
+
+impl<'a> Span<'a> {
+    /// The beginning and end query indices a pass writes, `None` for a pass in the middle.
+    fn indices(self, first: bool, last: bool) -> Option<(Option<u32>, Option<u32>)> {
+        (first || last).then_some((
+            first.then_some(2 * self.index),
+            last.then_some(2 * self.index + 1),
+        ))
+    }
+
+    /// The writes of a compute pass in the span: the `first` pass begins it, the `last` ends
+    /// it (one pass may be both).
+    pub fn compute(self, first: bool, last: bool) -> Option<wgpu::ComputePassTimestampWrites<'a>> {
+        let (begin, end) = self.indices(first, last)?;
+        Some(wgpu::ComputePassTimestampWrites {
+            query_set: self.set,
+            beginning_of_pass_write_index: begin,
+            end_of_pass_write_index: end,
+        })
+    }
+
+    /// As [`Span::compute`], for a render pass.
+    pub fn render(self, first: bool, last: bool) -> Option<wgpu::RenderPassTimestampWrites<'a>> {
+        let (begin, end) = self.indices(first, last)?;
+        Some(wgpu::RenderPassTimestampWrites {
+            query_set: self.set,
+            beginning_of_pass_write_index: begin,
+            end_of_pass_write_index: end,
+        })
     }
 }
 

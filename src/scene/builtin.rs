@@ -179,7 +179,16 @@ fn room() -> Scene {
         look_at: DVec3::new(0.0, 1.2, -3.0),
         up: DVec3::Y,
     };
-    b.finish(lights, Vec3::new(0.6, 0.7, 0.9), Vec3::splat(0.06), camera)
+    let mut room = b.finish(lights, Vec3::new(0.6, 0.7, 0.9), Vec3::splat(0.06), camera);
+    // A walk into the room at eye height, above the small objects: towards the mirror, past
+    // the glass sphere, to the box in the corner.
+    room.camera_path = walk(&[
+        ([0.0, 1.5, 2.5], [0.0, 1.2, -3.0]),
+        ([0.5, 1.5, 1.2], [-1.6, 1.0, -2.2]),
+        ([-0.4, 1.5, 0.2], [1.5, 0.8, -1.4]),
+        ([0.2, 1.6, -0.6], [3.1, 0.7, -3.3]),
+    ]);
+    room
 }
 
 fn grid() -> Scene {
@@ -252,7 +261,25 @@ fn many_small() -> Scene {
             palette[(k % 16) as usize],
         );
     }
-    outdoors(b, DVec3::new(0.0, 1.7, 0.0), DVec3::new(0.0, 1.2, -10.0))
+    let mut scene = outdoors(b, DVec3::new(0.0, 1.7, 0.0), DVec3::new(0.0, 1.2, -10.0));
+    // Straight ahead above the boxes (at most 1.4 high), turning right halfway.
+    scene.camera_path = walk(&[
+        ([0.0, 1.7, 0.0], [0.0, 1.2, -10.0]),
+        ([0.0, 1.7, -6.0], [0.0, 1.2, -16.0]),
+        ([3.0, 1.7, -10.0], [13.0, 1.2, -10.0]),
+    ]);
+    scene
+}
+
+/// Keyframes of (eye, look-at) pairs, y up.
+fn walk(keys: &[([f64; 3], [f64; 3])]) -> Vec<Camera> {
+    keys.iter()
+        .map(|&(position, look_at)| Camera {
+            position: DVec3::from(position),
+            look_at: DVec3::from(look_at),
+            up: DVec3::Y,
+        })
+        .collect()
 }
 
 /// An outdoor scene: the sun and sky of [`outdoor_lights`], a camera at `position` looking at
@@ -290,7 +317,14 @@ fn few_detailed() -> Scene {
         // 500 × 200 × 2 = 200,000 triangles each.
         b.torus(DVec3::new(x, 1.0, -4.0), 1.1, 0.45, 500, 200, m);
     }
-    outdoors(b, DVec3::new(0.0, 1.6, 1.0), DVec3::new(0.0, 1.0, -4.0))
+    let mut scene = outdoors(b, DVec3::new(0.0, 1.6, 1.0), DVec3::new(0.0, 1.0, -4.0));
+    // Up to the middle torus (outer radius 1.55 around z = -4) and along the row.
+    scene.camera_path = walk(&[
+        ([0.0, 1.6, 1.0], [0.0, 1.0, -4.0]),
+        ([0.0, 1.4, -1.2], [0.0, 1.0, -4.0]),
+        ([-2.0, 1.4, -1.6], [3.2, 1.0, -4.0]),
+    ]);
+    scene
 }
 
 #[cfg(test)]

@@ -15,11 +15,17 @@ pub use ray_query::RayQueryScene;
 
 use crate::bvh::{BvhQuality, SceneBvh};
 use crate::error::{Error, Result};
-use crate::gpu::{GpuContext, bind_buffers, dispatch_over_image, storage_entry, uniform_entry};
+use crate::gpu::{
+    GpuContext, bind_buffers, bind_group, dispatch_over_image, storage_entry, uniform_entry,
+};
 use crate::lens::LensCamera;
 use crate::lens::gpu::{DirectionSource, LensRays, lens_constants, params_buffer};
 use crate::scene::{Camera, Features, Scene, Surface};
 use crate::shader;
+
+/// Bytes between the frame uniforms of a [`TracePass`]'s views: wgpu's default (and largest)
+/// `min_uniform_buffer_offset_alignment`.
+const FRAME_SLOT: u64 = 256;
 
 /// The deepest Whitted recursion a kernel can run (its ray stack has one more entry).
 pub const MAX_DEPTH_LIMIT: u32 = 8;
@@ -400,7 +406,8 @@ impl GpuScene {
 /// group (group 0) and its outputs; records one frame per [`TracePass::encode`].
 pub struct TracePass {
     pipeline: wgpu::ComputePipeline,
-    bind_group: wgpu::BindGroup,
+    /// One bind group per view, each with its slot of `frame`.
+    bind_groups: Vec<wgpu::BindGroup>,
     colour: wgpu::Buffer,
     geometry: wgpu::Buffer,
     ids: wgpu::Buffer,
@@ -417,6 +424,18 @@ impl TracePass {
         camera: &LensCamera,
         scene: &GpuScene,
         source: DirectionSource,
+    ) -> Result<Self> {
+        Self::with_views(ctx, camera, scene, source, 1)
+    }
+
+    /// As [`TracePass::new`], with `views` camera poses (numbered from 0) that can be set
+    /// before one submission and traced in it, as the faces of a cube map are.
+    pub fn with_views(
+        ctx: &GpuContext,
+        camera: &LensCamera,
+        scene: &GpuScene,
+        source: DirectionSource,
+        views: u32,
     ) -> Result<Self> {
         let pixels = camera.size.pixels() as u64;
         for (what, bytes) in [
@@ -469,23 +488,46 @@ impl TracePass {
             let colour = output("fisheye.trace.colour", 16 * pixels);
             let geometry = output("fisheye.trace.geometry", 16 * pixels);
             let ids = output("fisheye.trace.ids", 4 * pixels);
+            let slots: Vec<u8> = (0..views)
+                .flat_map(|_| {
+                    let mut slot = bytemuck::bytes_of(&scene.frame).to_vec();
+                    slot.resize(FRAME_SLOT as usize, 0);
+                    slot
+                })
+                .collect();
             let frame = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
                 label: Some("fisheye.trace.frame"),
-                contents: bytemuck::bytes_of(&scene.frame),
+                contents: &slots,
                 usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
             });
             let placeholder = output("fisheye.trace.no_table", 16);
             let table = table.as_ref().map_or(&placeholder, |t| &t.directions);
             let lens = params_buffer(device, camera);
-            let bind_group = bind_buffers(
-                device,
-                "fisheye.trace.frame",
-                &layout,
-                &[&lens, table, &frame, &colour, &geometry, &ids],
-            );
+            let bind_groups = (0..views)
+                .map(|view| {
+                    let slot = wgpu::BufferBinding {
+                        buffer: &frame,
+                        offset: u64::from(view) * FRAME_SLOT,
+                        size: wgpu::BufferSize::new(size_of::<Frame>() as u64),
+                    };
+                    bind_group(
+                        device,
+                        "fisheye.trace.frame",
+                        &layout,
+                        [
+                            lens.as_entire_binding(),
+                            table.as_entire_binding(),
+                            wgpu::BindingResource::Buffer(slot),
+                            colour.as_entire_binding(),
+                            geometry.as_entire_binding(),
+                            ids.as_entire_binding(),
+                        ],
+                    )
+                })
+                .collect();
             Self {
                 pipeline,
-                bind_group,
+                bind_groups,
                 colour,
                 geometry,
                 ids,
@@ -499,23 +541,27 @@ impl TracePass {
     /// stays where it was uploaded, relative to its own camera, so poses far from it lose the
     /// precision that relative upload buys; paths through a scene are fine.
     pub fn set_pose(&self, ctx: &GpuContext, scene: &GpuScene, pose: &Camera) {
-        self.set_view(ctx, scene, pose.position, pose.rotation(), [0, 0]);
+        self.set_view(ctx, scene, 0, pose.position, pose.rotation(), [0, 0]);
     }
 
-    /// As [`TracePass::set_pose`], with the camera-to-world rotation given (columns: the
-    /// camera's right, down and forward axes in world space), and the first pixel that
-    /// [`TracePass::encode_region`] traces.
+    /// As [`TracePass::set_pose`] for view number `view` (see [`TracePass::with_views`]), with
+    /// the camera-to-world rotation given (columns: the camera's right, down and forward axes
+    /// in world space), and the first pixel that [`TracePass::encode_region`] traces.
     pub fn set_view(
         &self,
         ctx: &GpuContext,
         scene: &GpuScene,
+        view: u32,
         eye: DVec3,
         rotation: DMat3,
         offset: [u32; 2],
     ) {
         let frame = view_frame(scene.origin, eye, rotation, offset);
-        ctx.queue
-            .write_buffer(&self.frame, 0, bytemuck::bytes_of(&frame));
+        ctx.queue.write_buffer(
+            &self.frame,
+            u64::from(view) * FRAME_SLOT,
+            bytemuck::bytes_of(&frame),
+        );
     }
 
     /// The colour output of the last frame (as [`RenderOutput::colour`]), for passes that
@@ -531,20 +577,21 @@ impl TracePass {
         scene: &GpuScene,
         timestamp_writes: Option<wgpu::ComputePassTimestampWrites<'_>>,
     ) {
-        self.encode_region(encoder, scene, self.camera.size, timestamp_writes);
+        self.encode_region(encoder, scene, 0, self.camera.size, timestamp_writes);
     }
 
-    /// Records a frame of only the `extent` pixels from the offset given to
+    /// Records a frame of view `view` of only the `extent` pixels from the offset given to
     /// [`TracePass::set_view`] (the whole image from a zero offset); the other pixels keep what
     /// they had.
     pub fn encode_region(
         &self,
         encoder: &mut wgpu::CommandEncoder,
         scene: &GpuScene,
+        view: u32,
         extent: crate::lens::ImageSize,
         timestamp_writes: Option<wgpu::ComputePassTimestampWrites<'_>>,
     ) {
-        let mut groups = vec![&self.bind_group, &scene.bind_group];
+        let mut groups = vec![&self.bind_groups[view as usize], &scene.bind_group];
         if let Some(rq) = &scene.ray_query {
             groups.push(&rq.bind_group);
         }

@@ -1,0 +1,719 @@
+//! `fisheye bench` and `fisheye compare` as library calls: run every setup on every lens,
+//! and write what they measured into a folder as JSON, a Markdown table and PNG plots (error
+//! maps too, for compare). Each file names the machine ([`Machine`]).
+
+use std::fmt::Write as _;
+use std::path::Path;
+
+use serde::Serialize;
+
+use crate::bench::{
+    FrameStats, FrameTime, Machine, Method, Pass, Renderer, SceneSet, Setup, camera_path,
+};
+use crate::compare::{ImageError, error_map, image_error, pareto_front, supersampled};
+use crate::demo::save_png;
+use crate::error::{Error, Result};
+use crate::gpu::{GpuContext, median};
+use crate::lens::LensCamera;
+use crate::plot;
+use crate::scene::{Camera, Scene};
+use crate::trace::colour_image;
+
+pub use crate::bench::PathKind;
+
+/// A lens to measure, with the name reports give it.
+pub struct LensRun {
+    /// The spec it was made from (`canon-8-15mm@8mm`, `rectilinear:f=1`).
+    pub name: String,
+    /// The camera.
+    pub camera: LensCamera,
+}
+
+/// What is being measured, shared by both commands.
+pub struct Study<'a> {
+    /// The device.
+    pub ctx: &'a GpuContext,
+    /// The scene as loaded.
+    pub scene: &'a Scene,
+    /// How the scene was named on the command line.
+    pub scene_name: String,
+    /// The scene on the GPU.
+    pub scenes: &'a SceneSet,
+    /// The lenses.
+    pub lenses: &'a [LensRun],
+    /// The setups to run on each lens; those the adapter cannot run are skipped and listed.
+    pub setups: &'a [Setup],
+    /// Shadow-map size of rasterized faces.
+    pub shadow_size: u32,
+}
+
+/// Progress of a long run, for a progress bar: `done` of `total` frames, and what runs now.
+pub struct Progress<'a> {
+    /// Frames rendered so far.
+    pub done: usize,
+    /// Frames in the whole run.
+    pub total: usize,
+    /// The lens and setup being rendered.
+    pub what: &'a str,
+}
+
+impl Study<'_> {
+    /// The setups the adapter can run, and a line per setup it cannot.
+    fn runnable(&self) -> (Vec<Setup>, Vec<String>) {
+        let mut skipped = Vec::new();
+        let setups = self
+            .setups
+            .iter()
+            .filter(|s| match s.method.missing_feature(self.ctx) {
+                Some(feature) => {
+                    skipped.push(format!("{}: the adapter has no {feature}", s.label()));
+                    false
+                }
+                None => true,
+            })
+            .copied()
+            .collect();
+        (setups, skipped)
+    }
+
+    fn renderer(&self, lens: &LensRun, setup: Setup) -> Result<Renderer> {
+        Renderer::new(self.ctx, &lens.camera, self.scenes, setup, self.shadow_size)
+    }
+}
+
+/// One setup's frames along the path.
+#[derive(Serialize)]
+pub struct BenchEntry {
+    /// Lens name.
+    pub lens: String,
+    /// Setup label (`rt`, `cube-forward@512`).
+    pub setup: String,
+    /// Method name.
+    pub method: &'static str,
+    /// Cube face size, `None` for direct methods.
+    pub cube_size: Option<u32>,
+    /// The timed passes, in the order of each frame's `passes_ms`.
+    pub passes: &'static [Pass],
+    /// Statistics of the GPU time per frame (the sum of the passes), if timestamps exist.
+    pub gpu: Option<FrameStats>,
+    /// Statistics of the wall time per frame.
+    pub wall: FrameStats,
+    /// Median GPU ms of each pass.
+    pub pass_median_ms: Option<Vec<f64>>,
+    /// Every timed frame.
+    pub frames: Vec<FrameTime>,
+}
+
+impl BenchEntry {
+    /// The statistics plots and tables use: GPU time where timed, else wall time.
+    pub fn stats(&self) -> &FrameStats {
+        self.gpu.as_ref().unwrap_or(&self.wall)
+    }
+}
+
+/// What `fisheye bench` measured.
+#[derive(Serialize)]
+pub struct BenchReport {
+    /// Where it ran.
+    pub machine: Machine,
+    /// The scene as named.
+    pub scene: String,
+    /// Its triangle count.
+    pub triangles: usize,
+    /// Image size.
+    pub size: String,
+    /// The camera path.
+    pub path: String,
+    /// Untimed frames rendered first, per setup.
+    pub warmup: usize,
+    /// How the numbers were taken.
+    pub method_note: &'static str,
+    /// One entry per lens and setup.
+    pub entries: Vec<BenchEntry>,
+    /// Setups the adapter could not run, and why.
+    pub skipped: Vec<String>,
+}
+
+const BENCH_NOTE: &str = "Per frame: the pose is set, all passes are recorded into one command \
+    buffer and submitted, and the CPU waits for the GPU to finish (wall time). GPU time is the \
+    sum of the timed passes' timestamp spans. Shadow maps of rasterized faces are rendered \
+    once per scene (the lights do not move) and are not in the frame time.";
+
+/// Runs `frames` frames of every setup on every lens along `path`, after `warmup` untimed
+/// frames each.
+pub fn bench(
+    study: &Study<'_>,
+    path: PathKind,
+    frames: usize,
+    warmup: usize,
+    progress: &mut dyn FnMut(Progress<'_>),
+) -> Result<BenchReport> {
+    if frames == 0 {
+        return Err(Error::Scene("a benchmark needs at least one frame".into()));
+    }
+    let poses = camera_path(study.scene, path, frames)?;
+    let (setups, skipped) = study.runnable();
+    let total = study.lenses.len() * setups.len() * (frames + warmup);
+    let mut done = 0;
+    let mut entries = Vec::new();
+    for lens in study.lenses {
+        for &setup in &setups {
+            let what = format!("{} {}", lens.name, setup.label());
+            progress(Progress {
+                done,
+                total,
+                what: &what,
+            });
+            let renderer = study.renderer(lens, setup)?;
+            let mut timed = Vec::with_capacity(frames);
+            for k in 0..warmup + frames {
+                let pose = &poses[k.saturating_sub(warmup)];
+                let time = renderer.frame(study.ctx, study.scenes, pose)?;
+                if k >= warmup {
+                    timed.push(time);
+                }
+                done += 1;
+                progress(Progress {
+                    done,
+                    total,
+                    what: &what,
+                });
+            }
+            let wall: Vec<f64> = timed.iter().map(|t| t.wall_ms).collect();
+            let gpu: Option<Vec<f64>> = timed.iter().map(FrameTime::gpu_ms).collect();
+            let passes = setup.method.passes();
+            let pass_median_ms = timed
+                .iter()
+                .map(|t| t.passes_ms.clone())
+                .collect::<Option<Vec<_>>>()
+                .map(|per_frame| {
+                    (0..passes.len())
+                        .map(|p| median(&per_frame.iter().map(|f| f[p]).collect::<Vec<_>>()))
+                        .collect()
+                });
+            entries.push(BenchEntry {
+                lens: lens.name.clone(),
+                setup: setup.label(),
+                method: setup.method.name(),
+                cube_size: matches!(setup.method, Method::Cube(_)).then_some(setup.cube_size),
+                passes,
+                gpu: gpu.as_deref().and_then(FrameStats::of),
+                wall: FrameStats::of(&wall).expect("at least one frame"),
+                pass_median_ms,
+                frames: timed,
+            });
+        }
+    }
+    Ok(BenchReport {
+        machine: Machine::describe(study.ctx),
+        scene: study.scene_name.clone(),
+        triangles: study.scene.len(),
+        size: study
+            .lenses
+            .first()
+            .map_or(String::new(), |l| l.camera.size.to_string()),
+        path: format!("{path:?} ({frames} frames)").to_lowercase(),
+        warmup,
+        method_note: BENCH_NOTE,
+        entries,
+        skipped,
+    })
+}
+
+/// One setup's time and error on one lens.
+#[derive(Serialize)]
+pub struct CompareEntry {
+    /// Lens name.
+    pub lens: String,
+    /// Setup label.
+    pub setup: String,
+    /// Method name.
+    pub method: &'static str,
+    /// Cube face size, `None` for direct methods.
+    pub cube_size: Option<u32>,
+    /// Median GPU ms per frame, if timestamps exist.
+    pub gpu_ms: Option<f64>,
+    /// Median wall ms per frame.
+    pub wall_ms: f64,
+    /// Error against direct ray tracing at the same pixel centres.
+    pub error: ImageError,
+    /// Error against the supersampled reference.
+    pub error_supersampled: ImageError,
+    /// Whether no other setup on this lens is both faster and closer to the supersampled
+    /// reference.
+    pub pareto: bool,
+}
+
+impl CompareEntry {
+    /// GPU time where timed, else wall time.
+    pub fn ms(&self) -> f64 {
+        self.gpu_ms.unwrap_or(self.wall_ms)
+    }
+}
+
+/// Direct ray tracing against the fastest cube-map setting at least as accurate, on one lens.
+#[derive(Serialize)]
+pub struct Verdict {
+    /// Lens name.
+    pub lens: String,
+    /// Direct RT's ms per frame.
+    pub rt_ms: f64,
+    /// Direct RT's MSE against the supersampled reference.
+    pub rt_mse: f64,
+    /// The fastest cube-map setup with an MSE no larger, if any.
+    pub cube: Option<String>,
+    /// Its ms per frame over RT's: the speed-up of RT (the goal is at least 4).
+    pub speedup: Option<f64>,
+    /// The most accurate cube-map setup, when none is as accurate as RT.
+    pub best_cube: Option<String>,
+}
+
+/// What `fisheye compare` measured.
+#[derive(Serialize)]
+pub struct CompareReport {
+    /// Where it ran.
+    pub machine: Machine,
+    /// The scene as named.
+    pub scene: String,
+    /// Its triangle count.
+    pub triangles: usize,
+    /// Image size.
+    pub size: String,
+    /// The camera pose compared at.
+    pub pose: String,
+    /// Rays per pixel side of the supersampled reference.
+    pub supersample: u32,
+    /// Timed frames per setup (medians are reported), after one untimed.
+    pub frames: usize,
+    /// How errors are measured.
+    pub method_note: &'static str,
+    /// One entry per lens and setup.
+    pub entries: Vec<CompareEntry>,
+    /// Per lens, RT against the cube maps.
+    pub verdicts: Vec<Verdict>,
+    /// Setups the adapter could not run, and why.
+    pub skipped: Vec<String>,
+}
+
+const COMPARE_NOTE: &str = "Errors are over the pixels valid in both images, on displayed \
+    values (clamped to [0, 1], sRGB-encoded): MSE per channel, PSNR = 10 log10(1 / MSE). The \
+    first reference is direct ray tracing at the same pixel centres; the supersampled one \
+    averages N x N stratified rays per pixel. Mask agreement is the fraction of all pixels \
+    whose lens mask matches the reference's.";
+
+/// File-name-safe form of a label: letters, digits, `-`, `.` and `@` kept, the rest `_`.
+pub fn file_stem(label: &str) -> String {
+    label
+        .chars()
+        .map(|c| {
+            if c.is_ascii_alphanumeric() || "-.@".contains(c) {
+                c
+            } else {
+                '_'
+            }
+        })
+        .collect()
+}
+
+/// Times `frames` frames of every setup at `pose` on every lens, measures each image's error
+/// against direct ray tracing and a `supersample`² reference, and writes the references'
+/// images and each setup's error map into `out`.
+pub fn compare(
+    study: &Study<'_>,
+    pose: &Camera,
+    frames: usize,
+    supersample: u32,
+    out: &Path,
+    progress: &mut dyn FnMut(Progress<'_>),
+) -> Result<CompareReport> {
+    let (setups, skipped) = study.runnable();
+    let frames = frames.max(1);
+    let total = study.lenses.len() * (setups.len() * (frames + 1) + 2);
+    let mut done = 0;
+    let mut entries = Vec::new();
+    let mut verdicts = Vec::new();
+    for lens in study.lenses {
+        let size = lens.camera.size;
+        let stem = file_stem(&lens.name);
+        let what = format!("{} references", lens.name);
+        progress(Progress {
+            done,
+            total,
+            what: &what,
+        });
+        let rt = Setup {
+            method: Method::Rt,
+            cube_size: 0,
+        };
+        let reference_renderer = study.renderer(lens, rt)?;
+        reference_renderer.frame(study.ctx, study.scenes, pose)?;
+        let reference = reference_renderer.colour(study.ctx)?;
+        save_png(
+            &colour_image(size, &reference),
+            &out.join(format!("{stem}.reference.png")),
+        )?;
+        let fine = supersampled(
+            study.ctx,
+            &study.scenes.software,
+            &lens.camera,
+            pose,
+            supersample,
+            &reference,
+        )?;
+        save_png(
+            &colour_image(size, &fine),
+            &out.join(format!("{stem}.supersampled.png")),
+        )?;
+        done += 2;
+        let first = entries.len();
+        for &setup in &setups {
+            let what = format!("{} {}", lens.name, setup.label());
+            let renderer = study.renderer(lens, setup)?;
+            let mut times = Vec::with_capacity(frames);
+            for k in 0..=frames {
+                progress(Progress {
+                    done,
+                    total,
+                    what: &what,
+                });
+                let t = renderer.frame(study.ctx, study.scenes, pose)?;
+                if k > 0 {
+                    times.push(t);
+                }
+                done += 1;
+            }
+            let colour = renderer.colour(study.ctx)?;
+            save_png(
+                &error_map(size, &fine, &colour),
+                &out.join(format!("{stem}.{}.error.png", file_stem(&setup.label()))),
+            )?;
+            let gpu: Option<Vec<f64>> = times.iter().map(FrameTime::gpu_ms).collect();
+            let wall: Vec<f64> = times.iter().map(|t| t.wall_ms).collect();
+            entries.push(CompareEntry {
+                lens: lens.name.clone(),
+                setup: setup.label(),
+                method: setup.method.name(),
+                cube_size: matches!(setup.method, Method::Cube(_)).then_some(setup.cube_size),
+                gpu_ms: gpu.map(|g| median(&g)),
+                wall_ms: median(&wall),
+                error: image_error(&reference, &colour),
+                error_supersampled: image_error(&fine, &colour),
+                pareto: false,
+            });
+        }
+        let lens_entries = &mut entries[first..];
+        let points: Vec<(f64, f64)> = lens_entries
+            .iter()
+            .map(|e| (e.ms(), e.error_supersampled.mse))
+            .collect();
+        for (e, on) in lens_entries.iter_mut().zip(pareto_front(&points)) {
+            e.pareto = on;
+        }
+        if let Some(v) = verdict(&lens.name, lens_entries) {
+            verdicts.push(v);
+        }
+    }
+    progress(Progress {
+        done: total,
+        total,
+        what: "done",
+    });
+    Ok(CompareReport {
+        machine: Machine::describe(study.ctx),
+        scene: study.scene_name.clone(),
+        triangles: study.scene.len(),
+        size: study
+            .lenses
+            .first()
+            .map_or(String::new(), |l| l.camera.size.to_string()),
+        pose: format!(
+            "eye {:?} looking at {:?}",
+            pose.position.to_array(),
+            pose.look_at.to_array()
+        ),
+        supersample,
+        frames,
+        method_note: COMPARE_NOTE,
+        entries,
+        verdicts,
+        skipped,
+    })
+}
+
+/// RT against the fastest cube-map setup of no larger error (against the supersampled
+/// reference), `None` without an `rt` entry.
+fn verdict(lens: &str, entries: &[CompareEntry]) -> Option<Verdict> {
+    let rt = entries.iter().find(|e| e.method == "rt")?;
+    let rt_mse = rt.error_supersampled.mse;
+    let cubes = || entries.iter().filter(|e| e.cube_size.is_some());
+    let fastest = cubes()
+        .filter(|e| e.error_supersampled.mse <= rt_mse)
+        .min_by(|a, b| a.ms().total_cmp(&b.ms()));
+    let best = cubes().min_by(|a, b| {
+        a.error_supersampled
+            .mse
+            .total_cmp(&b.error_supersampled.mse)
+    });
+    Some(Verdict {
+        lens: lens.to_string(),
+        rt_ms: rt.ms(),
+        rt_mse,
+        cube: fastest.map(|e| e.setup.clone()),
+        speedup: fastest.map(|e| e.ms() / rt.ms()),
+        best_cube: fastest
+            .is_none()
+            .then(|| best.map(|e| e.setup.clone()))
+            .flatten(),
+    })
+}
+
+fn write_text(path: &Path, text: &str) -> Result<()> {
+    std::fs::write(path, text).map_err(|source| Error::Io {
+        path: path.to_path_buf(),
+        source,
+    })
+}
+
+fn write_json(path: &Path, value: &impl Serialize) -> Result<()> {
+    let text = serde_json::to_string_pretty(value).expect("reports serialize");
+    write_text(path, &(text + "\n"))
+}
+
+fn machine_lines(m: &Machine) -> String {
+    format!(
+        "- adapter: {}\n- driver: {}\n- CPU: {} ({} logical)\n- date: {}\n",
+        m.adapter, m.driver, m.cpu, m.cpus, m.date
+    )
+}
+
+/// A value in ms or fps to three significant figures, as the tables print them.
+fn sig(v: f64) -> String {
+    if v >= 100.0 {
+        format!("{v:.0}")
+    } else if v >= 10.0 {
+        format!("{v:.1}")
+    } else {
+        format!("{v:.2}")
+    }
+}
+
+impl BenchReport {
+    /// The Markdown table: a row per lens and setup, then the fisheye overhead of direct RT.
+    pub fn markdown(&self) -> String {
+        let mut md = format!(
+            "# fisheye bench: {} ({} triangles), {}, path {}, {} warm-up frames\n\n{}\n{}\n\n",
+            self.scene,
+            self.triangles,
+            self.size,
+            self.path,
+            self.warmup,
+            machine_lines(&self.machine),
+            self.method_note
+        );
+        let clock = if self.entries.iter().all(|e| e.gpu.is_some()) {
+            "GPU"
+        } else {
+            "wall"
+        };
+        let _ = writeln!(
+            md,
+            "| lens | setup | mean fps ({clock}) | fps variance | min fps | max fps | p50 ms | p99 ms | wall mean fps | median ms per pass |\n|---|---|---:|---:|---:|---:|---:|---:|---:|---|"
+        );
+        for e in &self.entries {
+            let s = e.stats();
+            let passes = match &e.pass_median_ms {
+                Some(ms) => e
+                    .passes
+                    .iter()
+                    .zip(ms)
+                    .map(|(p, ms)| format!("{} {}", p.name(), sig(*ms)))
+                    .collect::<Vec<_>>()
+                    .join(", "),
+                None => "untimed".into(),
+            };
+            let _ = writeln!(
+                md,
+                "| {} | {} | {} | {} | {} | {} | {} | {} | {} | {passes} |",
+                e.lens,
+                e.setup,
+                sig(s.mean_fps),
+                sig(s.fps_variance),
+                sig(s.min_fps),
+                sig(s.max_fps),
+                sig(s.p50_ms),
+                sig(s.p99_ms),
+                sig(e.wall.mean_fps),
+            );
+        }
+        let overheads = self.fisheye_overheads();
+        if !overheads.is_empty() {
+            md.push_str(
+                "\nFisheye overhead of direct ray tracing (median frame time over the pinhole's; goal ≤ 1.05):\n\n",
+            );
+            for (lens, ratio) in overheads {
+                let _ = writeln!(md, "- {lens}: {ratio:.3}");
+            }
+        }
+        for s in &self.skipped {
+            let _ = writeln!(md, "\nSkipped: {s}");
+        }
+        md
+    }
+
+    /// Per non-pinhole lens, direct RT's median frame time over the pinhole lens's (the
+    /// lens named `pinhole` or starting `rectilinear`).
+    pub fn fisheye_overheads(&self) -> Vec<(String, f64)> {
+        let rt = |lens: &str| {
+            self.entries
+                .iter()
+                .find(|e| e.lens == lens && e.setup == "rt")
+                .map(|e| e.stats().p50_ms)
+        };
+        let Some(pinhole) = self
+            .entries
+            .iter()
+            .find(|e| is_pinhole(&e.lens))
+            .and_then(|e| rt(&e.lens))
+        else {
+            return Vec::new();
+        };
+        let mut lenses: Vec<&str> = self.entries.iter().map(|e| e.lens.as_str()).collect();
+        lenses.dedup();
+        lenses
+            .into_iter()
+            .filter(|l| !is_pinhole(l))
+            .filter_map(|l| Some((l.to_string(), rt(l)? / pinhole)))
+            .collect()
+    }
+
+    /// Writes `bench.json`, `bench.md` and one `fps.LENS.png` per lens into `out`; returns
+    /// the plots' warning when they could not be drawn.
+    pub fn write(&self, out: &Path) -> Result<Option<String>> {
+        write_json(&out.join("bench.json"), self)?;
+        write_text(&out.join("bench.md"), &self.markdown())?;
+        if let Err(why) = plot::font() {
+            return Ok(Some(why));
+        }
+        let mut lenses: Vec<&str> = self.entries.iter().map(|e| e.lens.as_str()).collect();
+        lenses.dedup();
+        for lens in lenses {
+            let series: Vec<plot::Series> = self
+                .entries
+                .iter()
+                .filter(|e| e.lens == lens)
+                .map(|e| plot::Series {
+                    label: e.setup.clone(),
+                    points: e
+                        .frames
+                        .iter()
+                        .enumerate()
+                        .map(|(k, f)| (k as f64, 1e3 / f.gpu_ms().unwrap_or(f.wall_ms)))
+                        .collect(),
+                })
+                .collect();
+            let title = format!("{}: {lens}, {}", self.scene, self.size);
+            plot::fps_along_path(
+                &out.join(format!("fps.{}.png", file_stem(lens))),
+                &title,
+                "frames per second (GPU time)",
+                &series,
+            )?;
+        }
+        Ok(None)
+    }
+}
+
+fn is_pinhole(lens: &str) -> bool {
+    lens == "pinhole" || lens.starts_with("rectilinear")
+}
+
+impl CompareReport {
+    /// The Markdown table: a row per lens and setup, then the verdicts.
+    pub fn markdown(&self) -> String {
+        let mut md = format!(
+            "# fisheye compare: {} ({} triangles), {}, {}\n\n{}\n{} Supersampled reference: {}x{} rays per pixel. Times are medians of {} frames.\n\n",
+            self.scene,
+            self.triangles,
+            self.size,
+            self.pose,
+            machine_lines(&self.machine),
+            self.method_note,
+            self.supersample,
+            self.supersample,
+            self.frames
+        );
+        md.push_str(
+            "| lens | setup | ms / frame | MSE vs RT | PSNR vs RT (dB) | MSE vs supersampled | PSNR vs supersampled (dB) | mask agreement | Pareto |\n|---|---|---:|---:|---:|---:|---:|---:|:-:|\n",
+        );
+        for e in &self.entries {
+            let _ = writeln!(
+                md,
+                "| {} | {} | {} | {:.2e} | {:.1} | {:.2e} | {:.1} | {:.4} | {} |",
+                e.lens,
+                e.setup,
+                sig(e.ms()),
+                e.error.mse,
+                e.error.psnr_db,
+                e.error_supersampled.mse,
+                e.error_supersampled.psnr_db,
+                e.error.mask_agreement,
+                if e.pareto { "●" } else { "" }
+            );
+        }
+        md.push_str("\nDirect RT against the fastest cube-map setting with no larger error (vs the supersampled reference; goal: RT at least 4x faster):\n\n");
+        for v in &self.verdicts {
+            let line = match (&v.cube, v.speedup) {
+                (Some(cube), Some(s)) => format!(
+                    "{cube} at {} ms: RT ({} ms, MSE {:.2e}) is {s:.2}x faster",
+                    sig(v.rt_ms * s),
+                    sig(v.rt_ms),
+                    v.rt_mse
+                ),
+                _ => format!(
+                    "no cube-map setting reaches RT's MSE of {:.2e} (the closest: {})",
+                    v.rt_mse,
+                    v.best_cube.as_deref().unwrap_or("none run")
+                ),
+            };
+            let _ = writeln!(md, "- {}: {line}", v.lens);
+        }
+        for s in &self.skipped {
+            let _ = writeln!(md, "\nSkipped: {s}");
+        }
+        md
+    }
+
+    /// Writes `compare.json`, `compare.md` and one `tradeoff.LENS.png` per lens into `out`;
+    /// returns the plots' warning when they could not be drawn.
+    pub fn write(&self, out: &Path) -> Result<Option<String>> {
+        write_json(&out.join("compare.json"), self)?;
+        write_text(&out.join("compare.md"), &self.markdown())?;
+        if let Err(why) = plot::font() {
+            return Ok(Some(why));
+        }
+        let mut lenses: Vec<&str> = self.entries.iter().map(|e| e.lens.as_str()).collect();
+        lenses.dedup();
+        for lens in lenses {
+            let points: Vec<plot::TradeOff> = self
+                .entries
+                .iter()
+                .filter(|e| e.lens == lens)
+                .map(|e| plot::TradeOff {
+                    label: e.cube_size.map_or(e.setup.clone(), |s| s.to_string()),
+                    method: e.method,
+                    ms: e.ms(),
+                    error: e.error_supersampled.mse,
+                    pareto: e.pareto,
+                })
+                .collect();
+            let title = format!("{}: {lens}, {}", self.scene, self.size);
+            plot::time_against_error(
+                &out.join(format!("tradeoff.{}.png", file_stem(lens))),
+                &title,
+                "MSE vs supersampled reference (log)",
+                &points,
+            )?;
+        }
+        Ok(None)
+    }
+}

@@ -1,0 +1,236 @@
+//! `fisheye bench` and `fisheye compare` as library calls: every method's frame is timed per
+//! pass, the errors are measured against references whose exact relations to the methods
+//! are known, and the reports write what they claim.
+
+mod common;
+
+use common::{camera, ctx};
+use fisheye_rt::bench::{Method, PathKind, Renderer, SceneSet, Setup};
+use fisheye_rt::compare::{image_error, supersampled};
+use fisheye_rt::report::{self, LensRun, Study};
+use fisheye_rt::scene::builtin;
+use fisheye_rt::trace::{RenderOptions, render};
+
+fn setups(methods: &[Method], sizes: &[u32]) -> Vec<Setup> {
+    Setup::all(methods, sizes)
+}
+
+#[test]
+fn every_method_times_each_of_its_passes_and_renders_what_render_does() {
+    let scene = builtin::scene("default").unwrap();
+    let cam = camera("canon-8-15mm@8mm", 48, 36);
+    let all = setups(&Method::ALL, &[24]);
+    let scenes = SceneSet::new(ctx(), &scene, &RenderOptions::default(), &all).unwrap();
+    for setup in all {
+        let renderer = Renderer::new(ctx(), &cam, &scenes, setup, 256).unwrap();
+        let time = renderer.frame(ctx(), &scenes, &scene.camera).unwrap();
+        let passes = time.passes_ms.expect("lavapipe has timestamp queries");
+        assert_eq!(
+            passes.len(),
+            setup.method.passes().len(),
+            "{}",
+            setup.label()
+        );
+        assert!(
+            passes.iter().all(|ms| ms.is_finite() && *ms > 0.0),
+            "{}: {passes:?}",
+            setup.label()
+        );
+        // The GPU cannot spend longer on a frame than the wall clock waited for it (1%
+        // allowance for the two clocks' rates).
+        let gpu: f64 = passes.iter().sum();
+        assert!(
+            gpu <= time.wall_ms * 1.01,
+            "{}: {gpu} > {}",
+            setup.label(),
+            time.wall_ms
+        );
+        if setup.method == Method::Rt {
+            // The timed frame is the same image `trace::render` makes.
+            let colour = renderer.colour(ctx()).unwrap();
+            let once = render(ctx(), &scene, &cam, &RenderOptions::default()).unwrap();
+            assert_eq!(colour, once.colour);
+        }
+    }
+}
+
+/// A study of `setups` on one lens, the built-in scene `name`.
+fn study_on<'a>(
+    scene: &'a fisheye_rt::scene::Scene,
+    scenes: &'a SceneSet,
+    lenses: &'a [LensRun],
+    setups: &'a [Setup],
+) -> Study<'a> {
+    Study {
+        ctx: ctx(),
+        scene,
+        scene_name: "test".into(),
+        scenes,
+        lenses,
+        setups,
+        shadow_size: 512,
+    }
+}
+
+#[test]
+fn compare_errors_are_zero_exactly_where_the_methods_coincide() {
+    // A 90° pinhole on a 64-pixel-wide image, and a traced cube of 64-texel faces: every
+    // pixel centre is a texel centre of the front face, so the resampled image is the traced
+    // one up to f32 rounding. At a quarter of the size the cube must be worse.
+    let scene = builtin::scene("few-detailed").unwrap();
+    let lenses = [LensRun {
+        name: "pinhole".into(),
+        camera: camera("rectilinear:f=1", 64, 48),
+    }];
+    let all = setups(
+        &[
+            Method::Rt,
+            Method::Cube(fisheye_rt::cube::CubeMethod::Traced),
+        ],
+        &[16, 64],
+    );
+    let scenes = SceneSet::new(ctx(), &scene, &RenderOptions::default(), &all).unwrap();
+    let out = std::env::temp_dir().join("fisheye-test-compare");
+    let _ = std::fs::remove_dir_all(&out);
+    let study = study_on(&scene, &scenes, &lenses, &all);
+    let report = report::compare(&study, &scene.camera, 1, 2, &out, &mut |_| {}).unwrap();
+    let entry = |label: &str| report.entries.iter().find(|e| e.setup == label).unwrap();
+    let rt = entry("rt");
+    assert_eq!(rt.error.mse, 0.0);
+    assert_eq!(rt.error.mask_agreement, 1.0);
+    let matched = entry("cube-rt@64");
+    assert!(matched.error.mse < 1e-9, "{}", matched.error.mse);
+    let coarse = entry("cube-rt@16");
+    assert!(coarse.error.mse > 100.0 * matched.error.mse.max(1e-9));
+    for e in &report.entries {
+        assert_eq!(e.error.mask_agreement, 1.0, "{}", e.setup);
+        assert_eq!(e.error.compared, 64 * 48, "{}", e.setup);
+        // Against the supersampled reference even RT has an error: its aliasing.
+        assert!(e.error_supersampled.mse > 0.0, "{}", e.setup);
+    }
+    // The error maps and both references were written.
+    for file in [
+        "pinhole.reference.png",
+        "pinhole.supersampled.png",
+        "pinhole.rt.error.png",
+        "pinhole.cube-rt@16.error.png",
+    ] {
+        let img = image::open(out.join(file)).unwrap();
+        assert_eq!((img.width(), img.height()), (64, 48), "{file}");
+    }
+    // The fastest setup is always on the Pareto front, and RT's verdict names a cube setting
+    // only if that setting's error is no larger.
+    let fastest = report
+        .entries
+        .iter()
+        .min_by(|a, b| a.ms().total_cmp(&b.ms()))
+        .unwrap();
+    assert!(fastest.pareto);
+    let v = &report.verdicts[0];
+    if let Some(cube) = &v.cube {
+        assert!(entry(cube).error_supersampled.mse <= v.rt_mse);
+    }
+}
+
+#[test]
+fn the_supersampled_reference_averages_sub_pixel_rays() {
+    let scene = builtin::scene("default").unwrap();
+    let cam = camera("samyang-7.5mm", 40, 30);
+    let rt = setups(&[Method::Rt], &[]);
+    let scenes = SceneSet::new(ctx(), &scene, &RenderOptions::default(), &rt).unwrap();
+    let centres = render(ctx(), &scene, &cam, &RenderOptions::default()).unwrap();
+    // One ray per pixel is the reference itself.
+    let one = supersampled(
+        ctx(),
+        &scenes.software,
+        &cam,
+        &scene.camera,
+        1,
+        &centres.colour,
+    );
+    assert_eq!(one.unwrap(), centres.colour);
+    // 3 × 3: the middle sub-ray is the pixel centre, so each pixel is the mean of a 3× image's
+    // block, computed here from that image independently.
+    let fine_cam = camera("samyang-7.5mm", 120, 90);
+    let fine = render(ctx(), &scene, &fine_cam, &RenderOptions::default()).unwrap();
+    let three = supersampled(
+        ctx(),
+        &scenes.software,
+        &cam,
+        &scene.camera,
+        3,
+        &centres.colour,
+    )
+    .unwrap();
+    for (p, got) in three.iter().enumerate() {
+        assert_eq!(got[3], centres.colour[p][3], "the mask is the centres'");
+        if got[3] != 1.0 {
+            continue;
+        }
+        let (i, j) = (p % 40, p / 40);
+        let block: Vec<[f32; 4]> = (0..9)
+            .map(|k| fine.colour[(3 * j + k / 3) * 120 + 3 * i + k % 3])
+            .filter(|c| c[3] == 1.0)
+            .collect();
+        for c in 0..3 {
+            let mean = block.iter().map(|b| f64::from(b[c])).sum::<f64>() / block.len() as f64;
+            assert!((f64::from(got[c]) - mean).abs() < 1e-6, "pixel {p}");
+        }
+    }
+    assert!(image_error(&centres.colour, &three).mse > 0.0);
+}
+
+#[test]
+fn bench_times_every_frame_of_the_walk_and_writes_its_report() {
+    let scene = builtin::scene("default").unwrap();
+    let lenses = [
+        LensRun {
+            name: "canon-8-15mm@8mm".into(),
+            camera: camera("canon-8-15mm@8mm", 32, 24),
+        },
+        LensRun {
+            name: "pinhole".into(),
+            camera: camera("rectilinear:f=1", 32, 24),
+        },
+    ];
+    let raster = Method::Cube(fisheye_rt::cube::CubeMethod::Raster(
+        fisheye_rt::raster::RasterMethod::Deferred,
+    ));
+    let all = setups(&[Method::Rt, raster], &[16]);
+    let scenes = SceneSet::new(ctx(), &scene, &RenderOptions::default(), &all).unwrap();
+    let study = study_on(&scene, &scenes, &lenses, &all);
+    let mut calls = Vec::new();
+    let report = report::bench(&study, PathKind::Walk, 3, 1, &mut |p| {
+        calls.push((p.done, p.total))
+    })
+    .unwrap();
+    assert_eq!(report.entries.len(), 4);
+    for e in &report.entries {
+        assert_eq!(e.frames.len(), 3);
+        assert_eq!(e.wall.frames, 3);
+        let gpu = e.gpu.as_ref().unwrap();
+        assert!(gpu.min_fps <= gpu.mean_fps && gpu.mean_fps <= gpu.max_fps);
+        assert_eq!(e.pass_median_ms.as_ref().unwrap().len(), e.passes.len());
+    }
+    // Progress counts every frame, warm-up included, and ends complete.
+    assert_eq!(calls.last(), Some(&(16, 16)));
+    assert!(calls.windows(2).all(|w| w[0].0 <= w[1].0));
+    assert_eq!(report.fisheye_overheads().len(), 1);
+
+    let out = std::env::temp_dir().join("fisheye-test-bench");
+    let _ = std::fs::remove_dir_all(&out);
+    std::fs::create_dir_all(&out).unwrap();
+    assert_eq!(report.write(&out).unwrap(), None, "plots need a font");
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("bench.json")).unwrap()).unwrap();
+    assert_eq!(json["entries"].as_array().unwrap().len(), 4);
+    assert!(json["machine"]["date"].as_str().unwrap().starts_with("20"));
+    assert!(json["machine"]["driver"].as_str().unwrap().len() > 3);
+    let md = std::fs::read_to_string(out.join("bench.md")).unwrap();
+    assert!(md.contains("| canon-8-15mm@8mm | cube-deferred@16 |"));
+    assert!(md.contains("Fisheye overhead"));
+    for lens in ["canon-8-15mm@8mm", "pinhole"] {
+        let plot = image::open(out.join(format!("fps.{lens}.png"))).unwrap();
+        assert_eq!((plot.width(), plot.height()), (1100, 700));
+    }
+}
