@@ -87,15 +87,8 @@ struct RenderArgs {
     /// Face size of the cube map in texels (`cube-*` methods).
     #[arg(long, default_value_t = 1024)]
     cube_size: u32,
-    /// Shadow-map size in texels per side and layer (rasterized `cube-*` methods).
-    #[arg(long, default_value_t = 2048)]
-    shadow_size: u32,
-    /// Deepest reflection/refraction bounce.
-    #[arg(long, default_value_t = 5)]
-    max_depth: u32,
-    /// BVH build preset.
-    #[arg(long, value_enum, default_value = "fast")]
-    bvh: Quality,
+    #[command(flatten)]
+    shading: ShadingArgs,
     /// Primary ray directions: evaluated per pixel, or read from a table made once.
     #[arg(long, value_enum, default_value = "computed")]
     directions: Directions,
@@ -109,6 +102,20 @@ struct RenderArgs {
     /// File format of the ground-truth arrays.
     #[arg(long, value_enum, default_value = "npy")]
     format: ArrayFormat,
+}
+
+/// How the scene is built and shaded, for `render`, `bench` and `compare`.
+#[derive(clap::Args)]
+struct ShadingArgs {
+    /// Shadow-map size in texels per side and layer (rasterized `cube-*` methods).
+    #[arg(long, default_value_t = 2048)]
+    shadow_size: u32,
+    /// Deepest reflection/refraction bounce.
+    #[arg(long, default_value_t = 5)]
+    max_depth: u32,
+    /// BVH build preset.
+    #[arg(long, value_enum, default_value = "fast")]
+    bvh: Quality,
 }
 
 /// The scene, lenses, setups and outputs `bench` and `compare` share with `render`.
@@ -139,15 +146,8 @@ struct StudyArgs {
     /// Cube face sizes to measure the cube-map methods at (comma-separated).
     #[arg(long, value_delimiter = ',', default_value = "512,1024,1920")]
     cube_size: Vec<u32>,
-    /// Shadow-map size of rasterized faces.
-    #[arg(long, default_value_t = 2048)]
-    shadow_size: u32,
-    /// Deepest reflection/refraction bounce.
-    #[arg(long, default_value_t = 5)]
-    max_depth: u32,
-    /// BVH build preset.
-    #[arg(long, value_enum, default_value = "fast")]
-    bvh: Quality,
+    #[command(flatten)]
+    shading: ShadingArgs,
     /// Folder for the results; by default a new folder `fisheye-COMMAND-N` here.
     #[arg(long, short)]
     out: Option<PathBuf>,
@@ -428,8 +428,8 @@ fn load_scene(spec: &str) -> Result<Scene> {
 fn render(args: &RenderArgs) -> Result<()> {
     let started = Instant::now();
     let options = RenderOptions {
-        max_depth: args.max_depth,
-        bvh: args.bvh.into(),
+        max_depth: args.shading.max_depth,
+        bvh: args.shading.bvh.into(),
         directions: args.directions.into(),
         traversal: if args.method == Method::Rq {
             Traversal::RayQuery
@@ -470,7 +470,7 @@ fn render(args: &RenderArgs) -> Result<()> {
             bail!("--outputs come from the direct tracer; use --method rt for ground-truth arrays");
         }
         let settings = CubeSettings {
-            shadow_size: args.shadow_size,
+            shadow_size: args.shading.shadow_size,
             ..CubeSettings::new(args.cube_size, method)
         };
         let cube = CubeMap::new(&ctx, &camera, &gpu_scene, &settings)?;
@@ -738,6 +738,20 @@ struct Prepared {
     out: PathBuf,
 }
 
+impl Prepared {
+    fn study(&self, args: &StudyArgs) -> Study<'_> {
+        Study {
+            ctx: &self.ctx,
+            scene: &self.scene,
+            scene_name: args.scene.clone(),
+            scenes: &self.scenes,
+            lenses: &self.lenses,
+            setups: &self.setups,
+            shadow_size: args.shading.shadow_size,
+        }
+    }
+}
+
 /// Checks the arguments, loads the scene, makes the output folder and uploads the scene.
 fn prepare(args: &StudyArgs, command: &str) -> Result<Prepared> {
     let mut specs = args.lens.clone();
@@ -777,8 +791,8 @@ fn prepare(args: &StudyArgs, command: &str) -> Result<Prepared> {
     let ctx = GpuContext::new()?;
     println!("adapter: {}", ctx.adapter_name());
     let options = RenderOptions {
-        max_depth: args.max_depth,
-        bvh: args.bvh.into(),
+        max_depth: args.shading.max_depth,
+        bvh: args.shading.bvh.into(),
         ..RenderOptions::default()
     };
     let scenes = SceneSet::new(&ctx, &scene, &options, &setups)?;
@@ -847,15 +861,7 @@ fn run_bench(args: &BenchArgs) -> Result<()> {
         None if p.scene.camera_path.is_empty() => PathKind::Orbit,
         None => PathKind::Walk,
     };
-    let study = Study {
-        ctx: &p.ctx,
-        scene: &p.scene,
-        scene_name: args.study.scene.clone(),
-        scenes: &p.scenes,
-        lenses: &p.lenses,
-        setups: &p.setups,
-        shadow_size: args.study.shadow_size,
-    };
+    let study = p.study(&args.study);
     let report = report::bench(&study, path, args.frames, args.warmup, &mut progress_bar())?;
     let warning = report.write(&p.out)?;
     finish(&report.markdown(), &p.out, warning);
@@ -870,15 +876,7 @@ fn run_compare(args: &CompareArgs) -> Result<()> {
     let supersample = args
         .supersample
         .unwrap_or_else(|| fisheye_rt::compare::supersample_factor(&p.ctx, args.study.size));
-    let study = Study {
-        ctx: &p.ctx,
-        scene: &p.scene,
-        scene_name: args.study.scene.clone(),
-        scenes: &p.scenes,
-        lenses: &p.lenses,
-        setups: &p.setups,
-        shadow_size: args.study.shadow_size,
-    };
+    let study = p.study(&args.study);
     let pose = p.scene.camera;
     let report = report::compare(
         &study,

@@ -135,6 +135,20 @@ fn log_bounds(values: impl Iterator<Item = f64>) -> (f64, f64) {
     (lo / 1.6, hi * 1.6)
 }
 
+/// The series' legend, boxed in the upper right corner.
+fn legend<'a, CT: plotters::coord::CoordTranslate>(
+    chart: &mut ChartContext<'a, BitMapBackend<'a>, CT>,
+) -> std::result::Result<(), Box<dyn std::error::Error>> {
+    chart
+        .configure_series_labels()
+        .position(SeriesLabelPosition::UpperRight)
+        .background_style(WHITE.mix(0.85))
+        .border_style(BLACK)
+        .label_font((FAMILY, 13))
+        .draw()?;
+    Ok(())
+}
+
 /// A tick label with three significant figures at most.
 fn tick(v: f64) -> String {
     let decimals = (2 - v.abs().max(1e-12).log10().floor() as i32).clamp(0, 6) as usize;
@@ -175,14 +189,7 @@ pub fn fps_along_path(path: &Path, title: &str, y_label: &str, series: &[Series]
                     PathElement::new(vec![(x, y), (x + 20, y)], colour.stroke_width(2))
                 });
         }
-        chart
-            .configure_series_labels()
-            .position(SeriesLabelPosition::UpperRight)
-            .background_style(WHITE.mix(0.85))
-            .border_style(BLACK)
-            .label_font((FAMILY, 13))
-            .draw()?;
-        Ok(())
+        legend(&mut chart)
     })
 }
 
@@ -250,13 +257,6 @@ pub fn time_against_error(
                     .legend(move |(x, y)| Circle::new((x + 10, y), 6, colour.filled()));
             }
         }
-        chart
-            .configure_series_labels()
-            .position(SeriesLabelPosition::UpperRight)
-            .background_style(WHITE.mix(0.85))
-            .border_style(BLACK)
-            .label_font((FAMILY, 13))
-            .draw()?;
-        Ok(())
+        legend(&mut chart)
     })
 }

@@ -76,9 +76,34 @@ impl Study<'_> {
         (setups, skipped)
     }
 
+    fn run(&self) -> Run {
+        Run {
+            machine: Machine::describe(self.ctx),
+            scene: self.scene_name.clone(),
+            triangles: self.scene.len(),
+            size: self
+                .lenses
+                .first()
+                .map_or(String::new(), |l| l.camera.size.to_string()),
+        }
+    }
+
     fn renderer(&self, lens: &LensRun, setup: Setup) -> Result<Renderer> {
         Renderer::new(self.ctx, &lens.camera, self.scenes, setup, self.shadow_size)
     }
+}
+
+/// Where a run was made, and of what: the head of both reports.
+#[derive(Serialize)]
+pub struct Run {
+    /// The machine.
+    pub machine: Machine,
+    /// The scene as named.
+    pub scene: String,
+    /// Its triangle count.
+    pub triangles: usize,
+    /// Image size.
+    pub size: String,
 }
 
 /// One setup's frames along the path.
@@ -114,14 +139,9 @@ impl BenchEntry {
 /// What `fisheye bench` measured.
 #[derive(Serialize)]
 pub struct BenchReport {
-    /// Where it ran.
-    pub machine: Machine,
-    /// The scene as named.
-    pub scene: String,
-    /// Its triangle count.
-    pub triangles: usize,
-    /// Image size.
-    pub size: String,
+    /// Where and on what it ran.
+    #[serde(flatten)]
+    pub run: Run,
     /// The camera path.
     pub path: String,
     /// Untimed frames rendered first, per setup.
@@ -205,13 +225,7 @@ pub fn bench(
         }
     }
     Ok(BenchReport {
-        machine: Machine::describe(study.ctx),
-        scene: study.scene_name.clone(),
-        triangles: study.scene.len(),
-        size: study
-            .lenses
-            .first()
-            .map_or(String::new(), |l| l.camera.size.to_string()),
+        run: study.run(),
         path: format!("{path:?} ({frames} frames)").to_lowercase(),
         warmup,
         method_note: BENCH_NOTE,
@@ -271,14 +285,9 @@ pub struct Verdict {
 /// What `fisheye compare` measured.
 #[derive(Serialize)]
 pub struct CompareReport {
-    /// Where it ran.
-    pub machine: Machine,
-    /// The scene as named.
-    pub scene: String,
-    /// Its triangle count.
-    pub triangles: usize,
-    /// Image size.
-    pub size: String,
+    /// Where and on what it ran.
+    #[serde(flatten)]
+    pub run: Run,
     /// The camera pose compared at.
     pub pose: String,
     /// Rays per pixel side of the supersampled reference.
@@ -419,13 +428,7 @@ pub fn compare(
         what: "done",
     });
     Ok(CompareReport {
-        machine: Machine::describe(study.ctx),
-        scene: study.scene_name.clone(),
-        triangles: study.scene.len(),
-        size: study
-            .lenses
-            .first()
-            .map_or(String::new(), |l| l.camera.size.to_string()),
+        run: study.run(),
         pose: format!(
             "eye {:?} looking at {:?}",
             pose.position.to_array(),
@@ -479,6 +482,29 @@ fn write_json(path: &Path, value: &impl Serialize) -> Result<()> {
     write_text(path, &(text + "\n"))
 }
 
+/// Writes `NAME.json` and `NAME.md` into `out`, then a plot per lens (in order, each once)
+/// with `draw`; returns why there are no plots, if there is no font for them.
+fn write_report<'a>(
+    out: &Path,
+    name: &str,
+    report: &impl Serialize,
+    markdown: &str,
+    lenses: impl Iterator<Item = &'a str>,
+    mut draw: impl FnMut(&str) -> Result<()>,
+) -> Result<Option<String>> {
+    write_json(&out.join(format!("{name}.json")), report)?;
+    write_text(&out.join(format!("{name}.md")), markdown)?;
+    if let Err(why) = plot::font() {
+        return Ok(Some(why));
+    }
+    let mut lenses: Vec<&str> = lenses.collect();
+    lenses.dedup();
+    for lens in lenses {
+        draw(lens)?;
+    }
+    Ok(None)
+}
+
 fn machine_lines(m: &Machine) -> String {
     format!(
         "- adapter: {}\n- driver: {}\n- CPU: {} ({} logical)\n- date: {}\n",
@@ -502,12 +528,12 @@ impl BenchReport {
     pub fn markdown(&self) -> String {
         let mut md = format!(
             "# fisheye bench: {} ({} triangles), {}, path {}, {} warm-up frames\n\n{}\n{}\n\n",
-            self.scene,
-            self.triangles,
-            self.size,
+            self.run.scene,
+            self.run.triangles,
+            self.run.size,
             self.path,
             self.warmup,
-            machine_lines(&self.machine),
+            machine_lines(&self.run.machine),
             self.method_note
         );
         let clock = if self.entries.iter().all(|e| e.gpu.is_some()) {
@@ -589,14 +615,8 @@ impl BenchReport {
     /// Writes `bench.json`, `bench.md` and one `fps.LENS.png` per lens into `out`; returns
     /// the plots' warning when they could not be drawn.
     pub fn write(&self, out: &Path) -> Result<Option<String>> {
-        write_json(&out.join("bench.json"), self)?;
-        write_text(&out.join("bench.md"), &self.markdown())?;
-        if let Err(why) = plot::font() {
-            return Ok(Some(why));
-        }
-        let mut lenses: Vec<&str> = self.entries.iter().map(|e| e.lens.as_str()).collect();
-        lenses.dedup();
-        for lens in lenses {
+        let lenses = self.entries.iter().map(|e| e.lens.as_str());
+        write_report(out, "bench", self, &self.markdown(), lenses, |lens| {
             let series: Vec<plot::Series> = self
                 .entries
                 .iter()
@@ -611,15 +631,14 @@ impl BenchReport {
                         .collect(),
                 })
                 .collect();
-            let title = format!("{}: {lens}, {}", self.scene, self.size);
+            let title = format!("{}: {lens}, {}", self.run.scene, self.run.size);
             plot::fps_along_path(
                 &out.join(format!("fps.{}.png", file_stem(lens))),
                 &title,
                 "frames per second (GPU time)",
                 &series,
-            )?;
-        }
-        Ok(None)
+            )
+        })
     }
 }
 
@@ -632,11 +651,11 @@ impl CompareReport {
     pub fn markdown(&self) -> String {
         let mut md = format!(
             "# fisheye compare: {} ({} triangles), {}, {}\n\n{}\n{} Supersampled reference: {}x{} rays per pixel. Times are medians of {} frames.\n\n",
-            self.scene,
-            self.triangles,
-            self.size,
+            self.run.scene,
+            self.run.triangles,
+            self.run.size,
             self.pose,
-            machine_lines(&self.machine),
+            machine_lines(&self.run.machine),
             self.method_note,
             self.supersample,
             self.supersample,
@@ -686,14 +705,8 @@ impl CompareReport {
     /// Writes `compare.json`, `compare.md` and one `tradeoff.LENS.png` per lens into `out`;
     /// returns the plots' warning when they could not be drawn.
     pub fn write(&self, out: &Path) -> Result<Option<String>> {
-        write_json(&out.join("compare.json"), self)?;
-        write_text(&out.join("compare.md"), &self.markdown())?;
-        if let Err(why) = plot::font() {
-            return Ok(Some(why));
-        }
-        let mut lenses: Vec<&str> = self.entries.iter().map(|e| e.lens.as_str()).collect();
-        lenses.dedup();
-        for lens in lenses {
+        let lenses = self.entries.iter().map(|e| e.lens.as_str());
+        write_report(out, "compare", self, &self.markdown(), lenses, |lens| {
             let points: Vec<plot::TradeOff> = self
                 .entries
                 .iter()
@@ -706,14 +719,13 @@ impl CompareReport {
                     pareto: e.pareto,
                 })
                 .collect();
-            let title = format!("{}: {lens}, {}", self.scene, self.size);
+            let title = format!("{}: {lens}, {}", self.run.scene, self.run.size);
             plot::time_against_error(
                 &out.join(format!("tradeoff.{}.png", file_stem(lens))),
                 &title,
                 "MSE vs supersampled reference (log)",
                 &points,
-            )?;
-        }
-        Ok(None)
+            )
+        })
     }
 }
