@@ -377,7 +377,14 @@ pub fn compare(
         let first = entries.len();
         for &setup in &setups {
             let what = format!("{} {}", lens.name, setup.label());
-            let renderer = study.renderer(lens, setup)?;
+            // RT is the reference's own renderer: no second pipeline for it.
+            let own;
+            let renderer = if setup == rt {
+                &reference_renderer
+            } else {
+                own = study.renderer(lens, setup)?;
+                &own
+            };
             let mut times = Vec::with_capacity(frames);
             for k in 0..=frames {
                 progress(Progress {
