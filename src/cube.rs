@@ -16,7 +16,7 @@ use crate::gpu::{
     texture_array, uniform_entry,
 };
 use crate::lens::gpu::{DirectionSource, lens_constants, params_buffer};
-use crate::lens::{ImageSize, Lens, LensCamera, LensModel};
+use crate::lens::{ClassicLens, ImageSize, LensCamera, LensModel};
 use crate::raster::{RasterFaces, RasterMethod};
 use crate::scene::Camera;
 use crate::shader;
@@ -280,7 +280,7 @@ impl CubeSettings {
 /// it: `(size + 2)²` pixels, 90° across the inner `size`.
 pub fn face_camera(size: u32) -> Result<LensCamera> {
     let side = bordered(size);
-    let lens = Lens::new(LensModel::Rectilinear, bordered_focal(size))?;
+    let lens = ClassicLens::new(LensModel::Rectilinear, bordered_focal(size))?;
     Ok(LensCamera::new(lens, ImageSize::new(side, side)?))
 }
 

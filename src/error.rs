@@ -23,6 +23,46 @@ pub enum LensError {
         /// What is wrong with it.
         reason: String,
     },
+    /// A field of view the model cannot reach: its mapping turns back (a non-monotonic
+    /// calibration) or its domain ends before.
+    #[error(
+        "{model}: cannot reach the requested {fov}° field of view: {why} at a {reach:.2}° field \
+         of view"
+    )]
+    Unreachable {
+        /// The model's spec name.
+        model: &'static str,
+        /// The requested full field of view, degrees.
+        fov: f64,
+        /// The widest full field of view it reaches, degrees.
+        reach: f64,
+        /// Why it ends there.
+        why: &'static str,
+    },
+    /// A calibration file that cannot be read.
+    #[error("calibration file {path}: {reason}")]
+    Calibration {
+        /// The file.
+        path: String,
+        /// What is wrong with it.
+        reason: String,
+    },
+    /// A calibration format that cannot express a model.
+    #[error("the {format} calibration format cannot express {model}")]
+    Unsupported {
+        /// The format's name.
+        format: &'static str,
+        /// The model's name.
+        model: &'static str,
+    },
+    /// A model that needs a parameter that was not given.
+    #[error("{model} needs {what}")]
+    Needs {
+        /// The model's spec name.
+        model: &'static str,
+        /// What it needs.
+        what: &'static str,
+    },
     /// An image size of 0 or beyond what we can address.
     #[error("image size {text:?}: {reason}")]
     ImageSize {

@@ -3,8 +3,9 @@
 //! Renders images through fisheye and other wide-angle lenses by ray tracing in wgpu compute
 //! shaders, on any GPU (or on Mesa's lavapipe without one).
 //!
-//! - [`lens`]: lens models (the f64 reference and the specs and presets users name them by)
-//!   and their WGSL twin on the GPU ([`lens::gpu`]).
+//! - [`lens`]: lens models, classic and calibrated (the f64 reference and the specs, presets
+//!   and calibration files users name them by), and their WGSL twin on the GPU
+//!   ([`lens::gpu`]).
 //! - [`gpu`]: the one place that creates the adapter and device.
 //! - [`shader`]: how WGSL files are assembled into modules.
 //! - [`scene`], [`bvh`], [`trace`]: scenes (built-in and OBJ), the CWBVH, and the GPU tracer

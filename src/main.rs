@@ -1,7 +1,7 @@
 //! `fisheye`: the command-line tool. See `fisheye --help` and the README.
 
 use std::io::{BufRead, Write};
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use anyhow::{Context, Result, bail};
@@ -11,9 +11,11 @@ use fisheye_rt::bvh::BvhQuality;
 use fisheye_rt::cube::{CubeMap, CubeMethod, CubeSettings, FACES};
 use fisheye_rt::demo::{LensDemo, save_png};
 use fisheye_rt::gpu::{GpuContext, Queries};
+use fisheye_rt::lens::calib::{self, CalibFormat, Calibration};
 use fisheye_rt::lens::gpu::{DirectionSource, LensPoints};
 use fisheye_rt::lens::{
-    DirectionFormula, ImageSize, LensCamera, LensModel, PRESET_FOV_DEGREES, PRESETS, parse_spec,
+    CalibratedModel, DirectionFormula, ImageSize, LensCamera, LensModel, PRESET_FOV_DEGREES,
+    PRESETS, parse_spec,
 };
 use fisheye_rt::raster::RasterMethod;
 use fisheye_rt::report::{self, LensRun, Progress, Study};
@@ -71,6 +73,8 @@ struct RenderArgs {
     /// Image size in pixels, WIDTHxHEIGHT.
     #[arg(long, default_value = "1024x768")]
     size: ImageSize,
+    #[command(flatten)]
+    calib: CalibArgs,
     /// Camera pose instead of the scene's: `X,Y,Z:LX,LY,LZ` (eye and look-at point, y up),
     /// or `path:S` for the point S ∈ [0, 1] along the scene file's camera path.
     #[arg(long)]
@@ -279,15 +283,67 @@ impl From<Formula> for DirectionFormula {
     }
 }
 
+/// A calibration file in place of `--lens` and `--size`.
+#[derive(clap::Args)]
+struct CalibArgs {
+    /// Calibration file (OpenCV YAML/XML, Kalibr camchain YAML or Basalt JSON): render
+    /// through that camera at its resolution, instead of --lens and --size.
+    #[arg(long, conflicts_with_all = ["lens", "size"])]
+    calib: Option<PathBuf>,
+    /// Which camera of a multi-camera calibration file (0 is the first).
+    #[arg(long, default_value_t = 0, requires = "calib")]
+    calib_camera: usize,
+}
+
+impl CalibArgs {
+    /// The camera of `--calib`, or else `--lens` (required then) at `size`; warns when the
+    /// lens's field of view is clipped where its mapping turns.
+    fn camera(&self, lens: Option<&str>, size: ImageSize) -> Result<LensCamera> {
+        let camera = match &self.calib {
+            Some(path) => {
+                let cameras = calib::read(path)?;
+                let Some(c) = cameras.get(self.calib_camera) else {
+                    bail!(
+                        "{} holds {} camera(s); --calib-camera {} is not one",
+                        path.display(),
+                        cameras.len(),
+                        self.calib_camera
+                    );
+                };
+                LensCamera::new(c.lens, c.size)
+            }
+            None => {
+                let Some(spec) = lens else {
+                    bail!("give a lens: --lens SPEC or --calib FILE");
+                };
+                LensCamera::new(parse_spec(spec)?, size)
+            }
+        };
+        if let Some(turn) = camera.lens.calibrated().and_then(|l| l.turns_at()) {
+            eprintln!(
+                "warning: {}: the mapping stops increasing at θ = {:.2}°, so the field of view \
+                 is clipped to {:.2}° (pixels beyond have no ray)",
+                camera.lens.name(),
+                turn.to_degrees(),
+                2.0 * turn.to_degrees()
+            );
+        }
+        Ok(camera)
+    }
+}
+
 #[derive(clap::Args)]
 struct CameraArgs {
     /// Lens spec: a model with parameters (`equisolid:f=0.93`, `general:f=1,k1=0.5,k2=0.5`,
-    /// `equidistant:f=0.42,fov=180`) or a preset (`samyang-7.5mm`); see `fisheye lens list`.
+    /// `equidistant:f=0.42,fov=180`, `kb:fx=190,cx=255,cy=255,k1=0.003`), or a preset
+    /// (`samyang-7.5mm`); see `fisheye lens list`. Or give --calib.
     #[arg(long)]
-    lens: String,
+    lens: Option<String>,
     /// Image size in pixels, WIDTHxHEIGHT.
     #[arg(long, default_value = "1024x768")]
     size: ImageSize,
+    #[command(flatten)]
+    calib: CalibArgs,
     /// How directions are built from θ: the stable default, or the thesis's formula.
     #[arg(long, value_enum, default_value = "stable")]
     formula: Formula,
@@ -298,8 +354,8 @@ struct CameraArgs {
 
 impl CameraArgs {
     fn camera(&self) -> Result<LensCamera> {
-        let lens = parse_spec(&self.lens)?;
-        Ok(LensCamera::new(lens, self.size).with_formula(self.formula.into()))
+        let camera = self.calib.camera(self.lens.as_deref(), self.size)?;
+        Ok(camera.with_formula(self.formula.into()))
     }
 }
 
@@ -313,6 +369,22 @@ enum LensCommand {
     Unproject(CameraArgs),
     /// Read `dx dy dz` lines on stdin and write the pixel `px py` each lands on, or `none`.
     Project(CameraArgs),
+    /// Fit the thesis's classic mappings (equidistant, equisolid, orthographic,
+    /// stereographic) to a calibrated lens over the angles its image shows, and print each
+    /// one's focal length and radial residual in pixels, best first.
+    Fit(CameraArgs),
+    /// Write a lens (--lens SPEC at --size, or --calib FILE) as a calibration file: OpenCV
+    /// YAML or XML, a Kalibr camchain or Basalt JSON.
+    Convert {
+        #[command(flatten)]
+        camera: CameraArgs,
+        /// The output format.
+        #[arg(long, value_enum)]
+        format: Format,
+        /// The file to write.
+        #[arg(long, short)]
+        out: PathBuf,
+    },
     /// Draw what lenses do to the sphere of directions (10° grid, rings every 30° off the
     /// axis), one PNG per lens.
     Demo {
@@ -411,6 +483,12 @@ fn run(cli: Cli) -> Result<()> {
             }
             LensCommand::Unproject(args) => unproject(&args),
             LensCommand::Project(args) => project(&args),
+            LensCommand::Fit(args) => fit(&args),
+            LensCommand::Convert {
+                camera,
+                format,
+                out,
+            } => convert(&camera, format.into(), &out),
             LensCommand::Demo { lens, size, out } => demo(lens, size, out),
         },
     }
@@ -437,9 +515,9 @@ fn render(args: &RenderArgs) -> Result<()> {
             Traversal::Software
         },
     };
-    let (size, out) = (args.size, &args.out);
+    let camera = args.calib.camera(Some(&args.lens), args.size)?;
+    let (size, out) = (camera.size, &args.out);
     let scene_spec = &args.scene;
-    let camera = LensCamera::new(parse_spec(&args.lens)?, size);
     let mut scene = load_scene(scene_spec)?;
     if let Some(text) = &args.camera {
         scene.camera = parse_camera(text, &scene)?;
@@ -589,6 +667,13 @@ fn list() {
     ] {
         println!("  {:<14} {}", model.name(), model.formula());
     }
+    println!(
+        "\ncalibrated models (spec: NAME:fx=FX,fy=FY,cx=CX,cy=CY,...[,fov=DEGREES], pixels, \
+         OpenCV's centre convention):"
+    );
+    for ((name, keys), example) in CalibratedModel::NAMES.iter().zip(CalibratedModel::EXAMPLES) {
+        println!("  {name:<14} {keys}\n  {:<14} e.g. {example}", "");
+    }
     println!("\npresets (limited to {PRESET_FOV_DEGREES}°; spec: NAME[:f=F,fov=DEGREES]):");
     for p in PRESETS {
         println!(
@@ -670,6 +755,80 @@ fn project(args: &CameraArgs) -> Result<()> {
         Some(p) => format!("{:.6} {:.6}", p.x, p.y),
         None => "none".into(),
     }))
+}
+
+/// Calibration file formats, for `lens convert`.
+#[derive(Clone, Copy, ValueEnum)]
+enum Format {
+    OpencvYaml,
+    OpencvXml,
+    Kalibr,
+    Basalt,
+}
+
+impl From<Format> for CalibFormat {
+    fn from(f: Format) -> Self {
+        match f {
+            Format::OpencvYaml => CalibFormat::OpenCvYaml,
+            Format::OpencvXml => CalibFormat::OpenCvXml,
+            Format::Kalibr => CalibFormat::Kalibr,
+            Format::Basalt => CalibFormat::Basalt,
+        }
+    }
+}
+
+fn fit(args: &CameraArgs) -> Result<()> {
+    let camera = args.camera()?;
+    let Some(lens) = camera.lens.calibrated() else {
+        bail!(
+            "{} is already a classic lens; fit takes a calibrated one",
+            camera.lens
+        );
+    };
+    let angles = fisheye_rt::lens::fit::fitted_angles(lens, camera.size);
+    let widest = angles.last().copied().unwrap_or(0.0).to_degrees();
+    println!(
+        "{} at {}: classic mappings fitted over θ ≤ {widest:.1}° (a {:.1}° field)",
+        lens.model().name(),
+        camera.size,
+        2.0 * widest
+    );
+    println!(
+        "{:<14} {:>10} {:>10} {:>12} {:>12}",
+        "model", "f (px)", "f (norm.)", "rms (px)", "max (px)"
+    );
+    for f in fisheye_rt::lens::fit::fit_classic(lens, camera.size) {
+        println!(
+            "{:<14} {:>10.3} {:>10.4} {:>12.4} {:>12.4}",
+            f.model.name(),
+            f.f_pixels,
+            f.f_pixels * 2.0 / f64::from(camera.size.width),
+            f.rms,
+            f.max
+        );
+    }
+    Ok(())
+}
+
+fn convert(args: &CameraArgs, format: CalibFormat, out: &Path) -> Result<()> {
+    let camera = args.camera()?;
+    let Some(lens) = camera.lens.calibrated() else {
+        bail!(
+            "{} is a classic lens; calibration files hold calibrated models (see `fisheye lens \
+             list`)",
+            camera.lens
+        );
+    };
+    let text = calib::write(
+        &Calibration {
+            lens: *lens,
+            size: camera.size,
+        },
+        format,
+    )?;
+    std::fs::write(out, text).with_context(|| format!("writing {}", out.display()))?;
+    println!("wrote {} ({})", out.display(), format.name());
+    Ok(())
 }
 
 /// One representative lens per model, then every preset.

@@ -11,8 +11,9 @@ use crate::scene::Surface;
 use crate::trace;
 
 /// Every WGSL file of the project, by name (its file stem under `wgsl/`).
-pub const FILES: [(&str, &str); 20] = [
+pub const FILES: [(&str, &str); 21] = [
     ("math", include_str!("../wgsl/math.wgsl")),
+    ("calibrated", include_str!("../wgsl/calibrated.wgsl")),
     ("triangles", include_str!("../wgsl/triangles.wgsl")),
     ("bvh", include_str!("../wgsl/bvh.wgsl")),
     ("bvh_rq", include_str!("../wgsl/bvh_rq.wgsl")),
@@ -49,6 +50,7 @@ pub fn constants() -> Vec<(String, u32)> {
         ("WORKGROUP_1D".to_string(), WORKGROUP_1D),
     ];
     out.extend(LensKind::ALL.iter().map(|k| (k.const_name(), *k as u32)));
+    out.push(("NEWTON_STEPS".into(), crate::lens::gpu::NEWTON_STEPS));
     for formula in [DirectionFormula::Stable, DirectionFormula::Thesis] {
         let name = format!("FORMULA_{}", formula.name().to_uppercase());
         out.push((name, formula_id(formula)));

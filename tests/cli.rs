@@ -3,7 +3,7 @@
 use std::io::Write;
 use std::process::{Command, Output, Stdio};
 
-use fisheye_rt::lens::{ImageSize, LensCamera, PRESETS, parse_spec};
+use fisheye_rt::lens::{CalibratedModel, ImageSize, LensCamera, PRESETS, parse_spec};
 use glam::{DVec2, DVec3};
 
 fn fisheye(args: &[&str], stdin: &str) -> Output {
@@ -51,6 +51,12 @@ fn lens_list_names_every_model_and_preset() {
     }
     for preset in PRESETS {
         assert!(text.contains(preset.name), "{} missing", preset.name);
+    }
+    for ((name, _), example) in CalibratedModel::NAMES.iter().zip(CalibratedModel::EXAMPLES) {
+        assert!(
+            text.contains(name) && text.contains(example),
+            "{name} missing"
+        );
     }
 }
 
@@ -585,4 +591,150 @@ fn bench_and_compare_write_their_reports_into_a_new_folder() {
     let (ok, _, errors) = run(&["compare", "--supersample", "9"]);
     assert!(!ok && errors.contains("--supersample 9"), "{errors}");
     std::fs::remove_dir_all(dir).unwrap();
+}
+
+/// `--calib`: a Kalibr file drives `lens unproject`/`project` (f64 and GPU agree with the
+/// library's reading of it), `lens convert` writes it in another format that reads back the
+/// same, and `render` renders at the calibration's resolution; wrong uses are clear errors.
+#[test]
+fn calibration_files_drive_lens_and_render() {
+    let dir = std::env::temp_dir().join(format!("fisheye-cli-calib-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let kalibr = dir.join("camchain.yaml");
+    std::fs::write(
+        &kalibr,
+        "cam0:\n  camera_model: ds\n  intrinsics: [-0.18, 0.59, 40.0, 39.5, 47.5, 35.5]\n  \
+         distortion_model: none\n  resolution: [96, 72]\ncam1:\n  camera_model: pinhole\n  \
+         intrinsics: [60, 60, 47.5, 35.5]\n  distortion_model: equidistant\n  \
+         distortion_coeffs: [0.01, -0.002, 0, 0]\n  resolution: [96, 72]\n",
+    )
+    .unwrap();
+    let path = kalibr.to_str().unwrap();
+    let library = fisheye_rt::lens::calib::read(&kalibr).unwrap();
+    for (index, camera) in library.iter().enumerate() {
+        let cam = LensCamera::new(camera.lens, camera.size);
+        let pixels = [
+            DVec2::new(48.0, 36.0),
+            DVec2::new(10.25, 60.5),
+            DVec2::new(0.5, 0.5),
+        ];
+        let input: String = pixels
+            .iter()
+            .map(|p| format!("{} {}\n", p.x, p.y))
+            .collect();
+        let index = index.to_string();
+        for gpu in [false, true] {
+            let mut args = vec![
+                "lens",
+                "unproject",
+                "--calib",
+                path,
+                "--calib-camera",
+                &index,
+            ];
+            if gpu {
+                args.push("--gpu");
+            }
+            let text = stdout(&fisheye(&args, &input));
+            for (line, p) in text.lines().zip(pixels) {
+                let want = cam.unproject(p).unwrap();
+                let got = DVec3::from_slice(&numbers(line));
+                assert!(
+                    (got - want).length() < 1e-5,
+                    "{index} gpu={gpu}: {p} → {got} vs {want}"
+                );
+            }
+            let dirs: String = pixels
+                .iter()
+                .map(|&p| cam.unproject(p).unwrap())
+                .map(|d| format!("{} {} {}\n", d.x, d.y, d.z))
+                .collect();
+            args[1] = "project";
+            let text = stdout(&fisheye(&args, &dirs));
+            for (line, p) in text.lines().zip(pixels) {
+                let got = DVec2::from_slice(&numbers(line));
+                assert!(
+                    got.distance(p) < 1e-3,
+                    "{index} gpu={gpu}: {p} came back as {got}"
+                );
+            }
+        }
+    }
+    let json = dir.join("basalt.json");
+    let text = stdout(&fisheye(
+        &[
+            "lens",
+            "convert",
+            "--calib",
+            path,
+            "--format",
+            "basalt",
+            "-o",
+            json.to_str().unwrap(),
+        ],
+        "",
+    ));
+    assert!(text.contains("basalt"), "{text}");
+    assert_eq!(fisheye_rt::lens::calib::read(&json).unwrap()[0], library[0]);
+
+    let png = dir.join("ds.png");
+    let text = stdout(&fisheye(
+        &[
+            "render",
+            "builtin:default",
+            "--calib",
+            path,
+            "-o",
+            png.to_str().unwrap(),
+        ],
+        "",
+    ));
+    assert!(text.contains("at 96x72"), "{text}");
+    let image = image::open(&png).unwrap();
+    assert_eq!((image.width(), image.height()), (96, 72));
+
+    for (args, needle) in [
+        (
+            vec!["render", "--calib", path, "--size", "10x10"],
+            "cannot be used with",
+        ),
+        (
+            vec!["lens", "unproject", "--calib", path, "--calib-camera", "2"],
+            "holds 2 camera(s)",
+        ),
+        (vec!["lens", "project"], "give a lens"),
+        (
+            vec![
+                "lens",
+                "convert",
+                "--lens",
+                "equidistant:f=1",
+                "--format",
+                "kalibr",
+                "-o",
+                "x",
+            ],
+            "classic lens",
+        ),
+        (
+            vec![
+                "lens",
+                "unproject",
+                "--lens",
+                "kb:fx=300,cx=1,cy=1,k1=-0.3,fov=180",
+            ],
+            "stops increasing",
+        ),
+    ] {
+        let output = fisheye(&args, "");
+        assert!(!output.status.success(), "{args:?} succeeded");
+        let message = String::from_utf8_lossy(&output.stderr);
+        assert!(message.contains(needle), "{args:?}: {message}");
+    }
+    let clipped = fisheye(
+        &["lens", "unproject", "--lens", "kb:fx=300,cx=1,cy=1,k1=-0.3"],
+        "",
+    );
+    assert!(String::from_utf8_lossy(&clipped.stderr).contains("warning: kb: the mapping stops"));
+    std::fs::remove_dir_all(&dir).unwrap();
 }

@@ -24,6 +24,12 @@ fn builtin_scenes_match_the_reference() {
         ("default", "rectilinear:f=0.8"),
         ("grid", "samyang-7.5mm"),
         ("many-small", "equidistant:f=0.3"),
+        // Calibrated cameras: TUM-VI's Kannala–Brandt lens and a double sphere, at this size.
+        (
+            "default",
+            "kb:fx=47.7,cx=63.5,cy=47.5,k1=0.0034824,k2=0.00071503,k3=-0.0020532,k4=0.00020294",
+        ),
+        ("grid", "ds:fx=40,fy=39,cx=63.5,cy=47.5,xi=-0.18,alpha=0.59"),
     ] {
         let scene = builtin::scene(name).unwrap();
         let (gpu, cpu) = both(&scene, &camera(spec, 128, 96));

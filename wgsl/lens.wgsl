@@ -2,6 +2,7 @@
 // Conventions (see src/lens/camera.rs): normalized coordinates have half-width 1 and y up;
 // directions are camera space, x right, y down, z forward; pixels have a top-left origin.
 #import math
+#import calibrated
 
 // Mirrors `fisheye_rt::lens::gpu::LensParams` (a test checks the layouts agree).
 struct LensParams {
@@ -18,6 +19,18 @@ struct LensParams {
     height: u32,
     // Pixel (i, j) has a ray iff (2i+1-W)² + (H-2j-1)² ≤ mask_limit: exact, as on the CPU.
     mask_limit: u32,
+    // Calibrated models (wgsl/calibrated.wgsl): fx, fy, cx, cy in pixels; r_max and theta_max
+    // above bound their domain, in model coordinates.
+    intrinsics: vec4<f32>,
+    // The model's parameters, packed per kind (see wgsl/calibrated.wgsl).
+    coefficients: array<vec4<f32>, 2>,
+    // Scaramuzza's affine stretch (c, d, e).
+    affine: vec4<f32>,
+}
+
+// Whether LENS_KIND is a calibrated model (they follow the classic kinds).
+fn lens_is_calibrated() -> bool {
+    return LENS_KIND >= LENS_KANNALA_BRANDT;
 }
 
 // Which mapping (a LENS_* id) and which direction formula (a FORMULA_* id) a pipeline runs.
@@ -142,6 +155,9 @@ fn lens_direction(lens: LensParams, n: vec2<f32>) -> vec3<f32> {
 
 // Ray direction of pixel (i, j)'s centre; w = 1 with a ray, all zero where masked.
 fn lens_pixel_ray(lens: LensParams, pixel: vec2<u32>) -> vec4<f32> {
+    if lens_is_calibrated() {
+        return cal_unproject(lens, vec2<f32>(pixel) + 0.5);
+    }
     if !lens_pixel_inside(lens, pixel) {
         return vec4<f32>(0.0);
     }
@@ -175,6 +191,9 @@ fn lens_radius(lens: LensParams, theta: f32) -> f32 {
 // (inside the field of view and the image rectangle), all zero otherwise. Past 180° a
 // direction has several images; this is the one with θ ≤ π (straight back: azimuth 0).
 fn lens_project(lens: LensParams, dir: vec3<f32>) -> vec3<f32> {
+    if lens_is_calibrated() {
+        return lens_in_image(lens, cal_project(lens, dir));
+    }
     let d = normalize(dir);
     let rho = length(d.xy);
     let theta = atan2_pos(rho, d.z);
@@ -203,9 +222,27 @@ fn lens_project(lens: LensParams, dir: vec3<f32>) -> vec3<f32> {
     }
     let w = f32(lens.width);
     let h = f32(lens.height);
-    let p = vec2<f32>((n.x + 1.0) * w / 2.0, (h - n.y * w) / 2.0);
-    if p.x >= 0.0 && p.x <= w && p.y >= 0.0 && p.y <= h {
-        return vec3<f32>(p, 1.0);
+    return lens_in_image(lens, vec3<f32>((n.x + 1.0) * w / 2.0, (h - n.y * w) / 2.0, 1.0));
+}
+
+// A projected point (z = 1 when it has one) kept only when it lands inside the image.
+fn lens_in_image(lens: LensParams, p: vec3<f32>) -> vec3<f32> {
+    if p.z == 1.0 && p.x >= 0.0 && p.x <= f32(lens.width) && p.y >= 0.0
+        && p.y <= f32(lens.height) {
+        return p;
     }
     return vec3<f32>(0.0);
+}
+
+// The direction through a continuous pixel position: xyz, w = 1; all zero where it has none.
+fn lens_unproject(lens: LensParams, p: vec2<f32>) -> vec4<f32> {
+    if lens_is_calibrated() {
+        return cal_unproject(lens, p);
+    }
+    let n = lens_normalized(lens, p);
+    // `<=` is false for NaN: non-finite input has no ray.
+    if length(n) <= lens.r_max {
+        return vec4<f32>(lens_direction(lens, n), 1.0);
+    }
+    return vec4<f32>(0.0);
 }

@@ -13,13 +13,7 @@ fn unproject(@builtin(global_invocation_id) id: vec3<u32>) {
     if id.x >= arrayLength(&points) {
         return;
     }
-    let n = lens_normalized(lens, points[id.x].xy);
-    // `<=` is false for NaN: non-finite input has no ray.
-    if length(n) <= lens.r_max {
-        results[id.x] = vec4<f32>(lens_direction(lens, n), 1.0);
-    } else {
-        results[id.x] = vec4<f32>(0.0);
-    }
+    results[id.x] = lens_unproject(lens, points[id.x].xy);
 }
 
 @compute @workgroup_size(WORKGROUP_1D)

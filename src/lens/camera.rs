@@ -15,6 +15,11 @@
 //! `N = (2i + 1 - W)² + (H - 2j - 1)²`, so the test is the exact integer comparison
 //! `N ≤ N_max` ([`LensCamera::mask_limit`]). The GPU runs the same integer test, so the CPU and
 //! GPU masks agree bit for bit, also at the domain edge.
+//!
+//! Calibrated lenses ([`super::CalibratedLens`]) have pixel intrinsics and a domain that need
+//! not be a circle in pixels: a pixel has a ray iff its unprojection's domain test passes, in
+//! f64 here and in f32 on the GPU, so the masks can differ for pixels within rounding of the
+//! domain edge (none did in the tests).
 
 use glam::{DVec2, DVec3};
 
@@ -121,13 +126,34 @@ pub struct LensCamera {
 }
 
 impl LensCamera {
-    /// A camera with the default (stable) direction formula.
-    pub fn new(lens: Lens, size: ImageSize) -> Self {
+    /// A camera with the default (stable) direction formula. A calibrated lens's intrinsics
+    /// are in pixels of this image.
+    pub fn new(lens: impl Into<Lens>, size: ImageSize) -> Self {
         Self {
-            lens,
+            lens: lens.into(),
             size,
             formula: DirectionFormula::Stable,
         }
+    }
+
+    /// The same lens on an image `factor` times larger each way: the same field, with
+    /// `factor²` times the pixels (a calibrated lens's intrinsics scale with it).
+    pub fn scaled(&self, factor: u32) -> Result<Self, LensError> {
+        let size = ImageSize::new(
+            self.size.width.saturating_mul(factor),
+            self.size.height.saturating_mul(factor),
+        )?;
+        let lens = match self.lens {
+            Lens::Classic(lens) => Lens::Classic(lens),
+            Lens::Calibrated(lens) => {
+                Lens::Calibrated(lens.scaled(f64::from(factor), f64::from(factor)))
+            }
+        };
+        Ok(Self {
+            lens,
+            size,
+            ..*self
+        })
     }
 
     /// The same camera with another direction formula.
@@ -156,8 +182,13 @@ impl LensCamera {
         (nx * nx + ny * ny) as u64
     }
 
-    /// `N_max`: pixel `(i, j)` has a ray iff its [`Self::pixel_radius_units`] is ≤ this.
+    /// `N_max`: pixel `(i, j)` has a ray iff its [`Self::pixel_radius_units`] is ≤ this. Only
+    /// classic lenses have this exact integer mask; a calibrated lens's pixel has a ray iff
+    /// its unprojection's domain test passes (0 here).
     pub fn mask_limit(&self) -> u32 {
+        if self.lens.calibrated().is_some() {
+            return 0;
+        }
         let r_max = self.lens.r_max();
         let w = f64::from(self.size.width);
         let inside = |n: u64| (n as f64).sqrt() / w <= r_max;
@@ -178,6 +209,9 @@ impl LensCamera {
 
     /// The direction of the ray through pixel `(i, j)`'s centre, `None` where it is masked.
     pub fn pixel_direction(&self, i: u32, j: u32) -> Option<DVec3> {
+        if let Lens::Calibrated(lens) = &self.lens {
+            return lens.unproject(DVec2::new(f64::from(i) + 0.5, f64::from(j) + 0.5));
+        }
         if self.pixel_radius_units(i, j) > u64::from(self.mask_limit()) {
             return None;
         }
@@ -188,6 +222,13 @@ impl LensCamera {
     /// The direction of every pixel centre, row by row; `None` where masked. This is the
     /// thesis's direction table, in f64.
     pub fn directions(&self) -> Vec<Option<DVec3>> {
+        if self.lens.calibrated().is_some() {
+            let (w, h) = (self.size.width, self.size.height);
+            return (0..h)
+                .flat_map(|j| (0..w).map(move |i| (i, j)))
+                .map(|(i, j)| self.pixel_direction(i, j))
+                .collect();
+        }
         let limit = u64::from(self.mask_limit());
         let mut out = Vec::with_capacity(self.size.pixels());
         for j in 0..self.size.height {
@@ -204,6 +245,9 @@ impl LensCamera {
     /// The direction through a continuous pixel position, `None` outside the lens's domain
     /// or field of view (or for non-finite input).
     pub fn unproject(&self, pixel: DVec2) -> Option<DVec3> {
+        if let Lens::Calibrated(lens) = &self.lens {
+            return lens.unproject(pixel);
+        }
         let n = self.normalized(pixel);
         let r = n.length();
         (r.is_finite() && r <= self.lens.r_max()).then(|| self.direction_inside(n))
@@ -239,6 +283,11 @@ impl LensCamera {
     /// For lenses past 180° a direction has several images; this returns the one with
     /// θ ≤ π (for the direction straight back, the one at azimuth 0).
     pub fn project(&self, dir: DVec3) -> Option<DVec2> {
+        let (w, h) = (f64::from(self.size.width), f64::from(self.size.height));
+        let inside = |p: DVec2| (0.0..=w).contains(&p.x) && (0.0..=h).contains(&p.y);
+        if let Lens::Calibrated(lens) = &self.lens {
+            return lens.project(dir).filter(|p| inside(*p));
+        }
         let rho = dir.x.hypot(dir.y);
         if !(dir.is_finite() && dir.length_squared() > 0.0) {
             return None;
@@ -250,8 +299,6 @@ impl LensCamera {
         } else {
             DVec2::new(r * dir.x / rho, -r * dir.y / rho)
         };
-        let p = self.denormalized(n);
-        let (w, h) = (f64::from(self.size.width), f64::from(self.size.height));
-        ((0.0..=w).contains(&p.x) && (0.0..=h).contains(&p.y)).then_some(p)
+        Some(self.denormalized(n)).filter(|p| inside(*p))
     }
 }

@@ -6,7 +6,7 @@ use bytemuck::{Pod, Zeroable};
 use glam::{DVec2, DVec3, Vec2, Vec3};
 use wgpu::util::DeviceExt;
 
-use super::{Family, LensCamera, LensModel};
+use super::{CalibratedModel, Family, Lens, LensCamera, LensModel};
 use crate::error::Result;
 use crate::gpu::{GpuContext, dispatch_over_image};
 use crate::shader::{self, WORKGROUP_1D};
@@ -30,11 +30,25 @@ pub enum LensKind {
     GeneralTan = 5,
     /// `r = (f/k1) sin(|k2| θ)`.
     GeneralSin = 6,
+    /// Kannala–Brandt (calibrated).
+    KannalaBrandt = 7,
+    /// Double sphere (calibrated).
+    DoubleSphere = 8,
+    /// Extended unified, and unified as its β = 1 case (calibrated).
+    ExtendedUnified = 9,
+    /// Devernay and Faugeras's FOV model (calibrated).
+    FovModel = 10,
+    /// Scaramuzza's polynomial (calibrated).
+    Scaramuzza = 11,
+    /// f-theta (calibrated).
+    FTheta = 12,
+    /// Radial-tangential (calibrated).
+    RadTan = 13,
 }
 
 impl LensKind {
     /// Every kind, for emitting the WGSL constants.
-    pub const ALL: [LensKind; 7] = [
+    pub const ALL: [LensKind; 14] = [
         Self::Rectilinear,
         Self::Stereographic,
         Self::Equidistant,
@@ -42,10 +56,33 @@ impl LensKind {
         Self::Orthographic,
         Self::GeneralTan,
         Self::GeneralSin,
+        Self::KannalaBrandt,
+        Self::DoubleSphere,
+        Self::ExtendedUnified,
+        Self::FovModel,
+        Self::Scaramuzza,
+        Self::FTheta,
+        Self::RadTan,
     ];
 
-    /// The code path of a model.
-    pub fn of(model: LensModel) -> Self {
+    /// The code path of a lens.
+    pub fn of(lens: &Lens) -> Self {
+        let model = match lens {
+            Lens::Classic(lens) => lens.model(),
+            Lens::Calibrated(lens) => {
+                return match lens.model() {
+                    CalibratedModel::KannalaBrandt { .. } => Self::KannalaBrandt,
+                    CalibratedModel::DoubleSphere { .. } => Self::DoubleSphere,
+                    CalibratedModel::Unified { .. } | CalibratedModel::ExtendedUnified { .. } => {
+                        Self::ExtendedUnified
+                    }
+                    CalibratedModel::Fov { .. } => Self::FovModel,
+                    CalibratedModel::Scaramuzza { .. } => Self::Scaramuzza,
+                    CalibratedModel::FTheta { .. } => Self::FTheta,
+                    CalibratedModel::RadTan { .. } => Self::RadTan,
+                };
+            }
+        };
         match model {
             LensModel::Rectilinear => Self::Rectilinear,
             LensModel::Stereographic => Self::Stereographic,
@@ -70,10 +107,24 @@ impl LensKind {
             Self::Orthographic => "ORTHOGRAPHIC",
             Self::GeneralTan => "GENERAL_TAN",
             Self::GeneralSin => "GENERAL_SIN",
+            Self::KannalaBrandt => "KANNALA_BRANDT",
+            Self::DoubleSphere => "DOUBLE_SPHERE",
+            Self::ExtendedUnified => "EXTENDED_UNIFIED",
+            Self::FovModel => "FOV_MODEL",
+            Self::Scaramuzza => "SCARAMUZZA",
+            Self::FTheta => "FTHETA",
+            Self::RadTan => "RADTAN",
         };
         format!("LENS_{name}")
     }
 }
+
+/// The tolerance of the WGSL root finder, relative to its bracket (`wgsl/calibrated.wgsl`).
+pub const NEWTON_TOLERANCE: f64 = 1.0 / (1 << 22) as f64;
+
+/// The most iterations the WGSL root finder takes: [`crate::lens::newton_bound`] at
+/// [`NEWTON_TOLERANCE`].
+pub const NEWTON_STEPS: u32 = 22;
 
 /// Where a kernel that consumes ray directions gets them: the `DIRECTION_SOURCE` override.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -103,8 +154,9 @@ impl DirectionSource {
     }
 }
 
-/// The lens as WGSL's `LensParams` reads it (32 bytes; `wgsl/lens.wgsl` mirrors it and a test
-/// checks the layouts agree). See the WGSL struct for the fields' meaning.
+/// The lens as WGSL's `LensParams` reads it (96 bytes; `wgsl/lens.wgsl` mirrors it and a test
+/// checks the layouts agree). See the WGSL struct for the fields' meaning; the first eight
+/// fields serve classic lenses, the last three calibrated ones (zero for classic lenses).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, PartialEq, Pod, Zeroable)]
 pub struct LensParams {
@@ -124,36 +176,84 @@ pub struct LensParams {
     pub height: u32,
     /// `N_max` of [`LensCamera::mask_limit`].
     pub mask_limit: u32,
+    /// Calibrated: fx, fy, cx, cy in pixels.
+    pub intrinsics: [f32; 4],
+    /// Calibrated: the model's parameters, packed per kind as `calibrated_coefficients` says.
+    pub coefficients: [[f32; 4]; 2],
+    /// Calibrated: Scaramuzza's affine c, d, e.
+    pub affine: [f32; 4],
 }
 
-const _: () = assert!(std::mem::size_of::<LensParams>() == 32);
+const _: () = assert!(std::mem::size_of::<LensParams>() == 96);
+
+/// A calibrated model's parameters as WGSL reads them (`wgsl/calibrated.wgsl` documents each
+/// kind's packing), with derived constants precomputed in f64.
+fn calibrated_coefficients(model: CalibratedModel) -> ([[f64; 4]; 2], [f64; 4]) {
+    match model {
+        CalibratedModel::KannalaBrandt { k } => ([k, [0.0; 4]], [0.0; 4]),
+        CalibratedModel::DoubleSphere { xi, alpha } => {
+            ([[xi, alpha, 0.0, 0.0], [0.0; 4]], [0.0; 4])
+        }
+        CalibratedModel::Unified { alpha } => ([[alpha, 1.0, 0.0, 0.0], [0.0; 4]], [0.0; 4]),
+        CalibratedModel::ExtendedUnified { alpha, beta } => {
+            ([[alpha, beta, 0.0, 0.0], [0.0; 4]], [0.0; 4])
+        }
+        CalibratedModel::Fov { w } => ([[w, 2.0 * (0.5 * w).tan(), 0.0, 0.0], [0.0; 4]], [0.0; 4]),
+        CalibratedModel::Scaramuzza { a, c, d, e } => (
+            [[a[0], a[1], a[2], a[3]], [a[4], 0.0, 0.0, 0.0]],
+            [c, d, e, 0.0],
+        ),
+        CalibratedModel::FTheta { k } => {
+            ([[k[0], k[1], k[2], k[3]], [k[4], 0.0, 0.0, 0.0]], [0.0; 4])
+        }
+        CalibratedModel::RadTan { k, p } => {
+            ([[k[0], k[1], k[2], 0.0], [p[0], p[1], 0.0, 0.0]], [0.0; 4])
+        }
+    }
+}
 
 impl LensParams {
     /// The parameters of a camera, rounded to f32.
     pub fn new(camera: &LensCamera) -> Self {
         let lens = camera.lens;
-        let (_, k1, rate) = lens.model().general_form();
-        let f = lens.focal_length();
-        Self {
-            f: f as f32,
-            k1_over_f: (k1 / f) as f32,
-            rate: rate as f32,
+        let narrow = |v: [f64; 4]| v.map(|x| x as f32);
+        let mut params = Self {
+            f: 0.0,
+            k1_over_f: 0.0,
+            rate: 0.0,
             r_max: lens.r_max().min(f64::from(f32::MAX)) as f32,
             theta_max: lens.theta_max() as f32,
             width: camera.size.width,
             height: camera.size.height,
             mask_limit: camera.mask_limit(),
+            intrinsics: [0.0; 4],
+            coefficients: [[0.0; 4]; 2],
+            affine: [0.0; 4],
+        };
+        match lens {
+            Lens::Classic(lens) => {
+                let (_, k1, rate) = lens.model().general_form();
+                let f = lens.focal_length();
+                params.f = f as f32;
+                params.k1_over_f = (k1 / f) as f32;
+                params.rate = rate as f32;
+            }
+            Lens::Calibrated(lens) => {
+                let i = lens.intrinsics();
+                let (coefficients, affine) = calibrated_coefficients(lens.model());
+                params.intrinsics = narrow([i.fx, i.fy, i.cx, i.cy]);
+                params.coefficients = coefficients.map(narrow);
+                params.affine = narrow(affine);
+            }
         }
+        params
     }
 }
 
 /// The override constants that specialise a lens kernel to a camera's model and formula.
 pub fn lens_constants(camera: &LensCamera) -> [(&'static str, f64); 2] {
     [
-        (
-            "LENS_KIND",
-            f64::from(LensKind::of(camera.lens.model()) as u32),
-        ),
+        ("LENS_KIND", f64::from(LensKind::of(&camera.lens) as u32)),
         (
             "DIRECTION_FORMULA",
             f64::from(shader::formula_id(camera.formula)),
@@ -386,6 +486,9 @@ mod tests {
                 ("width", offset_of!(LensParams, width)),
                 ("height", offset_of!(LensParams, height)),
                 ("mask_limit", offset_of!(LensParams, mask_limit)),
+                ("intrinsics", offset_of!(LensParams, intrinsics)),
+                ("coefficients", offset_of!(LensParams, coefficients)),
+                ("affine", offset_of!(LensParams, affine)),
             ],
         );
     }

@@ -24,6 +24,7 @@
 
 use std::f64::consts::{FRAC_PI_2, TAU};
 
+use super::calibrated::CalibratedLens;
 use crate::error::LensError;
 
 /// A radial mapping family. Parameters other than the focal length live here.
@@ -112,7 +113,7 @@ impl LensModel {
 /// A lens: a mapping family, its focal length in normalized units, and an optional maximum
 /// field of view.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Lens {
+pub struct ClassicLens {
     model: LensModel,
     f: f64,
     max_fov: Option<f64>,
@@ -127,7 +128,7 @@ enum DomainEnd {
     Pole(f64),
 }
 
-impl Lens {
+impl ClassicLens {
     /// A lens with focal length `f` (normalized units: the image half-width is 1).
     ///
     /// Errors if `f` is not finite and positive or the model's parameters are out of range.
@@ -153,7 +154,7 @@ impl Lens {
     /// Limits the full field of view to `fov` radians (a cone of half-angle `fov/2`).
     ///
     /// Errors if `fov` is not in (0, 2π]. A limit wider than the model reaches is allowed and
-    /// has no effect; [`Lens::theta_max`] reports what is effective.
+    /// has no effect; [`ClassicLens::theta_max`] reports what is effective.
     pub fn with_max_fov(mut self, fov: f64) -> Result<Self, LensError> {
         if !(fov.is_finite() && fov > 0.0 && fov <= TAU * (1.0 + 1e-12)) {
             return Err(LensError::parameter(
@@ -270,7 +271,7 @@ impl Lens {
     }
 }
 
-impl std::fmt::Display for Lens {
+impl std::fmt::Display for ClassicLens {
     /// Writes the lens as a spec that [`crate::lens::parse_spec`] reads back.
     fn fmt(&self, out: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         write!(out, "{}:f={}", self.model.name(), self.f)?;
@@ -281,5 +282,105 @@ impl std::fmt::Display for Lens {
             write!(out, ",fov={}", fov.to_degrees())?;
         }
         Ok(())
+    }
+}
+
+/// Any lens: a classic radial mapping in normalized units, or a calibrated model with pixel
+/// intrinsics ([`CalibratedLens`]). Both share the radial profile: `radius(θ)` and `theta(r)`
+/// map the angle from the axis to the radius in the lens's own units (normalized
+/// coordinates for classic lenses, model coordinates for calibrated ones).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Lens {
+    /// A classic mapping.
+    Classic(ClassicLens),
+    /// A calibrated camera model.
+    Calibrated(CalibratedLens),
+}
+
+impl From<ClassicLens> for Lens {
+    fn from(lens: ClassicLens) -> Self {
+        Self::Classic(lens)
+    }
+}
+
+impl From<CalibratedLens> for Lens {
+    fn from(lens: CalibratedLens) -> Self {
+        Self::Calibrated(lens)
+    }
+}
+
+impl Lens {
+    /// The classic lens, if this is one.
+    pub fn classic(&self) -> Option<&ClassicLens> {
+        match self {
+            Self::Classic(lens) => Some(lens),
+            Self::Calibrated(_) => None,
+        }
+    }
+
+    /// The calibrated lens, if this is one.
+    pub fn calibrated(&self) -> Option<&CalibratedLens> {
+        match self {
+            Self::Calibrated(lens) => Some(lens),
+            Self::Classic(_) => None,
+        }
+    }
+
+    /// The model's name as used in lens specs.
+    pub fn name(&self) -> &'static str {
+        match self {
+            Self::Classic(lens) => lens.model().name(),
+            Self::Calibrated(lens) => lens.model().name(),
+        }
+    }
+
+    /// The largest θ a ray may have.
+    pub fn theta_max(&self) -> f64 {
+        match self {
+            Self::Classic(lens) => lens.theta_max(),
+            Self::Calibrated(lens) => lens.theta_max(),
+        }
+    }
+
+    /// The radius of the domain edge, in the lens's units.
+    pub fn r_max(&self) -> f64 {
+        match self {
+            Self::Classic(lens) => lens.r_max(),
+            Self::Calibrated(lens) => lens.r_max(),
+        }
+    }
+
+    /// Forward map θ → r; `None` outside the domain.
+    pub fn radius(&self, theta: f64) -> Option<f64> {
+        match self {
+            Self::Classic(lens) => lens.radius(theta),
+            Self::Calibrated(lens) => lens.radius(theta),
+        }
+    }
+
+    /// Inverse map r → θ; `None` outside the domain.
+    pub fn theta(&self, r: f64) -> Option<f64> {
+        match self {
+            Self::Classic(lens) => lens.theta(r),
+            Self::Calibrated(lens) => lens.theta(r),
+        }
+    }
+
+    /// `κ(r) = r·dθ/dr` (see [`ClassicLens::theta_sensitivity`]).
+    pub fn theta_sensitivity(&self, r: f64) -> f64 {
+        match self {
+            Self::Classic(lens) => lens.theta_sensitivity(r),
+            Self::Calibrated(lens) => lens.theta_sensitivity(r),
+        }
+    }
+}
+
+impl std::fmt::Display for Lens {
+    /// Writes the lens as a spec that [`crate::lens::parse_spec`] reads back.
+    fn fmt(&self, out: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Self::Classic(lens) => lens.fmt(out),
+            Self::Calibrated(lens) => lens.fmt(out),
+        }
     }
 }

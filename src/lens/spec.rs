@@ -1,7 +1,8 @@
 //! Lens specs (`equisolid:f=0.93`, `general:f=1,k1=0.5,k2=0.5,fov=180`, `samyang-7.5mm`) and
 //! the named presets from the thesis's validation table.
 
-use super::model::{Lens, LensModel};
+use super::calibrated::{CalibratedLens, CalibratedModel, Intrinsics};
+use super::model::{ClassicLens, Lens, LensModel};
 use crate::error::LensError;
 
 /// A named real lens: the model and model focal length (normalized units) the thesis fitted
@@ -70,21 +71,29 @@ pub const PRESETS: [Preset; 7] = [
 
 impl Preset {
     /// The preset as a lens (limited to [`PRESET_FOV_DEGREES`]).
-    pub fn lens(&self) -> Lens {
-        Lens::new(self.model, self.f)
+    pub fn lens(&self) -> ClassicLens {
+        ClassicLens::new(self.model, self.f)
             .and_then(|l| l.with_max_fov(PRESET_FOV_DEGREES.to_radians()))
             .expect("preset parameters are valid")
     }
 }
 
-/// Parses a lens spec: `NAME[:key=value,...]`, where NAME is a model (keys `f`, and `k1`, `k2`
-/// for `general`; `fov` in degrees for all) or a preset (keys override the preset's).
+/// Parses a lens spec: `NAME[:key=value,...]`, where NAME is
+/// - a classic model (keys `f`, and `k1`, `k2` for `general`; `fov` in degrees for all),
+/// - a preset (keys `f` and `fov` override the preset's), or
+/// - a calibrated model (see [`CalibratedModel::NAMES`] for each one's keys): intrinsics `fx`,
+///   `fy` (default `fx`), `cx`, `cy` in pixels with OpenCV's convention that the centre of the
+///   top-left pixel is (0, 0), as calibration files write them; `fov` in degrees. Scaramuzza
+///   and f-theta take `cx`, `cy` and optional scales `fx`, `fy` (default 1: their polynomials
+///   are in pixels). `ucm` takes `alpha`, or Mei's `xi` (then `fx`, `fy` are Mei's γ).
 ///
 /// ```
 /// use fisheye_rt::lens::{parse_spec, LensModel};
 /// let lens = parse_spec("equisolid:f=0.93,fov=180").unwrap();
-/// assert_eq!(lens.model(), LensModel::Equisolid);
+/// assert_eq!(lens.classic().unwrap().model(), LensModel::Equisolid);
 /// assert!(parse_spec("equisolid:f=-1").is_err());
+/// let kb = parse_spec("kb:fx=280,cx=319.5,cy=239.5,k1=-0.01,k2=0.002,k3=0,k4=0").unwrap();
+/// assert_eq!(kb.name(), "kb");
 /// ```
 pub fn parse_spec(spec: &str) -> Result<Lens, LensError> {
     let err = |reason: String| LensError::Spec {
@@ -92,66 +101,141 @@ pub fn parse_spec(spec: &str) -> Result<Lens, LensError> {
         reason,
     };
     let (name, params) = spec.trim().split_once(':').unwrap_or((spec.trim(), ""));
-    let mut f = None;
-    let mut k1 = None;
-    let mut k2 = None;
-    let mut fov = None;
+    let mut values: Vec<(&str, f64)> = Vec::new();
     for pair in params.split(',').map(str::trim).filter(|p| !p.is_empty()) {
         let (key, value) = pair
             .split_once('=')
             .ok_or_else(|| err(format!("{pair:?} is not key=value")))?;
+        let key = key.trim();
         let value: f64 = value
             .trim()
             .parse()
             .map_err(|_| err(format!("{key} = {value:?} is not a number")))?;
-        let slot = match key.trim() {
-            "f" => &mut f,
-            "k1" => &mut k1,
-            "k2" => &mut k2,
-            "fov" => &mut fov,
-            other => {
-                return Err(err(format!(
-                    "unknown parameter {other:?} (known: f, k1, k2, fov)"
-                )));
-            }
-        };
-        if slot.replace(value).is_some() {
+        if values.iter().any(|(k, _)| *k == key) {
             return Err(err(format!("{key} is given twice")));
         }
+        values.push((key, value));
     }
-
-    let lens = if let Some(preset) = PRESETS.iter().find(|p| p.name == name) {
-        if k1.is_some() || k2.is_some() {
-            return Err(err(format!("preset {name} takes only f and fov")));
-        }
-        let lens = Lens::new(preset.model, f.unwrap_or(preset.f))?;
-        lens.with_max_fov(fov.unwrap_or(PRESET_FOV_DEGREES).to_radians())?
+    let known: &[&str] = if PRESETS.iter().any(|p| p.name == name) {
+        &["f", "fov"]
     } else {
-        let model = match name {
-            "rectilinear" | "pinhole" => LensModel::Rectilinear,
-            "stereographic" => LensModel::Stereographic,
-            "equidistant" => LensModel::Equidistant,
-            "equisolid" => LensModel::Equisolid,
-            "orthographic" => LensModel::Orthographic,
-            "general" => LensModel::General {
-                k1: k1.ok_or_else(|| err("general needs k1".into()))?,
-                k2: k2.ok_or_else(|| err("general needs k2".into()))?,
-            },
+        match name {
+            "general" => &["f", "k1", "k2", "fov"],
+            "rectilinear" | "pinhole" | "stereographic" | "equidistant" | "equisolid"
+            | "orthographic" => &["f", "fov"],
+            "kb" => &["fx", "fy", "cx", "cy", "k1", "k2", "k3", "k4", "fov"],
+            "ds" => &["fx", "fy", "cx", "cy", "xi", "alpha", "fov"],
+            "ucm" => &["fx", "fy", "cx", "cy", "alpha", "xi", "fov"],
+            "eucm" => &["fx", "fy", "cx", "cy", "alpha", "beta", "fov"],
+            "fov-model" => &["fx", "fy", "cx", "cy", "w", "fov"],
+            "scaramuzza" => &[
+                "fx", "fy", "cx", "cy", "a0", "a1", "a2", "a3", "a4", "c", "d", "e", "fov",
+            ],
+            "ftheta" => &["fx", "fy", "cx", "cy", "k1", "k2", "k3", "k4", "k5", "fov"],
+            "radtan" => &["fx", "fy", "cx", "cy", "k1", "k2", "p1", "p2", "k3", "fov"],
             _ => {
                 return Err(err(format!(
                     "unknown model or preset {name:?} (see `fisheye lens list`)"
                 )));
             }
-        };
-        if !matches!(model, LensModel::General { .. }) && (k1.is_some() || k2.is_some()) {
-            return Err(err(format!("{name} takes no k1 or k2 (only general does)")));
         }
-        let f = f.ok_or_else(|| err(format!("{name} needs f, e.g. {name}:f=0.5")))?;
-        let lens = Lens::new(model, f)?;
-        match fov {
+    };
+    if let Some((key, _)) = values.iter().find(|(k, _)| !known.contains(k)) {
+        return Err(err(format!(
+            "{name} takes no parameter {key:?} (it takes: {})",
+            known.join(", ")
+        )));
+    }
+    let get = |key: &str| values.iter().find(|(k, _)| *k == key).map(|(_, v)| *v);
+    let need = |key: &str| {
+        get(key).ok_or_else(|| err(format!("{name} needs {key}, e.g. {name}:{key}=...")))
+    };
+    let fov = get("fov");
+
+    if let Some(preset) = PRESETS.iter().find(|p| p.name == name) {
+        let lens = ClassicLens::new(preset.model, get("f").unwrap_or(preset.f))?;
+        return Ok(lens
+            .with_max_fov(fov.unwrap_or(PRESET_FOV_DEGREES).to_radians())?
+            .into());
+    }
+    let classic = match name {
+        "rectilinear" | "pinhole" => Some(LensModel::Rectilinear),
+        "stereographic" => Some(LensModel::Stereographic),
+        "equidistant" => Some(LensModel::Equidistant),
+        "equisolid" => Some(LensModel::Equisolid),
+        "orthographic" => Some(LensModel::Orthographic),
+        "general" => Some(LensModel::General {
+            k1: need("k1")?,
+            k2: need("k2")?,
+        }),
+        _ => None,
+    };
+    if let Some(model) = classic {
+        let lens = ClassicLens::new(model, need("f")?)?;
+        return Ok(match fov {
             Some(deg) => lens.with_max_fov(deg.to_radians())?,
             None => lens,
         }
+        .into());
+    }
+
+    let zero = |key: &str| get(key).unwrap_or(0.0);
+    let polynomial = matches!(name, "scaramuzza" | "ftheta");
+    let fx = if polynomial {
+        get("fx").unwrap_or(1.0)
+    } else {
+        need("fx")?
     };
-    Ok(lens)
+    let mut intrinsics = Intrinsics {
+        fx,
+        fy: get("fy").unwrap_or(fx),
+        cx: need("cx")? + 0.5,
+        cy: need("cy")? + 0.5,
+    };
+    let model = match name {
+        "kb" => CalibratedModel::KannalaBrandt {
+            k: [zero("k1"), zero("k2"), zero("k3"), zero("k4")],
+        },
+        "ds" => CalibratedModel::DoubleSphere {
+            xi: need("xi")?,
+            alpha: need("alpha")?,
+        },
+        "ucm" => match (get("alpha"), get("xi")) {
+            (Some(alpha), None) => CalibratedModel::Unified { alpha },
+            (None, Some(xi)) => {
+                if !(xi.is_finite() && xi >= 0.0) {
+                    return Err(LensError::parameter("xi", xi, "must be finite and ≥ 0"));
+                }
+                intrinsics.fx /= 1.0 + xi;
+                intrinsics.fy /= 1.0 + xi;
+                CalibratedModel::Unified {
+                    alpha: xi / (1.0 + xi),
+                }
+            }
+            _ => return Err(err("ucm needs either alpha or Mei's xi".into())),
+        },
+        "eucm" => CalibratedModel::ExtendedUnified {
+            alpha: need("alpha")?,
+            beta: need("beta")?,
+        },
+        "fov-model" => CalibratedModel::Fov { w: need("w")? },
+        "scaramuzza" => CalibratedModel::Scaramuzza {
+            a: [need("a0")?, zero("a1"), zero("a2"), zero("a3"), zero("a4")],
+            c: get("c").unwrap_or(1.0),
+            d: zero("d"),
+            e: zero("e"),
+        },
+        "ftheta" => CalibratedModel::FTheta {
+            k: [need("k1")?, zero("k2"), zero("k3"), zero("k4"), zero("k5")],
+        },
+        _ => CalibratedModel::RadTan {
+            k: [zero("k1"), zero("k2"), zero("k3")],
+            p: [zero("p1"), zero("p2")],
+        },
+    };
+    let lens = match fov {
+        Some(deg) => CalibratedLens::with_fov(model, intrinsics, deg.to_radians())?,
+        None => CalibratedLens::new(model, intrinsics)?,
+    };
+    Ok(lens.into())
 }

@@ -1,0 +1,296 @@
+//! Calibration files: OpenCV YAML/XML, Kalibr and Basalt, read against values typed in from
+//! the files (independent of our writer), written and read back, and bad files refused with
+//! the line or key at fault.
+
+use std::path::PathBuf;
+
+use fisheye_rt::lens::calib::{self, CalibFormat, Calibration};
+use fisheye_rt::lens::{CalibratedModel, parse_spec};
+
+/// OpenCV's calibration sample writes a `cv::fisheye` result like this (values: TUM-VI cam0).
+const OPENCV_FISHEYE_YAML: &str = "%YAML:1.0
+---
+calibration_time: \"Sat 21 Nov 2026 10:00:00 UTC\"
+nr_of_frames: 40
+image_width: 512
+image_height: 512
+board_width: 6
+board_height: 6
+square_size: 6.0000000000000005e-02
+flags: 0
+fisheye_model: 1
+camera_matrix: !!opencv-matrix
+   rows: 3
+   cols: 3
+   dt: d
+   data: [ 1.9097847715128717e+02, 0., 2.5493170605935475e+02, 0.,
+       1.9097330705212260e+02, 2.5689744289965040e+02, 0., 0., 1. ]
+distortion_coefficients: !!opencv-matrix
+   rows: 4
+   cols: 1
+   dt: d
+   data: [ 3.4823894022493434e-03, 7.1503484521622570e-04,
+       -2.0532361418706202e-03, 2.0293673591811182e-04 ]
+avg_reprojection_error: 1.9e-01
+";
+
+/// The same sample's pinhole result as XML (values: EuRoC MAV cam0).
+const OPENCV_PINHOLE_XML: &str = "<?xml version=\"1.0\"?>
+<opencv_storage>
+<image_width>752</image_width>
+<image_height>480</image_height>
+<camera_matrix type_id=\"opencv-matrix\">
+  <rows>3</rows>
+  <cols>3</cols>
+  <dt>d</dt>
+  <data>
+    458.654 0. 367.215 0. 457.296 248.375 0. 0. 1.</data></camera_matrix>
+<distortion_coefficients type_id=\"opencv-matrix\">
+  <rows>5</rows>
+  <cols>1</cols>
+  <dt>d</dt>
+  <data>
+    -0.28340811 0.07395907 0.00019359 1.76187114e-05 0.</data></distortion_coefficients>
+</opencv_storage>
+";
+
+/// A Kalibr camchain with the three models it shares with us beyond the pinhole.
+const KALIBR: &str = "cam0:
+  cam_overlaps: [1]
+  camera_model: pinhole
+  distortion_coeffs: [-0.28340811, 0.07395907, 0.00019359, 1.76187114e-05]
+  distortion_model: radtan
+  intrinsics: [458.654, 457.296, 367.215, 248.375]
+  resolution: [752, 480]
+  rostopic: /cam0/image_raw
+cam1:
+  camera_model: ds
+  intrinsics: [-0.18, 0.59, 158.28, 158.24, 254.9, 256.9]
+  distortion_model: none
+  distortion_coeffs: []
+  resolution: [512, 512]
+cam2:
+  camera_model: omni
+  intrinsics: [1.5, 600.0, 500.0, 319.5, 239.5]
+  distortion_model: none
+  resolution: [640, 480]
+";
+
+/// Basalt's calibration JSON (abridged: extrinsics and noise left out).
+const BASALT: &str = r#"{
+    "value0": {
+        "T_imu_cam": [],
+        "intrinsics": [
+            {
+                "camera_type": "kb4",
+                "intrinsics": {
+                    "fx": 190.97847715128717, "fy": 190.9733070521226,
+                    "cx": 254.93170605935475, "cy": 256.8974428996504,
+                    "k1": 0.0034823894022493434, "k2": 0.0007150348452162257,
+                    "k3": -0.0020532361418706202, "k4": 0.00020293673591811182
+                }
+            },
+            {
+                "camera_type": "eucm",
+                "intrinsics": {
+                    "fx": 252.6, "fy": 252.5, "cx": 254.9, "cy": 256.9,
+                    "alpha": 0.64, "beta": 1.09
+                }
+            }
+        ],
+        "resolution": [[512, 512], [512, 512]],
+        "vignette": []
+    }
+}"#;
+
+fn only(text: &str, format: CalibFormat) -> Vec<Calibration> {
+    assert_eq!(CalibFormat::detect(text), Some(format));
+    calib::parse(text, format).unwrap_or_else(|e| panic!("{format:?}: {e}"))
+}
+
+fn close(a: f64, b: f64) -> bool {
+    (a - b).abs() <= 1e-12 * b.abs().max(1.0)
+}
+
+/// Each format's values land where they belong, the principal point moved by half a pixel.
+#[test]
+fn files_read_to_the_values_they_hold() {
+    let [tum] = only(OPENCV_FISHEYE_YAML, CalibFormat::OpenCvYaml)[..] else {
+        panic!()
+    };
+    assert_eq!((tum.size.width, tum.size.height), (512, 512));
+    let i = tum.lens.intrinsics();
+    assert!(close(i.fx, 190.97847715128717) && close(i.fy, 190.9733070521226));
+    assert!(close(i.cx, 255.43170605935475) && close(i.cy, 257.3974428996504));
+    assert_eq!(
+        tum.lens.model(),
+        CalibratedModel::KannalaBrandt {
+            k: [
+                3.4823894022493434e-03,
+                7.150_348_452_162_257e-4,
+                -2.0532361418706202e-03,
+                2.0293673591811182e-04
+            ]
+        }
+    );
+
+    let [euroc] = only(OPENCV_PINHOLE_XML, CalibFormat::OpenCvXml)[..] else {
+        panic!()
+    };
+    assert_eq!((euroc.size.width, euroc.size.height), (752, 480));
+    assert!(close(euroc.lens.intrinsics().cx, 367.715));
+    assert_eq!(
+        euroc.lens.model(),
+        CalibratedModel::RadTan {
+            k: [-0.28340811, 0.07395907, 0.0],
+            p: [0.00019359, 1.76187114e-05]
+        }
+    );
+
+    let kalibr = only(KALIBR, CalibFormat::Kalibr);
+    assert_eq!(kalibr.len(), 3);
+    assert_eq!(kalibr[0].lens, euroc.lens);
+    assert_eq!(
+        kalibr[1].lens.model(),
+        CalibratedModel::DoubleSphere {
+            xi: -0.18,
+            alpha: 0.59
+        }
+    );
+    // Mei's ξ = 1.5, γ = 600: α = 0.6, f = 240.
+    assert_eq!(
+        kalibr[2].lens.model(),
+        CalibratedModel::Unified { alpha: 0.6 }
+    );
+    assert!(close(kalibr[2].lens.intrinsics().fx, 240.0));
+    assert!(close(kalibr[2].lens.intrinsics().fy, 200.0));
+
+    let basalt = only(BASALT, CalibFormat::Basalt);
+    assert_eq!(basalt.len(), 2);
+    assert_eq!(basalt[0].lens, tum.lens);
+    assert_eq!(
+        basalt[1].lens.model(),
+        CalibratedModel::ExtendedUnified {
+            alpha: 0.64,
+            beta: 1.09
+        }
+    );
+}
+
+/// Every model a format can express survives writing and reading back exactly (the
+/// unified model through Kalibr's ξ form to rounding); the rest is a clear error.
+#[test]
+fn written_files_read_back() {
+    let size = fisheye_rt::lens::ImageSize::new(512, 512).unwrap();
+    for spec in CalibratedModel::EXAMPLES.iter().copied().chain([
+        "radtan:fx=300,cx=255.5,cy=255.5",
+        "radtan:fx=300,cx=255.5,cy=255.5,k1=-0.2,k2=0.05,p1=0.001,p2=-0.002",
+    ]) {
+        let lens = *parse_spec(spec).unwrap().calibrated().unwrap();
+        let calibration = Calibration { lens, size };
+        for (name, format) in CalibFormat::ALL {
+            match calib::write(&calibration, format) {
+                Ok(text) => {
+                    let back = calib::parse(&text, format)
+                        .unwrap_or_else(|e| panic!("{spec} as {name}: {e}\n{text}"));
+                    let back = back[0];
+                    assert_eq!(back.size, size, "{spec} as {name}");
+                    let (a, b) = (back.lens.intrinsics(), lens.intrinsics());
+                    for (x, y) in [(a.fx, b.fx), (a.fy, b.fy), (a.cx, b.cx), (a.cy, b.cy)] {
+                        assert!(close(x, y), "{spec} as {name}: {x} vs {y}\n{text}");
+                    }
+                    let (pa, pb) = (back.lens.model().parameters(), lens.model().parameters());
+                    for ((key, x), (_, y)) in pa.iter().zip(&pb) {
+                        assert!(close(*x, *y), "{spec} as {name}: {key} {x} vs {y}\n{text}");
+                    }
+                }
+                Err(e) => {
+                    let message = e.to_string();
+                    assert!(
+                        message.contains("cannot express"),
+                        "{spec} as {name}: {message}"
+                    );
+                    assert!(
+                        matches!(
+                            lens.model(),
+                            CalibratedModel::Scaramuzza { .. }
+                                | CalibratedModel::FTheta { .. }
+                                | CalibratedModel::DoubleSphere { .. }
+                                | CalibratedModel::Unified { .. }
+                                | CalibratedModel::ExtendedUnified { .. }
+                                | CalibratedModel::Fov { .. }
+                                | CalibratedModel::RadTan { .. }
+                        ),
+                        "{spec} as {name}: {message}"
+                    );
+                }
+            }
+        }
+    }
+    // Every model has at least one format that writes it, except the two polynomial ones
+    // (no format here has them) — and they are refused, not mangled.
+    for spec in CalibratedModel::EXAMPLES {
+        let lens = *parse_spec(spec).unwrap().calibrated().unwrap();
+        let written = CalibFormat::ALL
+            .iter()
+            .filter(|(_, f)| calib::write(&Calibration { lens, size }, *f).is_ok())
+            .count();
+        let polynomial = matches!(
+            lens.model(),
+            CalibratedModel::Scaramuzza { .. } | CalibratedModel::FTheta { .. }
+        );
+        assert_eq!(written == 0, polynomial, "{spec}: {written} formats");
+    }
+}
+
+/// Bad files name the file and the problem: the YAML line, the missing key, the model.
+#[test]
+fn bad_files_are_clear_errors() {
+    let dir = std::env::temp_dir().join(format!("fisheye-calib-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let file = |name: &str, text: &str| -> PathBuf {
+        let path = dir.join(name);
+        std::fs::write(&path, text).unwrap();
+        path
+    };
+    let cases = [
+        (
+            file("broken.yaml", "cam0:\n  camera_model: pinhole\n  intrinsics: [1, 2\n"),
+            "line 4",
+        ),
+        (file("nothing.yaml", "a: 1\n"), "not a calibration"),
+        (
+            file("no-matrix.yaml", &OPENCV_FISHEYE_YAML.replace("camera_matrix: !!", "camera_matrx: !!").replace("calibration_time", "camera_matrix_note")),
+            "camera_matrix is missing",
+        ),
+        (
+            file("three.yaml", &OPENCV_FISHEYE_YAML.replace("-2.0532361418706202e-03, ", "")),
+            "4 distortion_coefficients, not 3",
+        ),
+        (
+            file("model.yaml", &KALIBR.replace("camera_model: ds", "camera_model: fisheye")),
+            "cam1: unknown camera_model \"fisheye\"",
+        ),
+        (
+            file("omni-radtan.yaml", &KALIBR.replace("distortion_model: none\n  resolution: [640", "distortion_model: radtan\n  distortion_coeffs: [0, 0, 0, 0]\n  resolution: [640")),
+            "omni with distortion_model \"radtan\" is not supported",
+        ),
+        (file("bad.json", "{ \"value0\": { \"intrinsics\": 3 } }"), "value0.intrinsics"),
+        (
+            file("alpha.json", &BASALT.replace("\"alpha\": 0.64", "\"alpha\": 1.64")),
+            "alpha = 1.64",
+        ),
+        (file("bad.xml", "<opencv_storage><image_width>5</image_width>"), "not valid XML"),
+        (dir.join("missing.yaml"), "cannot read it"),
+    ];
+    for (path, needle) in cases {
+        let message = calib::read(&path).unwrap_err().to_string();
+        assert!(message.contains(&path.display().to_string()), "{message}");
+        assert!(
+            message.contains(needle),
+            "{}: {message:?} lacks {needle:?}",
+            path.display()
+        );
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}
