@@ -46,7 +46,7 @@
 //! is the Newton step from whichever evaluated point has the smaller `|h|`, when it lands
 //! strictly inside the bracket, else the midpoint. The iteration stops at a Newton step or a bracket of `tol`, so it takes at most
 //! `⌈log₂(W₀/tol)⌉` iterations of one or two evaluations ([`newton_bound`]), and converges
-//! quadratically where Newton does (4 to 6 iterations in practice: one-sided convergence
+//! quadratically where Newton does (3 to 7 iterations in practice: one-sided convergence
 //! costs the midpoint evaluations but never the Newton iterate). The WGSL twin runs the same
 //! iteration in f32 with //! `tol = W₀·2⁻²²`.
 
@@ -750,7 +750,7 @@ impl CalibratedLens {
     /// The iterations the iterative models take to unproject model radius `r` (or, for
     /// Scaramuzza and f-theta, to project angle `r`); `None` for closed-form models or
     /// outside the domain. For tests of the bound.
-    pub fn solver_evaluations(&self, x: f64) -> Option<u32> {
+    pub fn solver_iterations(&self, x: f64) -> Option<u32> {
         match self.model {
             CalibratedModel::KannalaBrandt { .. } | CalibratedModel::RadTan { .. } => {
                 self.theta_by_solving(x).map(|(_, n)| n)

@@ -649,7 +649,7 @@ fn newton_iterations_stay_within_the_stated_bound() {
                 }
                 _ => (t * radial, lens.theta_max()),
             };
-            let n = lens.solver_evaluations(x).unwrap();
+            let n = lens.solver_iterations(x).unwrap();
             let bound = newton_bound(hi, 4.0 * f64::EPSILON * hi);
             assert!(n <= bound, "{spec}: {n} iterations at {x} (bound {bound})");
             // Close to a domain that ends where the mapping turns, h' → 0 and Newton slows
