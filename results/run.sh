@@ -35,6 +35,12 @@ for scene in $scenes; do
     "$bin" bench "$scene" "${lenses[@]}" --size "$size" --cube-size "$bench_cubes" \
         --frames "$frames" --warmup 2 -o "$out/$name/bench"
 done
+# Lens validation: every preset and calibrated example. Two overlays are kept, and no
+# per-corner lists, to keep the folder small.
+"$bin" validate -o "$out/validate"
+find "$out/validate" -name 'overlay.*' ! -name 'overlay.kb_*' ! -name 'overlay.canon-8-15mm@8mm.png' \
+    -delete
+rm -f "$out/validate/points."*.csv
 # The thesis's face sizes at its kind of image size (THESIS=0 leaves it out).
 [ "${THESIS:-1}" = 1 ] || exit 0
 "$bin" compare builtin:many-small "${lenses[@]}" --no-pinhole --size 1024x768 \

@@ -116,10 +116,7 @@ pub fn supersampled(
     centres: &[[f32; 4]],
 ) -> Result<Vec<[f32; 4]>> {
     let size = camera.size;
-    let large = LensCamera {
-        size: ImageSize::new(size.width * factor, size.height * factor)?,
-        ..*camera
-    };
+    let large = camera.scaled(factor)?;
     let pass = TracePass::new(ctx, &large, scene, DirectionSource::Computed)?;
     pass.set_pose(ctx, scene, pose);
     ctx.checked("tracing the supersampled reference", || {

@@ -50,6 +50,7 @@ pub mod report;
 pub mod scene;
 pub mod shader;
 pub mod trace;
+pub mod validate;
 
 pub use error::{Error, LensError, Result};
 

@@ -23,6 +23,7 @@ use fisheye_rt::scene::{Scene, builtin};
 use fisheye_rt::trace::{
     Channel, GpuScene, RenderOptions, TracePass, Traversal, colour_image, world_directions,
 };
+use fisheye_rt::validate;
 use glam::{DVec2, DVec3};
 
 #[derive(Parser)]
@@ -49,6 +50,12 @@ enum Command {
     /// with its time per frame: JSON, a Markdown table, error maps and a time-against-error
     /// PNG with the Pareto front, in the --out folder.
     Compare(CompareArgs),
+    /// Check lens models against rendered images: render the built-in `grid` checkerboard
+    /// through each lens, find its corners in the image to a fraction of a pixel without the
+    /// lens model, and compare them with where the model projects them. Writes a Markdown
+    /// table, JSON, an overlay per lens and an error plot into the --out folder; exits
+    /// non-zero if a lens misses the bound.
+    Validate(ValidateArgs),
     /// List the built-in scenes.
     Scenes,
     /// Show the GPU adapter, its optional features and limits, and measure the precision of
@@ -187,6 +194,27 @@ struct CompareArgs {
     supersample: Option<u32>,
 }
 
+#[derive(clap::Args)]
+struct ValidateArgs {
+    /// Lens specs to validate (repeatable); by default every preset (at 512x512) and each
+    /// calibrated model's example (at the size it is calibrated for), as `fisheye lens list`
+    /// shows them.
+    #[arg(long)]
+    lens: Vec<String>,
+    /// Image size for --lens, WIDTHxHEIGHT.
+    #[arg(long, default_value = "512x512")]
+    size: ImageSize,
+    #[command(flatten)]
+    calib: CalibArgs,
+    /// Rays per pixel side of the rendered images (1 to 8); by default the most, up to 4,
+    /// whose image fits one storage binding.
+    #[arg(long)]
+    supersample: Option<u32>,
+    /// Folder for the results; by default a new folder `fisheye-validate-N` here.
+    #[arg(long, short)]
+    out: Option<PathBuf>,
+}
+
 #[derive(Clone, Copy, ValueEnum)]
 enum PathArg {
     Walk,
@@ -296,6 +324,18 @@ struct CalibArgs {
 }
 
 impl CalibArgs {
+    /// How reports name the camera of `--calib`: the file, and the camera if not the first.
+    fn describe(&self) -> String {
+        let path = self
+            .calib
+            .as_deref()
+            .map_or(String::new(), |p| p.display().to_string());
+        match self.calib_camera {
+            0 => path,
+            n => format!("{path}#{n}"),
+        }
+    }
+
     /// The camera of `--calib`, or else `--lens` (required then) at `size`; warns when the
     /// lens's field of view is clipped where its mapping turns.
     fn camera(&self, lens: Option<&str>, size: ImageSize) -> Result<LensCamera> {
@@ -469,6 +509,7 @@ fn run(cli: Cli) -> Result<()> {
         Command::Render(args) => render(&args),
         Command::Bench(args) => run_bench(&args),
         Command::Compare(args) => run_compare(&args),
+        Command::Validate(args) => run_validate(&args),
         Command::Scenes => {
             for (name, what) in builtin::SCENES {
                 println!("builtin:{name:<14} {what}");
@@ -939,14 +980,7 @@ fn prepare(args: &StudyArgs, command: &str) -> Result<Prepared> {
     if let Some(text) = &args.camera {
         scene.camera = parse_camera(text, &scene)?;
     }
-    let out = match &args.out {
-        Some(out) => out.clone(),
-        None => (1..)
-            .map(|n| PathBuf::from(format!("fisheye-{command}-{n}")))
-            .find(|p| !p.exists())
-            .expect("a free folder name"),
-    };
-    std::fs::create_dir_all(&out).with_context(|| format!("creating {}", out.display()))?;
+    let out = out_folder(args.out.as_deref(), command)?;
     let ctx = GpuContext::new()?;
     println!("adapter: {}", ctx.adapter_name());
     let options = RenderOptions {
@@ -971,6 +1005,19 @@ fn prepare(args: &StudyArgs, command: &str) -> Result<Prepared> {
         setups,
         out,
     })
+}
+
+/// `out`, or else a new folder `fisheye-COMMAND-N` here; created.
+fn out_folder(out: Option<&std::path::Path>, command: &str) -> Result<PathBuf> {
+    let out = match out {
+        Some(out) => out.to_path_buf(),
+        None => (1..)
+            .map(|n| PathBuf::from(format!("fisheye-{command}-{n}")))
+            .find(|p| !p.exists())
+            .expect("a free folder name"),
+    };
+    std::fs::create_dir_all(&out).with_context(|| format!("creating {}", out.display()))?;
+    Ok(out)
 }
 
 /// A progress bar on stderr when it is a terminal, else a line per new setup.
@@ -1047,5 +1094,52 @@ fn run_compare(args: &CompareArgs) -> Result<()> {
     )?;
     let warning = report.write(&p.out)?;
     finish(&report.markdown(), &p.out, warning);
+    Ok(())
+}
+
+fn run_validate(args: &ValidateArgs) -> Result<()> {
+    if let Some(s) = args.supersample.filter(|s| !(1..=8).contains(s)) {
+        bail!("--supersample {s}: must be 1 to 8");
+    }
+    let lenses = if args.calib.calib.is_some() {
+        vec![validate::LensToValidate {
+            name: args.calib.describe(),
+            camera: args.calib.camera(None, args.size)?,
+        }]
+    } else if args.lens.is_empty() {
+        validate::default_lenses()?
+    } else {
+        args.lens
+            .iter()
+            .map(|spec| {
+                Ok(validate::LensToValidate {
+                    name: spec.clone(),
+                    camera: args.calib.camera(Some(spec), args.size)?,
+                })
+            })
+            .collect::<Result<Vec<_>>>()?
+    };
+    let out = out_folder(args.out.as_deref(), "validate")?;
+    let ctx = GpuContext::new()?;
+    println!("adapter: {}", ctx.adapter_name());
+    let count = lenses.len();
+    let report = validate::run(&ctx, &lenses, args.supersample, &mut |k, name| {
+        eprintln!("[{}/{count}] {name}", k + 1);
+    })?;
+    let warning = report.write(&out)?;
+    finish(&report.markdown(), &out, warning);
+    let failed: Vec<&str> = report
+        .lenses
+        .iter()
+        .filter(|l| !l.passed)
+        .map(|l| l.lens.as_str())
+        .collect();
+    if !failed.is_empty() {
+        bail!(
+            "{} of {count} lens(es) failed validation: {}",
+            failed.len(),
+            failed.join(", ")
+        );
+    }
     Ok(())
 }

@@ -1,5 +1,6 @@
 //! PNG plots of the reports (plotters, drawing into a buffer that the `image` crate writes):
-//! frame rate along the camera path, and time against error with the Pareto front.
+//! frame rate along the camera path, time against error with the Pareto front, and the lens
+//! validation's error against field angle.
 //!
 //! Text needs a TrueType font, read at run time: `$FISHEYE_FONT`, else DejaVu Sans or Liberation
 //! Sans where Linux distributions put them (Debian: `fonts-dejavu-core`), else Arial on
@@ -256,6 +257,53 @@ pub fn time_against_error(
                     .label(p.method)
                     .legend(move |(x, y)| Circle::new((x + 10, y), 6, colour.filled()));
             }
+        }
+        legend(&mut chart)
+    })
+}
+
+/// Error (y, log) against field angle (x, degrees), a dot per point and a colour per series,
+/// with the pass bound as a dashed red line.
+pub fn error_against_angle(path: &Path, title: &str, series: &[Series], bound: f64) -> Result<()> {
+    write_png(path, |root| {
+        let all = || series.iter().flat_map(|s| s.points.iter().copied());
+        let x1 = all().map(|p| p.0).fold(90.0, f64::max) * 1.02;
+        // Room above the bound for the legend.
+        let (y0, y1) = log_bounds(all().map(|p| p.1).chain([bound, bound * 60.0]));
+        let mut chart = ChartBuilder::on(root)
+            .caption(title, (FAMILY, 22))
+            .margin(14)
+            .x_label_area_size(45)
+            .y_label_area_size(80)
+            .build_cartesian_2d(0.0..x1, (y0..y1).log_scale())?;
+        chart
+            .configure_mesh()
+            .x_desc("angle from the optical axis (degrees)")
+            .y_desc("detected − predicted position (px, log)")
+            .label_style((FAMILY, 15))
+            .light_line_style(WHITE)
+            .y_labels(8)
+            .y_label_formatter(&|v| format!("{v:.0e}"))
+            .draw()?;
+        chart
+            .draw_series(DashedLineSeries::new(
+                [(0.0, bound), (x1, bound)],
+                8,
+                5,
+                RED.stroke_width(2),
+            ))?
+            .label(format!("bound {bound} px"))
+            .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], RED.stroke_width(2)));
+        for (k, s) in series.iter().enumerate() {
+            let colour = Palette99::pick(k).to_rgba();
+            chart
+                .draw_series(
+                    s.points
+                        .iter()
+                        .map(|&(x, y)| Circle::new((x, y.max(1e-12)), 2, colour.filled())),
+                )?
+                .label(s.label.clone())
+                .legend(move |(x, y)| Circle::new((x + 10, y), 4, colour.filled()));
         }
         legend(&mut chart)
     })

@@ -477,14 +477,14 @@ fn verdict(lens: &str, entries: &[CompareEntry]) -> Option<Verdict> {
     })
 }
 
-fn write_text(path: &Path, text: &str) -> Result<()> {
+pub(crate) fn write_text(path: &Path, text: &str) -> Result<()> {
     std::fs::write(path, text).map_err(|source| Error::Io {
         path: path.to_path_buf(),
         source,
     })
 }
 
-fn write_json(path: &Path, value: &impl Serialize) -> Result<()> {
+pub(crate) fn write_json(path: &Path, value: &impl Serialize) -> Result<()> {
     let text = serde_json::to_string_pretty(value).expect("reports serialize");
     write_text(path, &(text + "\n"))
 }
@@ -512,7 +512,7 @@ fn write_report<'a>(
     Ok(None)
 }
 
-fn machine_lines(m: &Machine) -> String {
+pub(crate) fn machine_lines(m: &Machine) -> String {
     format!(
         "- adapter: {}\n- driver: {}\n- CPU: {} ({} logical)\n- date: {}\n",
         m.adapter, m.driver, m.cpu, m.cpus, m.date

@@ -738,3 +738,104 @@ fn calibration_files_drive_lens_and_render() {
     assert!(String::from_utf8_lossy(&clipped.stderr).contains("warning: kb: the mapping stops"));
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// `validate` writes its report, overlays, point lists and plot, passes a right lens (from a
+/// spec or a calibration file), and exits non-zero, naming the lens, when one fails.
+#[test]
+fn validate_reports_and_fails_loudly() {
+    let dir = std::env::temp_dir().join(format!("fisheye-cli-validate-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    let out = dir.join("v");
+    let output = Command::new(env!("CARGO_BIN_EXE_fisheye"))
+        .args([
+            "validate",
+            "--lens",
+            "samyang-7.5mm",
+            "--size",
+            "320x320",
+            "-o",
+        ])
+        .arg(&out)
+        .output()
+        .unwrap();
+    let text = stdout(&output);
+    assert!(text.contains("| samyang-7.5mm | 320x320 |"), "{text}");
+    for file in [
+        "validate.json",
+        "validate.md",
+        "overlay.samyang-7.5mm.png",
+        "points.samyang-7.5mm.csv",
+        "errors.png",
+    ] {
+        assert!(out.join(file).is_file(), "{file}");
+    }
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("validate.json")).unwrap()).unwrap();
+    let lens = &json["lenses"][0];
+    assert_eq!(lens["passed"], true);
+    assert!(lens["checked"].as_u64().unwrap() > 50);
+    assert_eq!(lens["checked"], lens["matched"]);
+    let overlay = image::open(out.join("overlay.samyang-7.5mm.png")).unwrap();
+    assert_eq!((overlay.width(), overlay.height()), (960, 960));
+    let csv = std::fs::read_to_string(out.join("points.samyang-7.5mm.csv")).unwrap();
+    assert_eq!(
+        csv.lines().count(),
+        1 + lens["projected"].as_u64().unwrap() as usize
+    );
+
+    // A calibration file: its camera at its resolution, named by the file.
+    let spec = CalibratedModel::EXAMPLES[1];
+    let calibration = fisheye_rt::lens::calib::Calibration {
+        lens: match parse_spec(spec).unwrap() {
+            fisheye_rt::lens::Lens::Calibrated(lens) => lens,
+            _ => unreachable!("{spec} is calibrated"),
+        },
+        size: ImageSize::new(512, 512).unwrap(),
+    };
+    let file = dir.join("ds.json");
+    let text =
+        fisheye_rt::lens::calib::write(&calibration, fisheye_rt::lens::calib::CalibFormat::Basalt)
+            .unwrap();
+    std::fs::write(&file, text).unwrap();
+    let output = Command::new(env!("CARGO_BIN_EXE_fisheye"))
+        .args(["validate", "--calib"])
+        .arg(&file)
+        .arg("-o")
+        .arg(dir.join("c"))
+        .output()
+        .unwrap();
+    let text = stdout(&output);
+    assert!(
+        text.contains("ds.json | 512x512 |") && text.contains("| yes |"),
+        "{text}"
+    );
+
+    // Too small an image to check a single corner: a failure, named.
+    let output = Command::new(env!("CARGO_BIN_EXE_fisheye"))
+        .args([
+            "validate",
+            "--lens",
+            "equidistant:f=0.3",
+            "--size",
+            "48x48",
+            "-o",
+        ])
+        .arg(dir.join("f"))
+        .output()
+        .unwrap();
+    let errors = String::from_utf8_lossy(&output.stderr);
+    assert!(!output.status.success());
+    assert!(
+        errors.contains("1 of 1 lens(es) failed validation: equidistant:f=0.3"),
+        "{errors}"
+    );
+    assert!(dir.join("f").join("validate.md").is_file());
+    let output = fisheye(&["validate", "--supersample", "0"], "");
+    let errors = String::from_utf8_lossy(&output.stderr);
+    assert!(
+        !output.status.success() && errors.contains("--supersample 0"),
+        "{errors}"
+    );
+    std::fs::remove_dir_all(dir).unwrap();
+}

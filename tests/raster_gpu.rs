@@ -98,7 +98,7 @@ fn diffuse_unshadowed() -> Scene {
         8,
         [200, 60, 40],
         [40, 160, 220],
-        [250; 3],
+        Some([250; 3]),
     ));
     let mut walls = Material::diffuse("walls", Vec3::splat(0.9));
     walls.diffuse_texture = Some(texture);

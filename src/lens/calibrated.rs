@@ -155,6 +155,18 @@ impl CalibratedModel {
         "radtan:fx=458.654,fy=457.296,cx=367.215,cy=248.375,k1=-0.28340811,k2=0.07395907,p1=0.00019359,p2=1.76187114e-05",
     ];
 
+    /// The image size each of [`Self::EXAMPLES`] is calibrated for (width, height).
+    pub const EXAMPLE_SIZES: [(u32, u32); 8] = [
+        (512, 512),
+        (512, 512),
+        (512, 512),
+        (512, 512),
+        (512, 512),
+        (512, 512),
+        (512, 512),
+        (752, 480),
+    ];
+
     /// The model's name in lens specs.
     pub fn name(&self) -> &'static str {
         match self {

@@ -13,7 +13,7 @@ pub const SCENES: [(&str, &str); 4] = [
     ),
     (
         "grid",
-        "a calibration grid on the inside of a cube around the camera, for lens validation",
+        "a black-and-white calibration checkerboard on the inside of a cube around the camera, for lens validation",
     ),
     (
         "many-small",
@@ -65,7 +65,7 @@ fn room() -> Scene {
         8,
         [200, 200, 190],
         [60, 60, 70],
-        [30, 30, 30],
+        Some([30, 30, 30]),
     ));
     let wall_tex = b.texture(checker(
         "grid",
@@ -73,7 +73,7 @@ fn room() -> Scene {
         4,
         [225, 215, 190],
         [215, 205, 180],
-        [80, 80, 90],
+        Some([80, 80, 90]),
     ));
     let floor = b.material(Material {
         diffuse_texture: Some(floor_tex),
@@ -191,37 +191,99 @@ fn room() -> Scene {
     room
 }
 
+/// Half the side of the `grid` scene's cube, centred on its camera.
+const GRID_HALF_SIDE: f64 = 5.0;
+/// Texels per side of the `grid` scene's texture.
+const GRID_TEXELS: u32 = 512;
+/// Checker cells per side of a face of the `grid` scene.
+pub const GRID_CELLS: u32 = 16;
+
+/// The `grid` scene's six inner cube faces as `(corner, u, v)`: the points
+/// `corner + s·u + t·v` with texture coordinates `(s, t)`, s, t ∈ [0, 1], facing `u × v`
+/// (inwards).
+fn grid_faces() -> [(DVec3, DVec3, DVec3); 6] {
+    let lo = DVec3::splat(-GRID_HALF_SIDE);
+    let e = 2.0 * GRID_HALF_SIDE;
+    let (x, y, z) = (DVec3::X * e, DVec3::Y * e, DVec3::Z * e);
+    [
+        (lo, x, y),
+        (lo + x + z, -x, y),
+        (lo + z, -z, y),
+        (lo + x, z, y),
+        (lo, z, x),
+        (lo + y, x, z),
+    ]
+}
+
+/// A corner of the `grid` scene's checkerboard, where four cells meet: a point whose position
+/// in the image a lens model predicts exactly.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct GridCorner {
+    /// Which cube face (0 to 5).
+    pub face: usize,
+    /// The cell edge along the face's v axis it is on (0 to [`GRID_CELLS`]), counted along u.
+    pub a: u32,
+    /// The cell edge along the face's u axis it is on, counted against v (0 to
+    /// [`GRID_CELLS`]).
+    pub b: u32,
+    /// World position.
+    pub world: DVec3,
+    /// World displacement to the next corner along u (to `a + 1`).
+    pub step_a: DVec3,
+    /// World displacement to the next corner against v (to `b + 1`).
+    pub step_b: DVec3,
+    /// Whether it is on the cube's edge (`a` or `b` is 0 or [`GRID_CELLS`]), where the
+    /// faces fold and the image of its cells is not locally flat.
+    pub fold: bool,
+}
+
+/// Every corner of the `grid` scene's checkerboard, face by face: those on the cube's edges
+/// (see [`GridCorner::fold`]) once per face they are on.
+///
+/// Cell edges are texel boundaries, `32k` of 512, which the bilinear filter of
+/// `wgsl/surface.wgsl` (texel centres at `(i + ½)/512`) turns into ramps one texel wide
+/// centred on texture coordinate `k/16`; texel rows run from the top (`t = 1`) down, so edge
+/// `b` along v is at `t = 1 - b/16`. A corner's image is symmetric about it under a half
+/// turn (the diagonal cells have one colour): that is what `fisheye validate`'s detector
+/// relies on.
+pub fn grid_corners() -> Vec<GridCorner> {
+    let step = 1.0 / f64::from(GRID_CELLS);
+    let mut out = Vec::new();
+    for (face, (corner, u, v)) in grid_faces().into_iter().enumerate() {
+        for b in 0..=GRID_CELLS {
+            for a in 0..=GRID_CELLS {
+                out.push(GridCorner {
+                    face,
+                    a,
+                    b,
+                    world: corner + u * (f64::from(a) * step) + v * (1.0 - f64::from(b) * step),
+                    step_a: u * step,
+                    step_b: -v * step,
+                    fold: a % GRID_CELLS == 0 || b % GRID_CELLS == 0,
+                });
+            }
+        }
+    }
+    out
+}
+
 fn grid() -> Scene {
     let mut b = MeshBuilder::new();
     let tex = b.texture(checker(
         "calibration",
-        512,
-        16,
-        [245, 245, 245],
-        [235, 235, 235],
+        GRID_TEXELS,
+        GRID_CELLS,
+        [240, 240, 240],
         [10, 10, 10],
+        None,
     ));
     let wall = b.material(Material {
         diffuse_texture: Some(tex),
         ..Material::diffuse("grid", Vec3::ONE)
     });
-    let s = 5.0;
-    let lo = DVec3::splat(-s);
-    let e = 2.0 * s;
-    let one = Vec2::ONE;
-    // The six inner faces of a cube centred on the camera.
-    b.quad(lo, DVec3::X * e, DVec3::Y * e, one, wall);
-    b.quad(
-        lo + DVec3::new(e, 0.0, e),
-        -DVec3::X * e,
-        DVec3::Y * e,
-        one,
-        wall,
-    );
-    b.quad(lo + DVec3::Z * e, -DVec3::Z * e, DVec3::Y * e, one, wall);
-    b.quad(lo + DVec3::X * e, DVec3::Z * e, DVec3::Y * e, one, wall);
-    b.quad(lo, DVec3::Z * e, DVec3::X * e, one, wall);
-    b.quad(lo + DVec3::Y * e, DVec3::X * e, DVec3::Z * e, one, wall);
+    for (corner, u, v) in grid_faces() {
+        b.quad(corner, u, v, Vec2::ONE, wall);
+    }
     let camera = Camera {
         position: DVec3::ZERO,
         look_at: -DVec3::Z,
@@ -350,5 +412,57 @@ mod tests {
         let room = scene("default").unwrap().features();
         assert!(room.mirrors && room.glass && room.textures && room.smooth_normals);
         assert!(scene("no-such").is_none());
+    }
+
+    /// Each corner lies on a triangle of the `grid` scene whose interpolated texture
+    /// coordinates put it on a texel corner where four texels of alternating colours meet
+    /// (the scene's own data, not the formula `grid_corners` uses).
+    #[test]
+    fn grid_corners_sit_where_four_cells_meet() {
+        let s = scene("grid").unwrap();
+        let uvs = s.uvs.as_ref().unwrap();
+        let texture = &s.textures[0];
+        let corners = grid_corners();
+        assert_eq!(corners.len(), 6 * 17 * 17);
+        assert_eq!(corners.iter().filter(|c| !c.fold).count(), 6 * 15 * 15);
+        for c in corners.iter().filter(|c| !c.fold) {
+            let (t, bary) = s
+                .triangles
+                .iter()
+                .enumerate()
+                .find_map(|(t, [p0, p1, p2])| {
+                    let n = (*p1 - *p0).cross(*p2 - *p0);
+                    let area = |a: DVec3, b: DVec3| (a - c.world).cross(b - c.world).dot(n);
+                    let w = [area(*p1, *p2), area(*p2, *p0), area(*p0, *p1)]
+                        .map(|a| a / n.length_squared());
+                    let on_plane = (c.world - *p0).dot(n).abs() < 1e-9 * n.length();
+                    (on_plane && w.iter().all(|&w| w >= 0.0)).then_some((t, w))
+                })
+                .unwrap_or_else(|| panic!("{c:?} is on no triangle"));
+            let uv = uvs[t]
+                .iter()
+                .zip(bary)
+                .fold(glam::DVec2::ZERO, |sum, (uv, w)| sum + uv.as_dvec2() * w);
+            // Texel space with texel edges at integers (rows from the top).
+            let size = f64::from(texture.width);
+            let st = glam::DVec2::new(uv.x, 1.0 - uv.y) * size;
+            assert!((st - st.round()).abs().max_element() < 1e-9, "{c:?}: {st}");
+            let texel = |x: f64, y: f64| {
+                let k = 4 * (y as usize * texture.width as usize + x as usize);
+                texture.rgba[k]
+            };
+            // The four texels around it, and texels a few away inside the same four cells.
+            for d in [0.5, 5.5] {
+                let (x, y) = (st.x, st.y);
+                let quad = [
+                    texel(x - d, y - d),
+                    texel(x + d, y - d),
+                    texel(x + d, y + d),
+                    texel(x - d, y + d),
+                ];
+                assert!(quad[0] == quad[2] && quad[1] == quad[3] && quad[0] != quad[1]);
+                assert!(quad.iter().all(|&v| v == 10 || v == 240), "{c:?}: {quad:?}");
+            }
+        }
     }
 }

@@ -256,21 +256,21 @@ impl MeshBuilder {
 }
 
 /// A procedural checker texture: `cells` × `cells` squares of two sRGB colours, with thin grid
-/// lines of a third, `size` texels square.
+/// lines of a third (the first texel row and column of each cell) if `line` is given, `size`
+/// texels square.
 pub fn checker(
     name: &str,
     size: u32,
     cells: u32,
     a: [u8; 3],
     b: [u8; 3],
-    line: [u8; 3],
+    line: Option<[u8; 3]>,
 ) -> Texture {
     let cell = size / cells;
     let mut rgba = Vec::with_capacity((size * size * 4) as usize);
     for y in 0..size {
         for x in 0..size {
-            let on_line = x % cell == 0 || y % cell == 0;
-            let c = if on_line {
+            let c = if let Some(line) = line.filter(|_| x % cell == 0 || y % cell == 0) {
                 line
             } else if (x / cell + y / cell).is_multiple_of(2) {
                 a
