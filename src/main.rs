@@ -135,7 +135,7 @@ struct StudyArgs {
     /// The scene, as for `render`.
     #[arg(default_value = "builtin:default")]
     scene: String,
-    /// Lens specs to measure (repeatable).
+    /// Lens specs to measure (repeatable); or give --calib.
     #[arg(long, default_value = "canon-8-15mm@8mm")]
     lens: Vec<String>,
     /// The pinhole baseline measured beside the lenses, at the same image size.
@@ -147,6 +147,8 @@ struct StudyArgs {
     /// Image size in pixels, WIDTHxHEIGHT.
     #[arg(long, default_value = "1024x768")]
     size: ImageSize,
+    #[command(flatten)]
+    calib: CalibArgs,
     /// Camera pose instead of the scene's (as for `render`); the orbit path circles its
     /// look-at point.
     #[arg(long)]
@@ -954,19 +956,30 @@ impl Prepared {
 
 /// Checks the arguments, loads the scene, makes the output folder and uploads the scene.
 fn prepare(args: &StudyArgs, command: &str) -> Result<Prepared> {
-    let mut specs = args.lens.clone();
-    if !args.no_pinhole {
-        specs.push(args.pinhole.clone());
-    }
-    let lenses = specs
-        .iter()
-        .map(|spec| {
-            Ok(LensRun {
-                name: spec.clone(),
-                camera: LensCamera::new(parse_spec(spec)?, args.size),
+    let mut lenses = match &args.calib.calib {
+        Some(_) => vec![LensRun {
+            name: args.calib.describe(),
+            camera: args.calib.camera(None, args.size)?,
+        }],
+        None => args
+            .lens
+            .iter()
+            .map(|spec| {
+                Ok(LensRun {
+                    name: spec.clone(),
+                    camera: LensCamera::new(parse_spec(spec)?, args.size),
+                })
             })
-        })
-        .collect::<Result<Vec<_>>>()?;
+            .collect::<Result<Vec<_>>>()?,
+    };
+    // The calibration's resolution, or --size.
+    let size = lenses.first().map_or(args.size, |l| l.camera.size);
+    if !args.no_pinhole {
+        lenses.push(LensRun {
+            name: args.pinhole.clone(),
+            camera: LensCamera::new(parse_spec(&args.pinhole)?, size),
+        });
+    }
     if let Some(&bad) = args.cube_size.iter().find(|&&s| s == 0) {
         bail!("--cube-size {bad}: face sizes must be at least 1");
     }
@@ -995,7 +1008,7 @@ fn prepare(args: &StudyArgs, command: &str) -> Result<Prepared> {
         scene.len(),
         setups.len(),
         lenses.len(),
-        args.size
+        size
     );
     Ok(Prepared {
         ctx,
@@ -1079,9 +1092,9 @@ fn run_compare(args: &CompareArgs) -> Result<()> {
         bail!("--supersample {s}: must be 1 to 8");
     }
     let p = prepare(&args.study, "compare")?;
-    let supersample = args
-        .supersample
-        .unwrap_or_else(|| fisheye_rt::compare::supersample_factor(&p.ctx, args.study.size));
+    let supersample = args.supersample.unwrap_or_else(|| {
+        fisheye_rt::compare::supersample_factor(&p.ctx, p.lenses[0].camera.size)
+    });
     let study = p.study(&args.study);
     let pose = p.scene.camera;
     let report = report::compare(

@@ -519,6 +519,15 @@ pub(crate) fn machine_lines(m: &Machine) -> String {
     )
 }
 
+/// `ratio` (another time over RT's) as "2.50x faster" or, below 1, "1.49x slower".
+fn speed_ratio(ratio: f64) -> String {
+    if ratio >= 1.0 {
+        format!("{ratio:.2}x faster")
+    } else {
+        format!("{:.2}x slower", 1.0 / ratio)
+    }
+}
+
 /// A value in ms or fps to three significant figures, as the tables print them.
 fn sig(v: f64) -> String {
     if v >= 100.0 {
@@ -638,7 +647,10 @@ impl BenchReport {
                         .collect(),
                 })
                 .collect();
-            let title = format!("{}: {lens}, {}", self.run.scene, self.run.size);
+            let title = format!(
+                "{}: {lens}, {} ({})",
+                self.run.scene, self.run.size, self.run.machine.adapter
+            );
             plot::fps_along_path(
                 &out.join(format!("fps.{}.png", file_stem(lens))),
                 &title,
@@ -690,10 +702,11 @@ impl CompareReport {
         for v in &self.verdicts {
             let line = match (&v.cube, v.speedup) {
                 (Some(cube), Some(s)) => format!(
-                    "{cube} at {} ms: RT ({} ms, MSE {:.2e}) is {s:.2}x faster",
+                    "{cube} at {} ms: RT ({} ms, MSE {:.2e}) is {}",
                     sig(v.rt_ms * s),
                     sig(v.rt_ms),
-                    v.rt_mse
+                    v.rt_mse,
+                    speed_ratio(s)
                 ),
                 _ => format!(
                     "no cube-map setting reaches RT's MSE of {:.2e} (the closest: {})",
@@ -726,7 +739,10 @@ impl CompareReport {
                     pareto: e.pareto,
                 })
                 .collect();
-            let title = format!("{}: {lens}, {}", self.run.scene, self.run.size);
+            let title = format!(
+                "{}: {lens}, {} ({})",
+                self.run.scene, self.run.size, self.run.machine.adapter
+            );
             plot::time_against_error(
                 &out.join(format!("tradeoff.{}.png", file_stem(lens))),
                 &title,
@@ -734,5 +750,17 @@ impl CompareReport {
                 &points,
             )
         })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::speed_ratio;
+
+    #[test]
+    fn speed_ratios_read_as_faster_or_slower() {
+        assert_eq!(speed_ratio(2.5), "2.50x faster");
+        assert_eq!(speed_ratio(1.0), "1.00x faster");
+        assert_eq!(speed_ratio(0.5), "2.00x slower");
     }
 }

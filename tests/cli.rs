@@ -693,6 +693,30 @@ fn calibration_files_drive_lens_and_render() {
     let image = image::open(&png).unwrap();
     assert_eq!((image.width(), image.height()), (96, 72));
 
+    // compare and bench measure the calibrated camera at its resolution, beside the pinhole.
+    let cmp = dir.join("cmp");
+    let text = stdout(&fisheye(
+        &[
+            "compare",
+            "builtin:grid",
+            "--calib",
+            path,
+            "--method",
+            "rt",
+            "--frames",
+            "1",
+            "--supersample",
+            "2",
+            "-o",
+            cmp.to_str().unwrap(),
+        ],
+        "",
+    ));
+    assert!(text.contains(&format!("| {path} | rt |")), "{text}");
+    assert!(text.contains("| rectilinear:f=1 | rt |"), "{text}");
+    let report = std::fs::read_to_string(cmp.join("compare.md")).unwrap();
+    assert!(report.contains("96x72"), "{report}");
+
     for (args, needle) in [
         (
             vec!["render", "--calib", path, "--size", "10x10"],
