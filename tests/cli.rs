@@ -693,7 +693,8 @@ fn calibration_files_drive_lens_and_render() {
     let image = image::open(&png).unwrap();
     assert_eq!((image.width(), image.height()), (96, 72));
 
-    // compare and bench measure the calibrated camera at its resolution, beside the pinhole.
+    // compare (and bench, which shares its setup) measures the calibrated camera at its
+    // resolution, beside the pinhole.
     let cmp = dir.join("cmp");
     let text = stdout(&fisheye(
         &[
