@@ -315,9 +315,8 @@ pub struct Prediction {
     /// the two families).
     pub spacing: f64,
     /// Whether it is checked: it is not on a fold of the cube, its neighbours are in the
-    /// image, parallel edges are at least
-    /// [`MIN_SPACING_PX`] apart and cross at 60° or more, and the detector's window around it
-    /// is all valid.
+    /// image, parallel edges are at least [`MIN_SPACING_PX`] apart and cross at 60° or more,
+    /// and the detector's window around it is all valid.
     pub checked: bool,
 }
 
@@ -371,7 +370,7 @@ pub fn predict(camera: &LensCamera, pose: &Camera, image: &Image) -> Vec<Predict
 pub struct PointResult {
     /// The prediction.
     pub prediction: Prediction,
-    /// The detection matched to it: the nearest within a third of the line spacing.
+    /// The detection matched to it: the nearest within a third of the edge spacing.
     pub detected: Option<DVec2>,
 }
 
@@ -414,9 +413,9 @@ pub struct LensValidation {
     /// Per corner.
     #[serde(skip)]
     pub points: Vec<PointResult>,
-    /// Detections that match no checked corner.
+    /// Where the stray detections are.
     #[serde(skip)]
-    pub unmatched: Vec<DVec2>,
+    pub strays: Vec<DVec2>,
 }
 
 /// Matches detections to predictions and summarizes.
@@ -448,21 +447,19 @@ pub fn evaluate(
         })
         .collect();
     let matched: Vec<DVec2> = points.iter().filter_map(|p| p.detected).collect();
-    let unmatched: Vec<DVec2> = detections
+    // A stray detection matches nothing and is nearer to a checked corner than to any
+    // unchecked one.
+    let strays: Vec<DVec2> = detections
         .iter()
         .map(|d| d.pixel)
         .filter(|d| !matched.contains(d))
-        .collect();
-    // A stray detection is nearer to a checked corner than to any unchecked one.
-    let stray = unmatched
-        .iter()
         .filter(|d| {
             predictions
                 .iter()
-                .min_by(|a, b| a.pixel.distance(**d).total_cmp(&b.pixel.distance(**d)))
+                .min_by(|a, b| a.pixel.distance(*d).total_cmp(&b.pixel.distance(*d)))
                 .is_some_and(|p| p.checked)
         })
-        .count();
+        .collect();
     let mut errors: Vec<f64> = points
         .iter()
         .filter_map(|p| p.error().map(DVec2::length))
@@ -483,11 +480,11 @@ pub fn evaluate(
         projected: points.len(),
         checked,
         matched: n,
-        stray,
+        stray: strays.len(),
         rms_px: (errors.iter().map(|e| e * e).sum::<f64>() / n.max(1) as f64).sqrt(),
+        // Nearest rank.
         p95_px: errors
-            .get((0.95 * n as f64).ceil() as usize)
-            .or(errors.last())
+            .get(((0.95 * n as f64).ceil() as usize).saturating_sub(1))
             .copied()
             .unwrap_or(0.0),
         max_px,
@@ -497,9 +494,9 @@ pub fn evaluate(
             .filter(|p| p.prediction.checked)
             .map(|p| p.prediction.theta.to_degrees())
             .fold(0.0, f64::max),
-        passed: checked > 0 && n == checked && stray == 0 && max_px <= BOUND_PX,
+        passed: checked > 0 && n == checked && strays.is_empty() && max_px <= BOUND_PX,
         points,
-        unmatched,
+        strays,
     }
 }
 
@@ -797,20 +794,8 @@ fn overlay(
                     c.stroke_width(2),
                 ))?;
             }
-            for d in &l.unmatched {
-                let nearest_checked = l
-                    .points
-                    .iter()
-                    .min_by(|a, b| {
-                        a.prediction
-                            .pixel
-                            .distance(*d)
-                            .total_cmp(&b.prediction.pixel.distance(*d))
-                    })
-                    .is_some_and(|p| p.prediction.checked);
-                if nearest_checked {
-                    area.draw(&Circle::new(at(*d), 5, BLUE.stroke_width(2)))?;
-                }
+            for d in &l.strays {
+                area.draw(&Circle::new(at(*d), 5, BLUE.stroke_width(2)))?;
             }
             area.present()?;
             Ok(())
