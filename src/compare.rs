@@ -119,12 +119,9 @@ pub fn supersampled(
     let large = camera.scaled(factor)?;
     let pass = TracePass::new(ctx, &large, scene, DirectionSource::Computed)?;
     pass.set_pose(ctx, scene, pose);
-    ctx.checked("tracing the supersampled reference", || {
-        let mut encoder = ctx.device.create_command_encoder(&Default::default());
-        pass.encode(&mut encoder, scene, None);
-        ctx.queue.submit([encoder.finish()]);
-    })?;
-    let fine = pass.read(ctx)?.colour;
+    let fine = pass
+        .trace(ctx, scene, "tracing the supersampled reference")?
+        .colour;
     let (w, f) = (size.width as usize, factor as usize);
     Ok(centres
         .iter()

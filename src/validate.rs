@@ -510,12 +510,7 @@ pub fn render(
 ) -> Result<Vec<[f32; 4]>> {
     let pass = TracePass::new(ctx, camera, scene, DirectionSource::Computed)?;
     pass.set_pose(ctx, scene, &pose());
-    ctx.checked("tracing the grid", || {
-        let mut encoder = ctx.device.create_command_encoder(&Default::default());
-        pass.encode(&mut encoder, scene, None);
-        ctx.queue.submit([encoder.finish()]);
-    })?;
-    let centres = pass.read(ctx)?.colour;
+    let centres = pass.trace(ctx, scene, "tracing the grid")?.colour;
     supersampled(ctx, scene, camera, &pose(), supersample, &centres)
 }
 

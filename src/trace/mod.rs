@@ -605,6 +605,16 @@ impl TracePass {
         );
     }
 
+    /// Traces one frame, reporting a GPU error as `what` failing, and reads it back.
+    pub fn trace(&self, ctx: &GpuContext, scene: &GpuScene, what: &str) -> Result<RenderOutput> {
+        ctx.checked(what, || {
+            let mut encoder = ctx.device.create_command_encoder(&Default::default());
+            self.encode(&mut encoder, scene, None);
+            ctx.queue.submit([encoder.finish()]);
+        })?;
+        self.read(ctx)
+    }
+
     /// Reads the last frame's outputs back.
     pub fn read(&self, ctx: &GpuContext) -> Result<RenderOutput> {
         Ok(RenderOutput {
@@ -636,13 +646,7 @@ pub fn render(
     options: &RenderOptions,
 ) -> Result<RenderOutput> {
     let gpu_scene = GpuScene::new(ctx, scene, options)?;
-    let pass = TracePass::new(ctx, camera, &gpu_scene, options.directions)?;
-    ctx.checked("tracing", || {
-        let mut encoder = ctx.device.create_command_encoder(&Default::default());
-        pass.encode(&mut encoder, &gpu_scene, None);
-        ctx.queue.submit([encoder.finish()]);
-    })?;
-    pass.read(ctx)
+    TracePass::new(ctx, camera, &gpu_scene, options.directions)?.trace(ctx, &gpu_scene, "tracing")
 }
 
 #[cfg(test)]
