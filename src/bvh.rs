@@ -116,11 +116,16 @@ impl SceneBvh {
             .iter()
             .position(|t| !t.iter().all(|p| p.is_finite()))
         {
+            let corners = |t: [DVec3; 3]| {
+                t.map(|p| format!("({:e}, {:e}, {:e})", p.x, p.y, p.z))
+                    .join(", ")
+            };
             return Err(Error::Scene(format!(
-                "triangle {i} has a corner at {:?}, {:?} from the camera: beyond the f32 range \
-                 the GPU computes in",
-                scene.triangles[i],
-                scene.triangles[i].map(|p| p - origin)
+                "triangle {i} lies beyond the f32 range the GPU computes in (magnitudes up to \
+                 {:e}): its corners are {} in the world, {} from the camera",
+                f32::MAX,
+                corners(scene.triangles[i]),
+                corners(scene.triangles[i].map(|p| p - origin))
             )));
         }
         if rounded.is_empty() {

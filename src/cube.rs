@@ -8,7 +8,6 @@
 //! from [`FACES`], and a test checks that both pick the same face and UV.
 
 use glam::{DMat3, DVec3, Vec2, Vec3};
-use wgpu::util::DeviceExt;
 
 use crate::error::{Error, Result};
 use crate::gpu::{
@@ -411,6 +410,7 @@ impl CubeMap {
                 max - 2
             )));
         }
+        ctx.check_image(camera.size)?;
         let side = bordered(size);
         ctx.check_binding(
             "the cube-map colour output",
@@ -605,11 +605,12 @@ pub fn face_uv_gpu(ctx: &GpuContext, directions: &[Vec3]) -> Result<Vec<(u32, Ve
     let out = ctx.checked("probing cube faces", || {
         let device = &ctx.device;
         let pipeline = shader::compute_pipeline(device, "cube_probe", "main", &[], &[]);
-        let points = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: Some("fisheye.cube_probe.directions"),
-            contents: bytemuck::cast_slice(&input),
-            usage: wgpu::BufferUsages::STORAGE,
-        });
+        let points = crate::gpu::buffer_init(
+            device,
+            "fisheye.cube_probe.directions",
+            bytemuck::cast_slice(&input),
+            wgpu::BufferUsages::STORAGE,
+        );
         let results = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("fisheye.cube_probe.results"),
             size: points.size(),

@@ -23,6 +23,7 @@ impl LensDemo {
     /// Creates the pass; with [`DirectionSource::Table`] also computes the table (one
     /// [`LensRays`] dispatch, submitted here, not per frame).
     pub fn new(ctx: &GpuContext, camera: &LensCamera, source: DirectionSource) -> Result<Self> {
+        ctx.check_image(camera.size)?;
         let bytes = 4 * camera.size.pixels() as u64;
         ctx.check_binding("the demo image", bytes)?;
         let table = LensRays::for_source(ctx, camera, source)?;

@@ -26,8 +26,9 @@ pub enum LensError {
     /// A field of view the model cannot reach: its mapping turns back (a non-monotonic
     /// calibration) or its domain ends before.
     #[error(
-        "{model}: cannot reach the requested {fov}° field of view: {why} at a {reach:.2}° field \
-         of view"
+        "{model}: cannot reach the requested {}° field of view: {why} at a {reach:.2}° field \
+         of view",
+        (fov * 1e6).round() / 1e6
     )]
     Unreachable {
         /// The model's spec name.

@@ -3,8 +3,6 @@
 //! cos to 2^-11 absolute), so the lens code uses the replacements, whose bound holds on any
 //! driver; `fisheye info` prints both.
 
-use wgpu::util::DeviceExt;
-
 use crate::error::Result;
 use crate::gpu::GpuContext;
 use crate::shader::compute_pipeline;
@@ -40,11 +38,12 @@ pub fn measure_trig(ctx: &GpuContext) -> Result<Vec<TrigError>> {
     let values = ctx.checked("probing trigonometry", || {
         let device = &ctx.device;
         let pipeline = compute_pipeline(device, "trig_probe", "main", &[], &[]);
-        let input = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: Some("fisheye.trig_probe.args"),
-            contents: bytemuck::cast_slice(&args),
-            usage: wgpu::BufferUsages::STORAGE,
-        });
+        let input = crate::gpu::buffer_init(
+            device,
+            "fisheye.trig_probe.args",
+            bytemuck::cast_slice(&args),
+            wgpu::BufferUsages::STORAGE,
+        );
         let values = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("fisheye.trig_probe.values"),
             size: 32 * args.len() as u64,

@@ -23,7 +23,6 @@ use std::num::NonZeroU32;
 
 use bytemuck::{Pod, Zeroable};
 use glam::{DAffine3, DMat3, DMat4, DVec3, DVec4};
-use wgpu::util::DeviceExt;
 
 use crate::cube::{FACES, Region, bordered, bordered_focal};
 use crate::error::{Error, Result};
@@ -203,11 +202,12 @@ impl ShadowMaps {
             } else {
                 &views[..]
             };
-            let buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                label: Some("fisheye.raster.shadow_views"),
-                contents: bytemuck::cast_slice(data),
-                usage: wgpu::BufferUsages::STORAGE,
-            });
+            let buffer = crate::gpu::buffer_init(
+                device,
+                "fisheye.raster.shadow_views",
+                bytemuck::cast_slice(data),
+                wgpu::BufferUsages::STORAGE,
+            );
             let views_entry = wgpu::BindGroupLayoutEntry {
                 binding: 0,
                 visibility: crate::gpu::ALL_STAGES,

@@ -239,6 +239,63 @@ fn adapter_errors_are_clear() {
     }
 }
 
+/// A lost device, a malformed OBJ line and an image beyond the adapter each end the command
+/// with a non-zero status and the message, and write no image.
+#[test]
+fn faults_and_bad_files_exit_non_zero_with_the_message() {
+    let dir = std::env::temp_dir().join(format!("fisheye-cli-faults-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let obj = dir.join("bad.obj");
+    std::fs::write(&obj, "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 x\n").unwrap();
+    let out = dir.join("out.png");
+    let (obj, out) = (obj.to_str().unwrap(), out.to_str().unwrap());
+    let lost = ("FISHEYE_INJECT_FAULT", "device-lost");
+    type Case<'a> = (&'a [&'a str], &'a [(&'a str, &'a str)], &'a str);
+    let cases: [Case; 6] = [
+        (
+            &["render", "-o", out],
+            &[lost],
+            "the GPU device was lost: Destroyed",
+        ),
+        (
+            &["render", "--method", "cube-forward", "-o", out],
+            &[lost],
+            "device was lost",
+        ),
+        (&["info"], &[lost], "device was lost"),
+        (
+            &["render", obj, "-o", out],
+            &[],
+            "bad.obj: line 4: face vertex \"x\"",
+        ),
+        (
+            &["render", "--size", "16385x8", "-o", out],
+            &[],
+            "2D texture limit",
+        ),
+        (
+            &["render", "--camera", "1,2:3", "-o", out],
+            &[],
+            "expected X,Y,Z:LX,LY,LZ",
+        ),
+    ];
+    for (args, env, needle) in cases {
+        let output = fisheye_with_env(args, "", env);
+        let stderr = String::from_utf8_lossy(&output.stderr);
+        assert_eq!(output.status.code(), Some(1), "{args:?}: {stderr}");
+        assert!(
+            stderr.contains(needle),
+            "{args:?}: {stderr:?} lacks {needle:?}"
+        );
+        assert!(!stderr.contains("panicked"), "{args:?}: {stderr}");
+        assert!(
+            !std::path::Path::new(out).exists(),
+            "{args:?} wrote an image"
+        );
+    }
+    std::fs::remove_dir_all(dir).unwrap();
+}
+
 /// `fisheye render` writes the colour image with the mask in alpha, and names what it did.
 #[test]
 fn render_writes_a_masked_png_and_reports() {

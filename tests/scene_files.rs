@@ -55,7 +55,13 @@ fn shipped_scene_files_render_as_the_reference_does() {
         let loaded = load_scene_file(&file)
             .unwrap_or_else(|e| panic!("{e} (the shared scenes belong in ../shared/scenes/)"));
         let name = file.file_name().unwrap().to_string_lossy();
-        assert!(loaded.warnings.is_empty(), "{name}: {:?}", loaded.warnings);
+        // Sibenik has 8 triangles with collinear corners, dropped with a warning; nothing
+        // else of the shipped scenes warns.
+        assert!(
+            loaded.warnings.iter().all(|w| w.contains("of zero area")),
+            "{name}: {:?}",
+            loaded.warnings
+        );
         let scene = loaded.scene;
         assert!(scene.camera_path.len() >= 2, "{name}: no camera path");
         let (gpu, cpu) = both(&scene, &camera("equidistant:f=0.45,fov=180", 64, 48));

@@ -507,7 +507,8 @@ fn camera_pose_set_on_a_pass_matches_a_fresh_upload() {
 }
 
 /// The same scene, lens and adapter give bit-identical outputs run to run, with the scene
-/// uploaded afresh each time (the BVH build is deterministic, traversal has no races).
+/// uploaded afresh each time, and on a device of its own as a new process would make (the BVH
+/// build is deterministic, traversal has no races).
 #[test]
 fn renders_are_bit_identical_run_to_run() {
     let scene = builtin::scene("default").unwrap();
@@ -515,6 +516,8 @@ fn renders_are_bit_identical_run_to_run() {
     let options = RenderOptions::default();
     let first = render(ctx(), &scene, &cam, &options).unwrap();
     let second = render(ctx(), &scene, &cam, &options).unwrap();
+    let own_device = fisheye_rt::gpu::GpuContext::new().unwrap();
+    let third = render(&own_device, &scene, &cam, &options).unwrap();
     let bits = |o: &fisheye_rt::trace::RenderOutput| -> Vec<u32> {
         let floats = o
             .colour
@@ -525,4 +528,5 @@ fn renders_are_bit_identical_run_to_run() {
         floats.chain(o.ids.iter().copied()).collect()
     };
     assert_eq!(bits(&first), bits(&second));
+    assert_eq!(bits(&first), bits(&third));
 }

@@ -57,6 +57,31 @@ pub fn bind_group<'a>(
     })
 }
 
+/// A buffer holding `contents`: `wgpu::util::DeviceExt::create_buffer_init` without its panic
+/// when the device is lost. The buffer is then invalid, and [`GpuContext::checked`] reports
+/// the loss.
+pub fn buffer_init(
+    device: &wgpu::Device,
+    label: &str,
+    contents: &[u8],
+    usage: wgpu::BufferUsages,
+) -> wgpu::Buffer {
+    let size = (contents.len() as u64).next_multiple_of(wgpu::COPY_BUFFER_ALIGNMENT);
+    let buffer = device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some(label),
+        size,
+        usage,
+        mapped_at_creation: size > 0,
+    });
+    if size > 0 {
+        if let Ok(mut view) = buffer.get_mapped_range_mut(..) {
+            view.slice(..contents.len()).copy_from_slice(contents);
+        }
+        buffer.unmap();
+    }
+    buffer
+}
+
 /// A square 2D texture array: `layers` layers of `side`² texels, one mip level.
 pub fn texture_array(
     device: &wgpu::Device,
@@ -149,6 +174,10 @@ pub fn submit_over_elements(
     ctx.queue.submit([encoder.finish()]);
 }
 
+/// The environment variable that injects a fault for tests of the error paths: with the value
+/// `device-lost`, every device is destroyed as soon as it is created, as a driver reset would.
+pub const FAULT_VARIABLE: &str = "FISHEYE_INJECT_FAULT";
+
 /// Optional device features the project uses when the adapter has them.
 pub const OPTIONAL_FEATURES: [(wgpu::Features, &str); 6] = [
     (wgpu::Features::TIMESTAMP_QUERY, "timestamp queries"),
@@ -173,7 +202,10 @@ pub struct GpuContext {
     pub device: wgpu::Device,
     /// The device's queue.
     pub queue: wgpu::Queue,
+    /// Why the device was lost, once it is.
     lost: Arc<Mutex<Option<String>>>,
+    /// The first error outside every error scope (wgpu's default handler would panic).
+    uncaptured: Arc<Mutex<Option<String>>>,
 }
 
 /// Ranks adapters: hardware first, software (lavapipe) last; among equals, GL (which lacks
@@ -277,14 +309,29 @@ impl GpuContext {
         let lost = Arc::new(Mutex::new(None));
         let flag = lost.clone();
         device.set_device_lost_callback(move |reason, message| {
-            *flag.lock().unwrap() = Some(format!("{reason:?}: {message}"));
+            let said = if message.is_empty() {
+                String::new()
+            } else {
+                format!(": {message}")
+            };
+            *flag.lock().unwrap() = Some(format!("{reason:?}{said}"));
         });
-        Ok(Self {
+        let uncaptured = Arc::new(Mutex::new(None));
+        let first = uncaptured.clone();
+        device.on_uncaptured_error(Arc::new(move |error: wgpu::Error| {
+            first.lock().unwrap().get_or_insert(error.to_string());
+        }));
+        let ctx = Self {
             adapter,
             device,
             queue,
             lost,
-        })
+            uncaptured,
+        };
+        if std::env::var(FAULT_VARIABLE).as_deref() == Ok("device-lost") {
+            ctx.device.destroy();
+        }
+        Ok(ctx)
     }
 
     /// The adapter's name, backend and type, e.g. `llvmpipe (LLVM 19.1.7, 256 bits) (Vulkan, Cpu)`.
@@ -357,9 +404,18 @@ impl GpuContext {
         }
     }
 
+    /// An error if the device was lost or an error escaped the error scopes.
     fn check_lost(&self) -> Result<()> {
-        match self.lost.lock().unwrap().as_ref() {
-            Some(reason) => Err(Error::DeviceLost(reason.clone())),
+        // wgpu calls the lost callback from a poll; a lost device explains any later error.
+        let _ = self.device.poll(wgpu::PollType::Poll);
+        if let Some(reason) = self.lost.lock().unwrap().as_ref() {
+            return Err(Error::DeviceLost(reason.clone()));
+        }
+        match self.uncaptured.lock().unwrap().as_ref() {
+            Some(message) => Err(Error::Gpu {
+                during: "earlier GPU work".into(),
+                message: message.clone(),
+            }),
             None => Ok(()),
         }
     }
@@ -451,6 +507,20 @@ impl GpuContext {
         drop(view);
         staging.unmap();
         Ok(out)
+    }
+
+    /// Checks that an image of `size` fits the adapter's 2D texture limit, as every image we
+    /// make must, to be drawn, copied or handed on as a texture.
+    pub fn check_image(&self, size: crate::lens::ImageSize) -> Result<()> {
+        let max = self.device.limits().max_texture_dimension_2d;
+        if size.width > max || size.height > max {
+            return Err(crate::error::LensError::ImageSize {
+                text: format!("{}x{}", size.width, size.height),
+                reason: format!("above this adapter's 2D texture limit of {max} pixels a side"),
+            }
+            .into());
+        }
+        Ok(())
     }
 
     /// Checks that a storage binding of `bytes` fits the device, naming `what` if not.

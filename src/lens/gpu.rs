@@ -4,7 +4,6 @@
 
 use bytemuck::{Pod, Zeroable};
 use glam::{DVec2, DVec3, Vec2, Vec3};
-use wgpu::util::DeviceExt;
 
 use super::{CalibratedModel, Family, Lens, LensCamera, LensModel};
 use crate::error::Result;
@@ -263,11 +262,12 @@ pub fn lens_constants(camera: &LensCamera) -> [(&'static str, f64); 2] {
 
 /// The uniform buffer holding a camera's [`LensParams`].
 pub(crate) fn params_buffer(device: &wgpu::Device, camera: &LensCamera) -> wgpu::Buffer {
-    device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-        label: Some("fisheye.lens.params"),
-        contents: bytemuck::bytes_of(&LensParams::new(camera)),
-        usage: wgpu::BufferUsages::UNIFORM,
-    })
+    crate::gpu::buffer_init(
+        device,
+        "fisheye.lens.params",
+        bytemuck::bytes_of(&LensParams::new(camera)),
+        wgpu::BufferUsages::UNIFORM,
+    )
 }
 
 /// A `vec4<f32>` per-element result with `w` (or `z`) as the validity flag, to `Option`.
@@ -438,11 +438,12 @@ impl LensPoints {
         for part in input.chunks(chunk) {
             let results = ctx.checked("running the lens-points pass", || {
                 let device = &ctx.device;
-                let points = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                    label: Some("fisheye.lens_points.points"),
-                    contents: bytemuck::cast_slice(part),
-                    usage: wgpu::BufferUsages::STORAGE,
-                });
+                let points = crate::gpu::buffer_init(
+                    device,
+                    "fisheye.lens_points.points",
+                    bytemuck::cast_slice(part),
+                    wgpu::BufferUsages::STORAGE,
+                );
                 let results = device.create_buffer(&wgpu::BufferDescriptor {
                     label: Some("fisheye.lens_points.results"),
                     size: points.size(),

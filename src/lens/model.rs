@@ -22,7 +22,7 @@
 //! written `sin(k2 θ)`; we take the rate as `|k2|` so that `r ≥ 0` (the sign of k2 only selects
 //! the sine family).
 
-use std::f64::consts::{FRAC_PI_2, TAU};
+use std::f64::consts::{FRAC_PI_2, PI, TAU};
 
 use super::calibrated::CalibratedLens;
 use crate::error::LensError;
@@ -153,8 +153,9 @@ impl ClassicLens {
 
     /// Limits the full field of view to `fov` radians (a cone of half-angle `fov/2`).
     ///
-    /// Errors if `fov` is not in (0, 2π]. A limit wider than the model reaches is allowed and
-    /// has no effect; [`ClassicLens::theta_max`] reports what is effective.
+    /// Errors if `fov` is not in (0, 2π], or is wider than the model reaches: a rectilinear
+    /// lens's pole at 90° off axis, where `r` grows without bound, or the end of a sine
+    /// family's increasing part (90° for orthographic).
     pub fn with_max_fov(mut self, fov: f64) -> Result<Self, LensError> {
         if !(fov.is_finite() && fov > 0.0 && fov <= TAU * (1.0 + 1e-12)) {
             return Err(LensError::parameter(
@@ -162,6 +163,22 @@ impl ClassicLens {
                 fov.to_degrees(),
                 "must be in (0, 360] degrees",
             ));
+        }
+        let half = (fov / 2.0).min(PI);
+        let (end, why) = match self.domain_end() {
+            DomainEnd::Pole(p) => (p, (half >= p).then_some("r grows without bound")),
+            DomainEnd::Closed(t) => (
+                t,
+                (half > t * (1.0 + 1e-12)).then_some("its mapping stops increasing"),
+            ),
+        };
+        if let Some(why) = why {
+            return Err(LensError::Unreachable {
+                model: self.model.name(),
+                fov: fov.to_degrees(),
+                reach: 2.0 * end.to_degrees(),
+                why,
+            });
         }
         self.max_fov = Some(fov.min(TAU));
         Ok(self)

@@ -37,8 +37,8 @@ use std::path::{Path, PathBuf};
 use glam::{DAffine3, DMat3, DVec3, Vec3};
 use serde::Deserialize;
 
-use super::obj::{DEFAULT_AMBIENT, DEFAULT_SKY, Loaded, framing, load_into};
-use super::{Camera, Light, Material, MeshBuilder, Surface};
+use super::obj::{DEFAULT_AMBIENT, DEFAULT_SKY, Loaded, because, framing, load_into};
+use super::{Camera, Light, Material, MeshBuilder, ReadFile, Surface};
 use crate::error::{Error, Result};
 
 type Triple = [f64; 3];
@@ -174,6 +174,11 @@ impl Check<'_> {
         if c.min_element() < 0.0 {
             return self.fail(format!("{what} = {v:?}: must not be negative"));
         }
+        if !c.as_vec3().is_finite() {
+            return self.fail(format!(
+                "{what} = {v:?}: beyond the f32 range the GPU computes in"
+            ));
+        }
         Ok(c.as_vec3())
     }
 
@@ -259,11 +264,23 @@ impl Check<'_> {
 /// Loads a scene file: its meshes (OBJ files loaded with their MTL, or shapes), material
 /// overrides, lights, sky and camera. Problems that do not stop the load come back as warnings.
 pub fn load_scene_file(path: &Path) -> Result<Loaded> {
+    load_scene_file_from(path, &super::disk)
+}
+
+/// As [`load_scene_file`], reading the file and the files it names through `read`.
+pub fn load_scene_file_from(path: &Path, read: ReadFile) -> Result<Loaded> {
     let check = Check { path };
-    let text = std::fs::read_to_string(path).map_err(|source| Error::Io {
+    let bytes = read(path).map_err(|source| Error::Io {
         path: path.to_path_buf(),
         source,
     })?;
+    let text = match String::from_utf8(bytes) {
+        Ok(text) => text,
+        Err(e) => {
+            let at = e.utf8_error().valid_up_to();
+            return check.fail(format!("not UTF-8 text (byte {at}), as TOML must be"));
+        }
+    };
     let file: SceneFile = toml::from_str(&text).map_err(|e| Error::SceneFile {
         path: path.to_path_buf(),
         message: e.to_string().trim_end().to_string(),
@@ -279,7 +296,7 @@ pub fn load_scene_file(path: &Path) -> Result<Loaded> {
         let transform = check.transform(&what, mesh)?;
         let first = b.len();
         match (&mesh.path, mesh.shape) {
-            (Some(obj), None) => load_into(&dir.join(obj), &mut b, &mut warnings)?,
+            (Some(obj), None) => load_into(&dir.join(obj), read, &mut b, &mut warnings)?,
             (None, Some(shape)) => {
                 let grey = b.material(Material::diffuse(&what, Vec3::splat(0.8)));
                 match shape {
@@ -320,6 +337,9 @@ pub fn load_scene_file(path: &Path) -> Result<Loaded> {
                 names.join(", ")
             ));
         }
+    }
+    if b.is_empty() {
+        return check.fail(format!("no triangles to render{}", because(&warnings)));
     }
     let mut lights = Vec::new();
     for (i, light) in file.lights.iter().enumerate() {

@@ -5,12 +5,22 @@
 
 pub mod builtin;
 pub mod file;
+mod lint;
 mod mesh;
 pub mod obj;
 
 use glam::{DMat3, DVec3, Vec2, Vec3};
 
 pub use mesh::{MeshBuilder, checker};
+
+/// How loaders read the files a scene names: [`disk`], or bytes held in memory (tests and the
+/// fuzz targets).
+pub type ReadFile<'a> = &'a dyn Fn(&std::path::Path) -> std::io::Result<Vec<u8>>;
+
+/// Reads a file from the file system.
+pub fn disk(path: &std::path::Path) -> std::io::Result<Vec<u8>> {
+    std::fs::read(path)
+}
 
 /// How a surface scatters light in the Whitted model.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

@@ -1,10 +1,12 @@
 //! Wavefront OBJ + MTL scenes through `tobj` (triangulated, parsed in f64).
 
+use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 
 use glam::{DVec3, Vec2, Vec3};
 
-use super::{Camera, Light, Material, MeshBuilder, Scene, Surface, Texture};
+use super::lint::{self, LineError};
+use super::{Camera, Light, Material, MeshBuilder, ReadFile, Scene, Surface, Texture};
 use crate::error::{Error, Result};
 
 /// A loaded scene and what was repaired or ignored on the way, for the user to read.
@@ -25,6 +27,7 @@ fn material(
     m: &tobj::Material,
     textures: &mut Vec<Texture>,
     dir: &Path,
+    read: ReadFile,
     warnings: &mut Vec<String>,
 ) -> Material {
     let surface = match m.illumination_model {
@@ -43,7 +46,10 @@ fn material(
     };
     let diffuse_texture = m.diffuse_texture.as_ref().and_then(|name| {
         let path = dir.join(name.replace('\\', "/"));
-        match image::open(&path) {
+        let image = read(&path)
+            .map_err(|e| e.to_string())
+            .and_then(|bytes| image::load_from_memory(&bytes).map_err(|e| e.to_string()));
+        match image {
             Ok(img) => {
                 let rgba = img.to_rgba8();
                 textures.push(Texture {
@@ -92,32 +98,80 @@ fn material(
     }
 }
 
-/// Loads an OBJ (and its MTL files and textures) into a [`MeshBuilder`].
-pub fn load_into(path: &Path, b: &mut MeshBuilder, warnings: &mut Vec<String>) -> Result<()> {
+/// An error on a line of an OBJ or MTL file.
+fn line_error(path: &Path, e: LineError) -> Error {
+    Error::Obj {
+        path: path.to_path_buf(),
+        message: format!("line {}: {}", e.line, e.message),
+    }
+}
+
+/// Loads an OBJ (and its MTL files and textures, through `read`) into a [`MeshBuilder`].
+///
+/// Every line is checked before tobj reads it (see `lint`); triangles with non-finite corners
+/// or no area are dropped with a warning naming their mesh.
+pub fn load_into(
+    path: &Path,
+    read: ReadFile,
+    b: &mut MeshBuilder,
+    warnings: &mut Vec<String>,
+) -> Result<()> {
+    let obj_error = |message: String| Error::Obj {
+        path: path.to_path_buf(),
+        message,
+    };
+    let bytes = read(path).map_err(|e| obj_error(format!("cannot open the file: {e}")))?;
+    let text = lint::clean(&String::from_utf8_lossy(&bytes));
+    let facts = lint::check_obj(&text).map_err(|e| line_error(path, e))?;
+    let shown = path.display();
+    warnings.extend(facts.warnings.iter().map(|w| format!("{shown}: {w}")));
+    let dir = path.parent().map_or_else(PathBuf::new, Path::to_path_buf);
+    let mut mtls = HashMap::new();
+    for name in &facts.mtllibs {
+        let mtl_path = dir.join(name);
+        match read(&mtl_path) {
+            Ok(bytes) => {
+                let mtl = lint::clean(&String::from_utf8_lossy(&bytes));
+                let checked = lint::check_mtl(&mtl).map_err(|e| line_error(&mtl_path, e))?;
+                let shown = mtl_path.display();
+                warnings.extend(checked.warnings.iter().map(|w| format!("{shown}: {w}")));
+                mtls.insert(PathBuf::from(name), mtl);
+            }
+            Err(e) => warnings.push(format!(
+                "{shown}: its MTL {} could not be read ({e}); using grey",
+                mtl_path.display()
+            )),
+        }
+    }
     let options = tobj::LoadOptions {
         triangulate: true,
         single_index: true,
-        ..Default::default()
+        ignore_points: true,
+        ignore_lines: true,
     };
-    let (models, materials) = tobj::load_obj(path, &options).map_err(|e| Error::Obj {
-        path: path.to_path_buf(),
-        message: match e {
-            tobj::LoadError::OpenFileFailed => "cannot open the file".into(),
-            other => other.to_string(),
-        },
-    })?;
-    let dir = path.parent().map_or_else(PathBuf::new, Path::to_path_buf);
-    let materials = materials.unwrap_or_else(|e| {
-        warnings.push(format!(
-            "{}: its MTL could not be loaded ({e}); using grey",
-            path.display()
-        ));
-        Vec::new()
-    });
+    // The check above keeps tobj from the inputs it panics on; should it still panic, the
+    // user gets an error, not a crash.
+    let loaded = std::panic::catch_unwind(|| {
+        tobj::load_obj_buf(&mut text.as_bytes(), &options, |p| match mtls.get(p) {
+            Some(mtl) => tobj::load_mtl_buf(&mut mtl.as_bytes()),
+            None => Err(tobj::LoadError::OpenFileFailed),
+        })
+    })
+    .map_err(|_| obj_error("the OBJ loader (tobj) failed on this file".into()))?;
+    let (models, materials) = loaded.map_err(|e| obj_error(e.to_string()))?;
+    // Every MTL that was read passed the check, so tobj read it too.
+    let materials = materials.unwrap_or_default();
+    for (name, line) in &facts.used_materials {
+        if !materials.iter().any(|m| &m.name == name) {
+            warnings.push(format!(
+                "{shown}: line {line}: usemtl {name:?}: no MTL defines it; using grey"
+            ));
+        }
+    }
     let mut textures = Vec::new();
     let converted: Vec<Material> = materials
         .iter()
-        .map(|m| material(m, &mut textures, &dir, warnings))
+        .map(|m| material(m, &mut textures, &dir, read, warnings))
         .collect();
     let texture_base = b.texture_count();
     for t in textures {
@@ -130,46 +184,88 @@ pub fn load_into(path: &Path, b: &mut MeshBuilder, warnings: &mut Vec<String>) -
     }
     let default = b.material(Material::diffuse("default", Vec3::splat(0.8)));
     for model in &models {
-        let mesh = &model.mesh;
-        let material = mesh.material_id.map_or(default, |m| base + m as u32);
-        let position = |i: u32| {
-            let k = 3 * i as usize;
-            DVec3::new(
-                mesh.positions[k],
-                mesh.positions[k + 1],
-                mesh.positions[k + 2],
-            )
-        };
-        let normal = |i: u32| {
-            let k = 3 * i as usize;
-            DVec3::new(mesh.normals[k], mesh.normals[k + 1], mesh.normals[k + 2]).as_vec3()
-        };
-        let uv = |i: u32| {
-            let k = 2 * i as usize;
-            Vec2::new(mesh.texcoords[k] as f32, mesh.texcoords[k + 1] as f32)
-        };
-        let mut dropped = 0;
-        for face in mesh.indices.chunks_exact(3) {
-            let corners = [face[0], face[1], face[2]].map(position);
-            if !corners.iter().all(|p| p.is_finite()) {
-                dropped += 1;
-                continue;
-            }
-            let normals = (!mesh.normals.is_empty())
-                .then(|| [face[0], face[1], face[2]].map(normal))
-                .filter(|n| n.iter().all(|n| n.is_finite() && n.length_squared() > 0.0));
-            let uvs = (!mesh.texcoords.is_empty()).then(|| [face[0], face[1], face[2]].map(uv));
-            b.triangle(corners, normals, uvs, material);
-        }
-        if dropped > 0 {
-            warnings.push(format!(
-                "{}: mesh {:?}: dropped {dropped} triangles with non-finite vertices",
-                path.display(),
-                model.name
-            ));
-        }
+        add_mesh(path, model, base, default, b, warnings);
     }
     Ok(())
+}
+
+/// Adds one tobj mesh's triangles, dropping (with a warning naming the mesh) those with
+/// non-finite corners, which are undefined behaviour in hardware acceleration structures, and
+/// those with no area, which no ray hits.
+fn add_mesh(
+    path: &Path,
+    model: &tobj::Model,
+    material_base: u32,
+    default: u32,
+    b: &mut MeshBuilder,
+    warnings: &mut Vec<String>,
+) {
+    let mesh = &model.mesh;
+    let material = mesh
+        .material_id
+        .map_or(default, |m| material_base + m as u32);
+    let vertices = mesh.positions.len() / 3;
+    let warn = |what: String| format!("{}: mesh {:?}: {what}", path.display(), model.name);
+    // A mesh whose faces give texture coordinates or normals to some vertices only gets a
+    // shorter array from tobj: use neither then.
+    let has_normals = !mesh.normals.is_empty();
+    let has_uvs = !mesh.texcoords.is_empty();
+    let normals_ok = mesh.normals.len() == 3 * vertices;
+    let uvs_ok = mesh.texcoords.len() == 2 * vertices;
+    for (has, ok, what) in [
+        (has_normals, normals_ok, "normals"),
+        (has_uvs, uvs_ok, "texture coordinates"),
+    ] {
+        if has && !ok {
+            warnings.push(warn(format!(
+                "some faces give {what} and some do not; ignoring its {what}"
+            )));
+        }
+    }
+    let position = |i: u32| {
+        let k = 3 * i as usize;
+        DVec3::new(
+            mesh.positions[k],
+            mesh.positions[k + 1],
+            mesh.positions[k + 2],
+        )
+    };
+    let normal = |i: u32| {
+        let k = 3 * i as usize;
+        DVec3::new(mesh.normals[k], mesh.normals[k + 1], mesh.normals[k + 2]).as_vec3()
+    };
+    let uv = |i: u32| {
+        let k = 2 * i as usize;
+        Vec2::new(mesh.texcoords[k] as f32, mesh.texcoords[k + 1] as f32)
+    };
+    let (mut non_finite, mut flat) = (0, 0);
+    for face in mesh.indices.chunks_exact(3) {
+        let face = [face[0], face[1], face[2]];
+        let corners = face.map(position);
+        if !corners.iter().all(|p| p.is_finite()) {
+            non_finite += 1;
+            continue;
+        }
+        if (corners[1] - corners[0]).cross(corners[2] - corners[0]) == DVec3::ZERO {
+            flat += 1;
+            continue;
+        }
+        let normals = (has_normals && normals_ok)
+            .then(|| face.map(normal))
+            .filter(|n| n.iter().all(|n| n.is_finite() && n.length_squared() > 0.0));
+        let uvs = (has_uvs && uvs_ok).then(|| face.map(uv));
+        b.triangle(corners, normals, uvs, material);
+    }
+    if non_finite > 0 {
+        warnings.push(warn(format!(
+            "dropped {non_finite} triangles with non-finite vertices"
+        )));
+    }
+    if flat > 0 {
+        warnings.push(warn(format!(
+            "dropped {flat} triangles of zero area (corners on one line)"
+        )));
+    }
 }
 
 /// The sky of scenes that do not set one.
@@ -181,7 +277,10 @@ pub const DEFAULT_AMBIENT: Vec3 = Vec3::splat(0.08);
 /// radii, whatever its units or offset, with a headlight at the camera and a sun.
 pub fn framing(lo: DVec3, hi: DVec3) -> (Camera, Vec<Light>) {
     let centre = (lo + hi) / 2.0;
-    let radius = ((hi - lo).length() / 2.0).max(1e-6);
+    // Scaled so that the length of a box beyond 1e154 does not overflow.
+    let half = (hi - lo) / 2.0;
+    let scale = half.max_element().max(1e-6);
+    let radius = (scale * (half / scale).length()).max(1e-6);
     let position = centre + DVec3::new(0.0, 0.3 * radius, 1.3 * radius);
     let lights = vec![
         Light::Point {
@@ -203,11 +302,32 @@ pub fn framing(lo: DVec3, hi: DVec3) -> (Camera, Vec<Light>) {
 
 /// A bare OBJ as a scene, [`framing`] its bounds so that any OBJ shows something.
 pub fn load_obj(path: &Path) -> Result<Loaded> {
+    load_obj_from(path, &super::disk)
+}
+
+/// As [`load_obj`], reading the OBJ and the files it names through `read`.
+///
+/// Errors if no triangle is left to render.
+pub fn load_obj_from(path: &Path, read: ReadFile) -> Result<Loaded> {
     let mut b = MeshBuilder::new();
     let mut warnings = Vec::new();
-    load_into(path, &mut b, &mut warnings)?;
+    load_into(path, read, &mut b, &mut warnings)?;
+    if b.is_empty() {
+        return Err(Error::Obj {
+            path: path.to_path_buf(),
+            message: format!("no triangles to render{}", because(&warnings)),
+        });
+    }
     let (lo, hi) = b.bounds().unwrap_or((DVec3::ZERO, DVec3::ZERO));
     let (camera, lights) = framing(lo, hi);
     let scene = b.finish(lights, DEFAULT_SKY, DEFAULT_AMBIENT, camera);
     Ok(Loaded { scene, warnings })
+}
+
+/// `": " + the warnings`, to say why a load left nothing (empty when there are none).
+pub(crate) fn because(warnings: &[String]) -> String {
+    match warnings {
+        [] => String::new(),
+        w => format!(" ({})", w.join("; ")),
+    }
 }

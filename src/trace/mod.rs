@@ -7,8 +7,7 @@ mod output;
 mod ray_query;
 
 use bytemuck::{Pod, Zeroable};
-use glam::{DMat3, DVec3};
-use wgpu::util::DeviceExt;
+use glam::{DMat3, DVec3, Vec3};
 
 pub use output::{Channel, RenderOutput, colour_image, linear_to_srgb};
 pub use ray_query::RayQueryScene;
@@ -162,7 +161,7 @@ fn to3(v: glam::Vec3) -> [f32; 3] {
 
 /// Per scene triangle: vertex normals when smooth, UVs when textured, as `vec4<f32>`s.
 pub fn shading_vertices(scene: &Scene, features: Features) -> Vec<[f32; 4]> {
-    let mut out = Vec::new();
+    let mut out = Vec::with_capacity(scene.len() * shading_vectors_per_triangle(features));
     for i in 0..scene.len() {
         if features.smooth_normals {
             let n = scene.normals.as_ref().expect("smooth normals")[i];
@@ -175,6 +174,81 @@ pub fn shading_vertices(scene: &Scene, features: Features) -> Vec<[f32; 4]> {
         }
     }
     out
+}
+
+/// The scene's lights as the GPU reads them, relative to `origin`, and the shadow-map layers
+/// they need (see [`GpuLight::shadow_layer`]). Errors if a light's position, direction or
+/// colour does not survive the rounding to f32.
+pub fn gpu_lights(scene: &Scene, origin: DVec3) -> Result<(Vec<GpuLight>, u32)> {
+    let mut shadow_layers = 0;
+    let mut lights = Vec::new();
+    for (i, light) in scene.lights.iter().enumerate() {
+        let (point, vector, colour) = light.relative_to(origin);
+        // A point light may sit at the camera; a direction must not vanish.
+        if !(vector.is_finite() && (point || vector != Vec3::ZERO) && colour.is_finite()) {
+            return Err(Error::Scene(format!(
+                "light {} ({light:?}) is beyond the f32 range the GPU computes in, relative \
+                 to the camera at {origin}",
+                i + 1
+            )));
+        }
+        lights.push(GpuLight {
+            vector: vector.to_array(),
+            kind: LIGHT_KINDS[usize::from(!point)].1,
+            colour: to3(colour),
+            shadow_layer: shadow_layers,
+        });
+        shadow_layers += if point { 6 } else { 1 };
+    }
+    Ok((lights, shadow_layers))
+}
+
+/// How many `vec4<f32>` of [`shading_vertices`] each triangle has.
+fn shading_vectors_per_triangle(f: Features) -> usize {
+    3 * usize::from(f.smooth_normals) + 2 * usize::from(f.textures)
+}
+
+/// Refuses a scene whose triangles, shading data or texels would not fit one storage binding
+/// of the adapter, with the numbers, before the BVH is built for nothing.
+fn check_scene_size(ctx: &GpuContext, scene: &Scene, features: Features) -> Result<()> {
+    let limit = ctx.device.limits().max_storage_buffer_binding_size;
+    let triangles = scene.len() as u64;
+    let mib = |bytes: u64| bytes as f64 / f64::from(1 << 20);
+    let per_triangle = [
+        ("triangle data", size_of::<crate::bvh::GpuTriangle>() as u64),
+        (
+            "shading data (vertex normals and UVs)",
+            16 * shading_vectors_per_triangle(features) as u64,
+        ),
+    ];
+    for (what, each) in per_triangle {
+        if each * triangles > limit {
+            return Err(Error::Scene(format!(
+                "{triangles} triangles are too many for this adapter: their {what} takes \
+                 {:.1} MiB ({each} bytes a triangle), above its limit of {:.0} MiB per storage \
+                 binding; at most {} triangles fit",
+                mib(each * triangles),
+                mib(limit),
+                limit / each
+            )));
+        }
+    }
+    let texels: u64 = scene
+        .textures
+        .iter()
+        .filter(|_| features.textures)
+        .map(|t| 4 * u64::from(t.width) * u64::from(t.height))
+        .sum();
+    if texels > limit {
+        return Err(Error::Scene(format!(
+            "the scene's {} textures take {:.1} MiB, above this adapter's limit of {:.0} MiB \
+             per storage binding; use smaller textures",
+            scene.textures.len(),
+            mib(texels),
+            mib(limit)
+        )));
+    }
+    Ok(())
 }
 
 /// The overrides of `wgsl/surface.wgsl` for a scene's features: code for what the scene does
@@ -227,13 +301,12 @@ fn storage_for<T: Pod>(
     let data = if data.is_empty() { &zero[..] } else { data };
     let bytes: &[u8] = bytemuck::cast_slice(data);
     ctx.check_binding(label, bytes.len() as u64)?;
-    Ok(ctx
-        .device
-        .create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: Some(label),
-            contents: bytes,
-            usage: wgpu::BufferUsages::STORAGE | extra,
-        }))
+    Ok(crate::gpu::buffer_init(
+        &ctx.device,
+        label,
+        bytes,
+        wgpu::BufferUsages::STORAGE | extra,
+    ))
 }
 
 /// A scene on the GPU: its BVH, triangles, materials, lights, shading data and textures, in
@@ -279,9 +352,10 @@ impl GpuScene {
         if options.traversal == Traversal::RayQuery {
             RayQueryScene::check(ctx, scene.len() as u64)?;
         }
+        let features = scene.features();
+        check_scene_size(ctx, scene, features)?;
         let origin = scene.camera.position;
         let bvh = SceneBvh::build(scene, origin, options.bvh)?;
-        let features = scene.features();
         let materials: Vec<GpuMaterial> = scene
             .materials
             .iter()
@@ -298,26 +372,7 @@ impl GpuScene {
                 pad: [0; 3],
             })
             .collect();
-        let mut shadow_layers = 0;
-        let lights: Vec<GpuLight> = scene
-            .lights
-            .iter()
-            .map(|l| {
-                let (point, vector, colour) = l.relative_to(origin);
-                let shadow_layer = shadow_layers;
-                shadow_layers += if point { 6 } else { 1 };
-                GpuLight {
-                    vector: vector.to_array(),
-                    kind: if point {
-                        LIGHT_KINDS[0].1
-                    } else {
-                        LIGHT_KINDS[1].1
-                    },
-                    colour: to3(colour),
-                    shadow_layer,
-                }
-            })
-            .collect();
+        let (lights, shadow_layers) = gpu_lights(scene, origin)?;
         let mut texture_info = Vec::new();
         let mut texels: Vec<u32> = Vec::new();
         if features.textures {
@@ -358,11 +413,12 @@ impl GpuScene {
         ];
         let scene = ctx.checked("uploading the scene", || {
             let device = &ctx.device;
-            let uniform = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                label: Some("fisheye.scene.shading"),
-                contents: bytemuck::bytes_of(&shading),
-                usage: wgpu::BufferUsages::UNIFORM,
-            });
+            let uniform = crate::gpu::buffer_init(
+                device,
+                "fisheye.scene.shading",
+                bytemuck::bytes_of(&shading),
+                wgpu::BufferUsages::UNIFORM,
+            );
             // Binding order = @binding(n) order in wgsl/bvh.wgsl, wgsl/triangles.wgsl and
             // wgsl/surface.wgsl; the rasterizer reads them in its vertex and fragment stages.
             let mut entries: Vec<_> = (0..7).map(|b| storage_entry(b, true)).collect();
@@ -437,6 +493,7 @@ impl TracePass {
         source: DirectionSource,
         views: u32,
     ) -> Result<Self> {
+        ctx.check_image(camera.size)?;
         let pixels = camera.size.pixels() as u64;
         for (what, bytes) in [
             ("the colour output", 16 * pixels),
@@ -495,11 +552,12 @@ impl TracePass {
                     slot
                 })
                 .collect();
-            let frame = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                label: Some("fisheye.trace.frame"),
-                contents: &slots,
-                usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
-            });
+            let frame = crate::gpu::buffer_init(
+                device,
+                "fisheye.trace.frame",
+                &slots,
+                wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            );
             let placeholder = output("fisheye.trace.no_table", 16);
             let table = table.as_ref().map_or(&placeholder, |t| &t.directions);
             let lens = params_buffer(device, camera);
@@ -662,7 +720,7 @@ mod tests {
         assert_wgsl_layout(
             "triangles",
             "BvhTriangle",
-            size_of::<GpuTriangle>(),
+            size_of::<crate::bvh::GpuTriangle>(),
             &[
                 ("v0", offset_of!(GpuTriangle, v0)),
                 ("triangle", offset_of!(GpuTriangle, triangle)),
