@@ -26,8 +26,6 @@ pub(crate) struct ObjFacts {
     pub mtllibs: Vec<String>,
     /// Each material `usemtl` names, with the first line naming it.
     pub used_materials: BTreeMap<String, usize>,
-    /// `f` statements.
-    pub faces: usize,
 }
 
 /// OBJ statements of free-form geometry, grouping and display that tobj skips.
@@ -172,10 +170,13 @@ fn name_after_space(text: &str) -> &str {
     text.split_once(' ').map_or("", |(_, rest)| rest.trim())
 }
 
-/// Where a face refers to: the index (1-based, or negative counting back) of a position, a
-/// texture coordinate and a normal.
+/// What a face vertex refers to, by slot: a position, a texture coordinate, a normal.
+const KINDS: [&str; 3] = ["position", "texture coordinate", "normal"];
+
+/// One index of a face vertex: its slot in [`KINDS`] and the index (1-based, or negative
+/// counting back).
 struct Reference {
-    kind: &'static str,
+    slot: usize,
     index: isize,
 }
 
@@ -244,28 +245,22 @@ pub(crate) fn check_obj(text: &str) -> Result<ObjFacts, LineError> {
                     ));
                 }
                 for word in args {
-                    for r in references(line, word)? {
-                        let slot = match r.kind {
-                            "position" => 0,
-                            "texture coordinate" => 1,
-                            _ => 2,
-                        };
-                        if r.index > 0 {
-                            forward.push((line, slot, r.index));
-                        } else if r.index.unsigned_abs() > counts[slot] {
+                    for Reference { slot, index } in references(line, word)? {
+                        if index > 0 {
+                            forward.push((line, slot, index));
+                        } else if index.unsigned_abs() > counts[slot] {
                             return Err(error(
                                 line,
                                 format!(
-                                    "{} index {} reaches back past the first: only {} so far",
-                                    r.kind, r.index, counts[slot]
+                                    "{} index {index} reaches back past the first: only {} so \
+                                     far",
+                                    KINDS[slot], counts[slot]
                                 ),
                             ));
                         }
                     }
                 }
-                if keyword == "f" {
-                    facts.faces += 1;
-                } else {
+                if keyword == "l" {
                     skipped.entry("l".into()).or_insert((line, 0)).1 += 1;
                 }
             }
@@ -287,7 +282,6 @@ pub(crate) fn check_obj(text: &str) -> Result<ObjFacts, LineError> {
             other => skipped.entry(other.into()).or_insert((line, 0)).1 += 1,
         }
     }
-    const KINDS: [&str; 3] = ["position", "texture coordinate", "normal"];
     for (line, slot, index) in forward {
         if index.unsigned_abs() > counts[slot] {
             return Err(error(
@@ -330,10 +324,7 @@ fn references(line: usize, word: &str) -> Result<Vec<Reference>, LineError> {
         ));
     }
     let mut out = Vec::new();
-    for (part, kind) in parts
-        .iter()
-        .zip(["position", "texture coordinate", "normal"])
-    {
+    for (slot, (part, kind)) in parts.iter().zip(KINDS).enumerate() {
         if part.is_empty() {
             continue;
         }
@@ -349,7 +340,7 @@ fn references(line: usize, word: &str) -> Result<Vec<Reference>, LineError> {
                 format!("face vertex {word:?}: {kind} index 0 (OBJ indices start at 1)"),
             ));
         }
-        out.push(Reference { kind, index });
+        out.push(Reference { slot, index });
     }
     Ok(out)
 }
@@ -511,7 +502,6 @@ mod tests {
         let facts = check_obj(&clean(text)).unwrap();
         assert_eq!(facts.mtllibs, ["a b.mtl"]);
         assert_eq!(facts.used_materials.get("red"), Some(&12));
-        assert_eq!(facts.faces, 5);
         let warnings = facts.warnings.join("\n");
         for wanted in [
             "line 20: `curv` skipped: free-form",
