@@ -379,7 +379,7 @@ impl GpuContext {
     /// Runs `work` inside validation, out-of-memory and internal error scopes and turns what
     /// they catch, or a lost device, into an [`Error`] naming `during`.
     pub fn checked<T>(&self, during: &str, work: impl FnOnce() -> T) -> Result<T> {
-        self.check_lost()?;
+        self.check_lost(false)?;
         let scopes = [
             wgpu::ErrorFilter::Internal,
             wgpu::ErrorFilter::OutOfMemory,
@@ -394,7 +394,7 @@ impl GpuContext {
                 first.get_or_insert(error);
             }
         }
-        self.check_lost()?;
+        self.check_lost(first.is_some())?;
         match first {
             Some(error) => Err(Error::Gpu {
                 during: during.to_string(),
@@ -404,10 +404,14 @@ impl GpuContext {
         }
     }
 
-    /// An error if the device was lost or an error escaped the error scopes.
-    fn check_lost(&self) -> Result<()> {
-        // wgpu calls the lost callback from a poll; a lost device explains any later error.
-        let _ = self.device.poll(wgpu::PollType::Poll);
+    /// An error if the device was lost or an error escaped the error scopes. wgpu calls the
+    /// lost callback from a poll, so after an error (`failed`, or one that escaped the scopes)
+    /// this polls once, for a lost device to explain it; on the error-free path of every frame
+    /// it does not.
+    fn check_lost(&self, failed: bool) -> Result<()> {
+        if failed || self.uncaptured.lock().unwrap().is_some() {
+            let _ = self.device.poll(wgpu::PollType::Poll);
+        }
         if let Some(reason) = self.lost.lock().unwrap().as_ref() {
             return Err(Error::DeviceLost(reason.clone()));
         }
@@ -428,7 +432,8 @@ impl GpuContext {
                 during: "waiting for the GPU".into(),
                 message: e.to_string(),
             })?;
-        self.check_lost()
+        // The blocking poll above has called the lost callback if the device is gone.
+        self.check_lost(false)
     }
 
     /// Copies `buffer` (which must have `COPY_SRC`) to the CPU as `T`s.
