@@ -2,8 +2,7 @@
 //! shared real scenes, in triangles per second, with Criterion. The build includes what the
 //! tracer uploads: camera-relative f32 triangles reordered by `primitive_indices`.
 //!
-//! `cargo bench --bench bvh` (the shared scenes are read from `../shared/scenes/`; scenes
-//! that are missing are skipped with a note).
+//! `cargo bench --bench bvh` (the third-party scenes ship in `scenes/`).
 
 use std::hint::black_box;
 use std::time::Duration;
@@ -21,10 +20,8 @@ fn scenes() -> Vec<(&'static str, Scene)> {
         concat!(env!("CARGO_MANIFEST_DIR"), "/scenes/bunny.toml"),
     ] {
         let name = spec.rsplit('/').next().unwrap_or(spec);
-        match scene::load(spec) {
-            Ok(loaded) => out.push((name, loaded.scene)),
-            Err(e) => eprintln!("skipping {name}: {e}"),
-        }
+        let loaded = scene::load(spec).unwrap_or_else(|e| panic!("{name}: {e}"));
+        out.push((name, loaded.scene));
     }
     out
 }
