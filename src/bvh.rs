@@ -16,6 +16,13 @@ use crate::scene::Scene;
 /// is refused at build time rather than traversed wrongly.
 pub const TRAVERSAL_STACK: u32 = 32;
 
+/// The widest extent, in scene units from the camera, of a scene the BVH is built for. obvhs
+/// computes surface areas in f32, and past about 1e19 they overflow and its build panics
+/// (measured: a chain of triangles doubling in distance up to 2^69 units); 1e18 leaves room
+/// for its sums of areas. No f32 geometry is meaningful across such a span anyway: at 1e18 a
+/// coordinate's ulp is 1e11.
+pub const MAX_EXTENT: f64 = 1e18;
+
 /// obvhs's build presets, fastest build first.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum BvhQuality {
@@ -128,6 +135,16 @@ impl SceneBvh {
                 corners(scene.triangles[i].map(|p| p - origin))
             )));
         }
+        let extent = rounded
+            .iter()
+            .flatten()
+            .fold(0.0f32, |e, p| e.max(p.abs().max_element()));
+        if f64::from(extent) > MAX_EXTENT {
+            return Err(Error::Scene(format!(
+                "the scene reaches {extent:e} units from the camera; the BVH is built in f32 \
+                 for scenes within {MAX_EXTENT:e}"
+            )));
+        }
         if rounded.is_empty() {
             return Ok(Self {
                 nodes: vec![CwBvhNode::default()],
@@ -225,5 +242,39 @@ mod tests {
             message.contains("triangle 1") && message.contains("f32 range"),
             "{message}"
         );
+    }
+
+    /// A scene wider than [`MAX_EXTENT`] is refused before obvhs, which would panic on it; a
+    /// scene just inside builds.
+    #[test]
+    fn scenes_beyond_the_extent_are_refused() {
+        let chain = |last: i32| {
+            let mut b = MeshBuilder::new();
+            let m = b.material(Material::diffuse("grey", Vec3::ONE));
+            for k in 0..=last {
+                let x = 2f64.powi(k);
+                let s = 0.1 * x;
+                let corners = [
+                    DVec3::new(x, 0.0, 0.0),
+                    DVec3::new(x + s, 0.0, 0.0),
+                    DVec3::new(x, s, 0.0),
+                ];
+                b.triangle(corners, None, None, m);
+            }
+            let camera = Camera {
+                position: DVec3::ZERO,
+                look_at: DVec3::X,
+                up: DVec3::Y,
+            };
+            let scene = b.finish(Vec::new(), Vec3::ZERO, Vec3::ZERO, camera);
+            SceneBvh::build(&scene, scene.camera.position, BvhQuality::Fast).map(|b| b.depth)
+        };
+        // 2^69 (with its 10% triangle) panicked inside obvhs; 2^58 is within 1e18.
+        let message = chain(69).expect_err("refused").to_string();
+        assert!(
+            message.contains("6.4") && message.contains("1e18"),
+            "{message}"
+        );
+        assert!(chain(58).is_ok());
     }
 }

@@ -660,17 +660,6 @@ mod tests {
     }
 
     #[test]
-    fn a_face_edge_is_shared_by_its_neighbours_in_the_border() {
-        // A point on the +z/+x edge, seen from both faces: u = 1 on +z, u = 0 on +x.
-        let d = Vec3::new(1.0, 0.25, 1.0);
-        let on_z = (Vec2::new(d.x, d.y) / d.z + 1.0) * 0.5;
-        assert_eq!(on_z, Vec2::new(1.0, 0.625));
-        let x = &FACES[0];
-        let on_x = (Vec2::new(d.dot(x.right), d.dot(x.down)) / d.dot(x.forward) + 1.0) * 0.5;
-        assert_eq!(on_x, Vec2::new(0.0, 0.625));
-    }
-
-    #[test]
     fn bilinear_sampling_reads_the_border() {
         // A face of 2 texels (4 × 4 bordered) whose texel (x, y) holds x + 10 y: sampling is
         // exact for this linear function anywhere, the border included.

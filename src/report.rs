@@ -755,12 +755,75 @@ impl CompareReport {
 
 #[cfg(test)]
 mod tests {
-    use super::speed_ratio;
+    use super::*;
 
     #[test]
     fn speed_ratios_read_as_faster_or_slower() {
         assert_eq!(speed_ratio(2.5), "2.50x faster");
         assert_eq!(speed_ratio(1.0), "1.00x faster");
         assert_eq!(speed_ratio(0.5), "2.00x slower");
+    }
+
+    /// A setup with a time (GPU, else wall) and an MSE against the supersampled reference.
+    fn entry(setup: &str, gpu_ms: Option<f64>, wall_ms: f64, mse: f64) -> CompareEntry {
+        let error = ImageError {
+            mse,
+            psnr_db: -10.0 * mse.log10(),
+            max_abs: mse.sqrt(),
+            mask_agreement: 1.0,
+            compared: 1,
+        };
+        let (method, cube_size) = match setup.split_once('@') {
+            Some((_, size)) => ("cube-rt", Some(size.parse().unwrap())),
+            None => ("rt", None),
+        };
+        CompareEntry {
+            lens: "lens".into(),
+            setup: setup.into(),
+            method,
+            cube_size,
+            gpu_ms,
+            wall_ms,
+            error: error.clone(),
+            error_supersampled: error,
+            pareto: false,
+        }
+    }
+
+    /// The verdict names the fastest cube setting whose error is no larger than RT's (equal
+    /// counts), with its time over RT's; without one, the most accurate cube setting instead;
+    /// times are GPU times where there are some.
+    #[test]
+    fn the_verdict_takes_the_fastest_cube_at_least_as_accurate() {
+        let entries = [
+            entry("rt", Some(10.0), 50.0, 0.01),
+            entry("cube-rt@64", Some(5.0), 1.0, 0.02),
+            entry("cube-rt@256", Some(30.0), 1.0, 0.005),
+            entry("cube-rt@128", Some(20.0), 1.0, 0.01),
+        ];
+        let v = verdict("lens", &entries).unwrap();
+        assert_eq!((v.rt_ms, v.rt_mse), (10.0, 0.01));
+        assert_eq!(v.cube.as_deref(), Some("cube-rt@128"));
+        assert_eq!(v.speedup, Some(2.0));
+        assert_eq!(v.best_cube, None);
+
+        // RT more accurate than every cube: no speed-up, and the closest cube is named.
+        let mut entries = entries;
+        entries[0].error_supersampled.mse = 0.001;
+        let v = verdict("lens", &entries).unwrap();
+        assert_eq!((v.cube, v.speedup), (None, None));
+        assert_eq!(v.best_cube.as_deref(), Some("cube-rt@256"));
+
+        // Wall times where nothing has timestamps; no verdict without RT.
+        let walls = [
+            entry("rt", None, 8.0, 0.01),
+            entry("cube-rt@64", None, 4.0, 0.01),
+        ];
+        let v = verdict("lens", &walls).unwrap();
+        assert_eq!(
+            (v.cube.as_deref(), v.speedup),
+            (Some("cube-rt@64"), Some(0.5))
+        );
+        assert!(verdict("lens", &walls[1..]).is_none());
     }
 }

@@ -116,17 +116,21 @@ fn malformed_obj_and_mtl_lines_name_the_file_and_line() {
 }
 
 /// What can be repaired warns and loads: statements that are skipped, a material no MTL
-/// defines, triangles of zero area (dropped, naming the mesh), UVs on some faces only.
+/// defines, triangles of zero area (dropped, naming the mesh), UVs or normals on some faces of
+/// a mesh only (that mesh renders without them).
 #[test]
 fn repairable_input_warns_naming_what_was_done() {
     let dir = temp_dir("warn");
     let obj = format!(
         "hello there\n{TRIANGLE}v 2 0 0\nvt 0 0\no flat\nusemtl ghost\nf 1/1 2/1 3/1\nf 1 2 4\n\
-         o mixed\nf 1/1 2/1 3/1\nf 1 3 2\ncurv 0 1 1 2\n"
+         o mixed\nf 1/1 2/1 3/1\nf 1 3 2\ncurv 0 1 1 2\n\
+         vn 0 0 1\no halfsmooth\nf 1//1 2//1 3//1\nf 1 3 4\n"
     );
     let path = write(&dir, "w.obj", obj.as_bytes());
     let loaded = load_obj(&path).unwrap();
-    assert_eq!(loaded.scene.len(), 3);
+    assert_eq!(loaded.scene.len(), 5);
+    // No mesh kept its partial attributes.
+    assert!(loaded.scene.uvs.is_none() && loaded.scene.normals.is_none());
     let warnings = loaded.warnings.join("\n");
     for wanted in [
         "line 1: `hello` skipped: not an OBJ statement",
@@ -134,6 +138,7 @@ fn repairable_input_warns_naming_what_was_done() {
         "line 8: usemtl \"ghost\": no MTL defines it; using grey",
         "mesh \"flat\": dropped 1 triangles of zero area",
         "mesh \"mixed\": some faces give texture coordinates and some do not",
+        "mesh \"halfsmooth\": some faces give normals and some do not; ignoring its normals",
     ] {
         assert!(warnings.contains(wanted), "{warnings}");
     }
@@ -267,16 +272,22 @@ fn sizes_beyond_the_adapter_are_errors_with_the_limit() {
             && message.contains(&format!("2D texture limit of {max}")),
         "{message}"
     );
-    // Within the texture limit, but its outputs are beyond one storage binding.
-    let side = max.min(8192);
-    let bytes = 16 * u64::from(side) * u64::from(side);
-    if bytes > limits.max_storage_buffer_binding_size {
-        let message = error_of(pass(side, side));
-        assert!(
-            message.contains("MiB") && message.contains("per binding"),
-            "{message}"
-        );
-    }
+    // Within the texture limit, but its outputs (16 bytes a pixel) are beyond one storage
+    // binding: on an adapter whose bindings stop at 1 MiB, 256² fits and 257² does not.
+    let small = fisheye_rt::gpu::GpuContext::with_binding_limit(1 << 20).unwrap();
+    let grid = fisheye_rt::scene::builtin::scene("grid").unwrap();
+    let small_scene = GpuScene::new(&small, &grid, &options).unwrap();
+    let on_small = |side: u32| {
+        let camera = common::camera("equidistant:f=0.5", side, side);
+        TracePass::new(&small, &camera, &small_scene, DirectionSource::Computed).map(|_| ())
+    };
+    on_small(256).unwrap();
+    let message = error_of(on_small(257));
+    assert!(
+        message.contains("needs a storage buffer of 1.01 MiB")
+            && message.contains("limit of 1.00 MiB per binding"),
+        "{message}"
+    );
     let camera = common::camera("equidistant:f=0.5", 16, 16);
     for (size, method) in [
         (0, fisheye_rt::cube::CubeMethod::Traced),
@@ -320,29 +331,33 @@ fn sizes_beyond_the_adapter_are_errors_with_the_limit() {
 }
 
 /// A scene whose triangles cross the adapter's storage-binding limit (128 MiB on lavapipe and
-/// by default) is refused before the BVH is built, with the triangle count, the bytes and the
-/// limit; so is one whose textures cross it.
+/// by default; 1 MiB here, forced) is refused before the BVH is built, with the triangle
+/// count, the bytes and the limit, while one triangle fewer uploads; so is one whose textures
+/// cross it.
 #[test]
 fn scenes_beyond_one_storage_binding_are_refused_with_the_numbers() {
-    let ctx = common::ctx();
-    let limit = ctx.device.limits().max_storage_buffer_binding_size;
+    let limit = 1 << 20;
+    let ctx = &fisheye_rt::gpu::GpuContext::with_binding_limit(limit).unwrap();
     let camera = Camera {
         position: DVec3::new(0.0, 0.0, 5.0),
         look_at: DVec3::ZERO,
         up: DVec3::Y,
     };
-    // 48 bytes a triangle (`GpuTriangle`): one more than fit.
+    // 48 bytes a triangle (`GpuTriangle`): as many as fit, then one more.
+    let scene = |count: u64| {
+        let mut b = MeshBuilder::new();
+        let m = b.material(Material::diffuse("grey", Vec3::splat(0.8)));
+        for i in 0..count {
+            let x = (i % 4096) as f64;
+            let y = (i / 4096) as f64;
+            let p = DVec3::new(x, y, 0.0);
+            b.triangle([p, p + DVec3::X, p + DVec3::Y], None, None, m);
+        }
+        b.finish(Vec::new(), Vec3::ONE, Vec3::ZERO, camera)
+    };
     let count = limit / 48 + 1;
-    let mut b = MeshBuilder::new();
-    let m = b.material(Material::diffuse("grey", Vec3::splat(0.8)));
-    for i in 0..count {
-        let x = (i % 4096) as f64;
-        let y = (i / 4096) as f64;
-        let p = DVec3::new(x, y, 0.0);
-        b.triangle([p, p + DVec3::X, p + DVec3::Y], None, None, m);
-    }
-    let scene = b.finish(Vec::new(), Vec3::ONE, Vec3::ZERO, camera);
-    let message = error_of(GpuScene::new(ctx, &scene, &RenderOptions::default()));
+    GpuScene::new(ctx, &scene(count - 1), &RenderOptions::default()).unwrap();
+    let message = error_of(GpuScene::new(ctx, &scene(count), &RenderOptions::default()));
     let limit_mib = format!("{:.0} MiB", limit as f64 / f64::from(1 << 20));
     for wanted in [
         format!("{count} triangles are too many"),
@@ -352,7 +367,6 @@ fn scenes_beyond_one_storage_binding_are_refused_with_the_numbers() {
     ] {
         assert!(message.contains(&wanted), "{message:?} lacks {wanted:?}");
     }
-    drop(scene);
 
     // Textures: one square texture of just over the limit in RGBA8 texels.
     let side = ((limit / 4) as f64).sqrt() as u32 + 1;

@@ -199,10 +199,21 @@ fn written_files_read_back() {
                     for (x, y) in [(a.fx, b.fx), (a.fy, b.fy), (a.cx, b.cx), (a.cy, b.cy)] {
                         assert!(close(x, y), "{spec} as {name}: {x} vs {y}\n{text}");
                     }
-                    let (pa, pb) = (back.lens.model().parameters(), lens.model().parameters());
+                    // The same model, every parameter by name, each value.
+                    let (a, b) = (back.lens.model(), lens.model());
+                    assert_eq!(a.name(), b.name(), "{spec} as {name}: model\n{text}");
+                    let (pa, pb) = (a.parameters(), b.parameters());
+                    let keys = |p: &[(&str, f64)]| {
+                        p.iter().map(|(k, _)| k.to_string()).collect::<Vec<_>>()
+                    };
+                    assert_eq!(keys(&pa), keys(&pb), "{spec} as {name}: parameters\n{text}");
                     for ((key, x), (_, y)) in pa.iter().zip(&pb) {
                         assert!(close(*x, *y), "{spec} as {name}: {key} {x} vs {y}\n{text}");
                     }
+                    assert!(
+                        close(back.lens.theta_max(), lens.theta_max()),
+                        "{spec} as {name}: field of view\n{text}"
+                    );
                 }
                 Err(e) => {
                     let message = e.to_string();

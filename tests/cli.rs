@@ -1,5 +1,7 @@
 //! The `fisheye` binary end to end, as a user runs it.
 
+mod common;
+
 use std::io::Write;
 use std::process::{Command, Output, Stdio};
 
@@ -339,13 +341,19 @@ fn npy<T: npyz::Deserialize>(path: &std::path::Path) -> (Vec<u64>, Vec<T>) {
 }
 
 /// `--outputs` writes ground truth through the lens as NPY, consistent across channels and
-/// with the PNG's mask.
+/// with the PNG's mask, and equal to the f64 reference's: ids, ranges and normals under the
+/// tolerances of `tests/common/mod.rs`, and directions that, walked for the written range from
+/// the camera, land on the written triangle in the world (which checks their frame without the
+/// camera rotation the renderer and the reference share).
 #[test]
 fn render_writes_ground_truth_arrays() {
     let dir = std::env::temp_dir().join(format!("fisheye-npy-{}", std::process::id()));
     let png = dir.join("view.png");
     let args = [
         "render",
+        "builtin:default",
+        "--lens",
+        "canon-8-15mm@8mm",
         "--size",
         "64x48",
         "--out",
@@ -385,6 +393,7 @@ fn render_writes_ground_truth_arrays() {
         }
     }
     assert!(mask.iter().filter(|&&m| m == 1).count() > 500);
+    check_against_the_reference(&range, &normal, &ids, &direction);
 
     // The same arrays as OpenEXR: every value bit for bit, in the documented channels.
     let args = [&args[..], &["--format", "exr"]].concat();
@@ -427,6 +436,52 @@ fn render_writes_ground_truth_arrays() {
         }
     }
     std::fs::remove_dir_all(dir).unwrap();
+}
+
+/// The arrays of `render_writes_ground_truth_arrays` against the f64 reference.
+fn check_against_the_reference(range: &[f32], normal: &[f32], ids: &[u32], direction: &[f32]) {
+    use fisheye_rt::trace::cpu::Reference;
+    let scene = fisheye_rt::scene::builtin::scene("default").unwrap();
+    let cam = LensCamera::new(
+        parse_spec("canon-8-15mm@8mm").unwrap(),
+        ImageSize::new(64, 48).unwrap(),
+    );
+    let reference = Reference::new(&scene, 5).render(&cam);
+    let tolerance = common::SYNTHETIC;
+    let vector = |v: &[f32]| DVec3::new(v[0].into(), v[1].into(), v[2].into());
+    let mut hits = 0;
+    for i in 0..ids.len() {
+        assert_eq!(ids[i], reference.ids[i], "id at pixel {i}");
+        if ids[i] == u32::MAX {
+            continue;
+        }
+        hits += 1;
+        let expected = f64::from(reference.geometry[i][3]);
+        let error = (f64::from(range[i]) - expected).abs() / expected;
+        assert!(error <= tolerance.distance, "range at {i}: {error:e}");
+        let (n, m) = (vector(&normal[3 * i..]), vector(&reference.geometry[i]));
+        let angle = n.cross(m).length().atan2(n.dot(m));
+        assert!(angle <= tolerance.normal, "normal at {i}: {angle:e} rad");
+        // Walk the ray and find the point on the triangle's plane, inside its corners.
+        let p = scene.camera.position + vector(&direction[3 * i..]) * f64::from(range[i]);
+        let [a, b, c] = scene.triangles[ids[i] as usize];
+        let plane = (b - a).cross(c - a).normalize();
+        let off = (p - a).dot(plane).abs();
+        assert!(
+            off <= tolerance.distance * f64::from(range[i]),
+            "pixel {i}: {off:e} off its triangle's plane"
+        );
+        let area = |x: DVec3, y: DVec3, z: DVec3| (y - x).cross(z - x).dot(plane);
+        let total = area(a, b, c);
+        for w in [area(p, b, c), area(a, p, c), area(a, b, p)] {
+            assert!(
+                w / total >= -1e-4,
+                "pixel {i}: outside its triangle ({})",
+                w / total
+            );
+        }
+    }
+    assert!(hits > 500);
 }
 
 /// A scene file renders from the command line; `--camera` replaces its pose with an explicit

@@ -225,3 +225,80 @@ fn faces_larger_than_a_storage_binding_render() {
     // edges remain.
     assert!(mse < 1e-3, "{mse}");
 }
+
+/// The border texels of traced faces are real samples of the neighbouring faces: inside a box
+/// whose six walls have six colours, seen from its centre along the walls' axes, every inner
+/// texel of a face shows that face's wall, and every border texel (a direction just past the
+/// edge) shows the neighbour's wall, never a copy of its own face.
+#[test]
+fn border_texels_show_the_neighbouring_faces() {
+    use fisheye_rt::scene::{Camera, Material, MeshBuilder};
+    use glam::{DVec3, Vec2};
+    // Camera space is world space: x right, y down, z forward.
+    let walls = [
+        (DVec3::X, Vec3::new(1.0, 0.0, 0.0)),
+        (DVec3::NEG_X, Vec3::new(0.0, 1.0, 0.0)),
+        (DVec3::Y, Vec3::new(0.0, 0.0, 1.0)),
+        (DVec3::NEG_Y, Vec3::new(1.0, 1.0, 0.0)),
+        (DVec3::Z, Vec3::new(0.0, 1.0, 1.0)),
+        (DVec3::NEG_Z, Vec3::new(1.0, 0.0, 1.0)),
+    ];
+    let mut b = MeshBuilder::new();
+    for (axis, colour) in walls {
+        let m = b.material(Material::diffuse("wall", colour));
+        // A 2 × 2 square at distance 1 along `axis`, spanned by the other two axes.
+        let (u, v) = (
+            DVec3::new(axis.y, axis.z, axis.x) * 2.0,
+            DVec3::new(axis.z, axis.x, axis.y) * 2.0,
+        );
+        b.quad(axis - 0.5 * (u + v), u, v, glam::Vec2::ONE, m);
+    }
+    let pose = Camera {
+        position: DVec3::ZERO,
+        look_at: DVec3::Z,
+        up: DVec3::NEG_Y,
+    };
+    let scene = b.finish(Vec::new(), Vec3::ZERO, Vec3::ONE, pose);
+    let gpu_scene = GpuScene::new(ctx(), &scene, &RenderOptions::default()).unwrap();
+    let size = 8;
+    let settings = CubeSettings {
+        coverage: Coverage::WholeFaces,
+        ..CubeSettings::new(size, CubeMethod::Traced)
+    };
+    let all_round = camera("equidistant:f=0.2,fov=360", 32, 32);
+    let cube = CubeMap::new(ctx(), &all_round, &gpu_scene, &settings).unwrap();
+    cube.render(ctx(), &gpu_scene, &pose).unwrap();
+    let texels = cube.texels(ctx()).unwrap();
+    let side = size as usize + 2;
+    let mut border = 0;
+    for (f, face) in FACES.iter().enumerate() {
+        for y in 0..side {
+            for x in 0..side {
+                let edge_x = x == 0 || x == side - 1;
+                let edge_y = y == 0 || y == side - 1;
+                if edge_x && edge_y {
+                    continue; // a corner texel looks along the cube's corner: two walls tie
+                }
+                // The texel's centre in face coordinates, past ±1 in the border.
+                let ab = (Vec2::new(x as f32, y as f32) - 0.5) / size as f32 * 2.0 - 1.0;
+                let d = (face.right * ab.x + face.down * ab.y + face.forward).as_dvec3();
+                let axis = d.abs().max_position();
+                let wall = 2 * axis + usize::from(d[axis] < 0.0);
+                assert_eq!(
+                    wall != f,
+                    edge_x || edge_y,
+                    "face {} texel ({x}, {y})",
+                    face.name
+                );
+                let shown = Vec3::from_slice(&texels[(f * side + y) * side + x][..3]);
+                assert_eq!(
+                    shown, walls[wall].1,
+                    "face {} texel ({x}, {y}) looks along {d}: it shows {shown}",
+                    face.name
+                );
+                border += usize::from(wall != f);
+            }
+        }
+    }
+    assert_eq!(border, 6 * 4 * size as usize);
+}

@@ -358,8 +358,8 @@ fn oversized_direction_table_is_a_clear_error() {
     );
 }
 
-/// The bound for a calibrated lens at pixel `p`. Beyond the `4ε(1 + κ)` of the classic
-/// models, f32 rounds `u - cx` to an absolute error of about `ε(|u| + |cx|)` pixels, a
+/// The bound for a calibrated lens at pixel `p`: the classic models' `ε(1 + κ)` (see the
+/// module's comment), plus what rounding the pixel does: f32 rounds `u - cx` to an absolute error of about `ε(|u| + |cx|)` pixels, a
 /// model-coordinate error of that over `f`, which turns the ray by `g = max(θ'(r), sin θ / r)`
 /// per unit.
 fn calibrated_bound(lens: &CalibratedLens, p: DVec2) -> f64 {
@@ -376,9 +376,11 @@ fn calibrated_bound(lens: &CalibratedLens, p: DVec2) -> f64 {
     EPS * (1.0 + kappa + g * rounding)
 }
 
-/// Every calibrated model: the WGSL direction of every pixel against the f64 reference, the
-/// masks (identical but for pixels within f32 rounding of the domain edge), and GPU
-/// projection of the reference directions back onto their pixels.
+/// Every calibrated model: the WGSL direction of every pixel against the f64 reference (within
+/// [`calibrated_bound`]: measured on lavapipe at most 0.67 of it, asserted 1), the masks
+/// (identical at every pixel, domain edges in the image included), and GPU projection of the
+/// reference directions back onto their pixels (measured within 1.53e-4 px, asserted 2e-4 px:
+/// a coordinate in [256, 512) has an f32 ulp of 3e-5 px, and the direction and θ carry a few).
 #[test]
 fn calibrated_models_match_the_reference() {
     for spec in CalibratedModel::EXAMPLES.iter().copied().chain([
@@ -397,13 +399,12 @@ fn calibrated_models_match_the_reference() {
         let cam = LensCamera::new(lens, size);
         let gpu = LensRays::new(ctx(), &cam).unwrap().compute(ctx()).unwrap();
         let cpu = cam.directions();
-        let (mut valid, mut edge, mut worst) = (0, 0, 0.0f64);
+        let (mut valid, mut worst) = (0, 0.0f64);
         let mut pixels = Vec::new();
         let mut dirs = Vec::new();
         for (index, (g, r)) in gpu.iter().zip(&cpu).enumerate() {
             let (x, y) = (index % size.width as usize, index / size.width as usize);
             let p = DVec2::new(x as f64 + 0.5, y as f64 + 0.5);
-            let near_edge = |d: DVec3| (d.z.acos() - cal.theta_max()).abs() < 1e-4;
             match (g, r) {
                 (Some(g), Some(r)) => {
                     let g = g.as_dvec3();
@@ -414,8 +415,6 @@ fn calibrated_models_match_the_reference() {
                     dirs.push(*r);
                 }
                 (None, None) => {}
-                (Some(d), None) if near_edge(d.as_dvec3()) => edge += 1,
-                (None, Some(d)) if near_edge(*d) => edge += 1,
                 _ => panic!("{spec}: masks differ at {p}: gpu {g:?}, cpu {r:?}"),
             }
         }
@@ -432,18 +431,13 @@ fn calibrated_models_match_the_reference() {
             }
         }
         eprintln!(
-            "{:<12} {valid} rays ({edge} at the edge differ), error ≤ {worst:.2} of the bound, \
+            "{:<12} {valid} rays, error ≤ {worst:.2} of the bound, \
              round trip {worst_px:.2e} px ({unprojected} not back)",
             cal.model().name()
         );
         assert!(valid > 50_000, "{spec}: only {valid} rays");
-        // Measured on lavapipe: at most 0.63 of the bound.
-        assert!(worst <= 2.0, "{spec}: error {worst:.2} times the bound");
-        assert!(edge <= 40, "{spec}: {edge} masks differ at the edge");
-        assert!(
-            unprojected <= edge + 2,
-            "{spec}: {unprojected} directions did not project"
-        );
-        assert!(worst_px < 0.02, "{spec}: round trip off by {worst_px} px");
+        assert!(worst <= 1.0, "{spec}: error {worst:.2} times the bound");
+        assert_eq!(unprojected, 0, "{spec}: directions did not project");
+        assert!(worst_px <= 2e-4, "{spec}: round trip off by {worst_px} px");
     }
 }

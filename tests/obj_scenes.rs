@@ -1,30 +1,15 @@
-//! OBJ/MTL scenes: the shared real scenes (read from `../shared/scenes/`, never copied), their
-//! materials, the framing of bare OBJs, and bad files.
+//! OBJ/MTL scenes: the third-party scenes in `scenes/`, their materials, the framing of bare
+//! OBJs, and bad files.
 
 mod common;
 
 use std::path::{Path, PathBuf};
 
-use common::{assert_agrees, both, camera, ctx};
+use common::{assert_agrees, both, camera, ctx, real_scene, shared};
 use fisheye_rt::scene::Surface;
 use fisheye_rt::scene::obj::load_obj;
 use fisheye_rt::trace::{RenderOptions, render};
 use glam::Vec3;
-
-/// A file of the shared scenes beside the repository (CI clones the repository with `shared/`
-/// beside it); a clear failure if it is not there.
-fn shared(path: &str) -> PathBuf {
-    let file = Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../shared/scenes")
-        .join(path);
-    assert!(
-        file.exists(),
-        "{} is missing: these tests read the shared scenes from ../shared/scenes/ beside the \
-         repository (see its README)",
-        file.display()
-    );
-    file
-}
 
 fn material<'a>(
     scene: &'a fisheye_rt::scene::Scene,
@@ -73,7 +58,7 @@ fn cornell_spheres_match_the_reference() {
     let (gpu, cpu) = both(&scene, &camera("equisolid:f=0.6", 128, 96));
     // Measured: 2,099 of 12,288 pixels see the box.
     assert!(gpu.counts().1 > 1500);
-    assert_agrees("Cornell spheres", &gpu, &cpu);
+    assert_agrees("Cornell spheres", &gpu, &cpu, real_scene(gpu.ids.len()));
 }
 
 /// A bare OBJ in its own units (the bunny is 0.15 m tall, 0.1 m off the origin) is framed:

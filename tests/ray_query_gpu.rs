@@ -5,7 +5,7 @@
 
 mod common;
 
-use common::{assert_agrees, camera, ctx, on_id_edge};
+use common::{assert_agrees, camera, ctx, on_id_edge, real_scene};
 use fisheye_rt::cube::{CubeMap, CubeMethod, CubeSettings};
 use fisheye_rt::gpu::GpuContext;
 use fisheye_rt::raster::RasterMethod;
@@ -32,18 +32,18 @@ fn ray_queries_agree_with_software_traversal_and_the_reference() {
         ("builtin:few-detailed", "equidistant:f=0.5,fov=200"),
         ("scenes/cornell-sphere.toml", "canon-8-15mm@15mm"),
     ] {
-        let scene = scene::load(spec).unwrap().scene;
+        let scene = common::scene(spec);
         let cam = camera(lens, 96, 72);
         let software = render(ctx(), &scene, &cam, &RenderOptions::default()).unwrap();
         let hardware = render(ctx(), &scene, &cam, &ray_query()).unwrap();
-        let size = cam.size;
+        let reference = Reference::new(&scene, RenderOptions::default().max_depth).render(&cam);
         let mut differing = 0;
         for i in 0..software.ids.len() {
             assert_eq!(software.valid(i), hardware.valid(i), "{spec}: masks at {i}");
             if software.ids[i] != hardware.ids[i] {
-                // Only where two triangles meet (a tie or a silhouette).
+                // Only where two triangles meet in the reference (a tie or a silhouette).
                 assert!(
-                    on_id_edge(&software.ids, size, i) || on_id_edge(&hardware.ids, size, i),
+                    on_id_edge(&reference.ids, cam.size, i),
                     "{spec}: pixel {i} hits {} by ray query, {} by software, inside a surface",
                     hardware.ids[i],
                     software.ids[i]
@@ -55,10 +55,16 @@ fn ray_queries_agree_with_software_traversal_and_the_reference() {
             "{spec}: {differing} of {} primary hits differ, all on edges",
             software.ids.len()
         );
-        // Both traversals hit the same triangle at 99% of the pixels or more.
-        assert!(differing * 100 <= software.ids.len(), "{spec}: {differing}");
-        let reference = Reference::new(&scene, RenderOptions::default().max_depth).render(&cam);
-        assert_agrees(&format!("{spec} by ray query"), &hardware, &reference);
+        // The driver's own triangle test decides edges and ties its own way, for primary and
+        // secondary rays alike: the allowance of real scenes (see there).
+        let tolerance = real_scene(software.ids.len());
+        assert!(differing <= tolerance.id_mismatches, "{spec}: {differing}");
+        assert_agrees(
+            &format!("{spec} by ray query"),
+            &hardware,
+            &reference,
+            tolerance,
+        );
     }
 }
 

@@ -6,7 +6,7 @@ mod common;
 
 use std::path::{Path, PathBuf};
 
-use common::{assert_agrees, both, camera};
+use common::{assert_agrees, both, camera, real_scene};
 use fisheye_rt::scene::file::load_scene_file;
 use fisheye_rt::scene::{Light, Surface, face_normal};
 use glam::{DVec3, Vec3};
@@ -24,7 +24,7 @@ fn write(dir: &Path, name: &str, text: &str) -> PathBuf {
     path
 }
 
-/// Every scene file in `scenes/` (they read `../shared/scenes/`) loads without warnings, has
+/// Every scene file in `scenes/` (they read the models beside them) loads without warnings, has
 /// a camera path, puts its camera where it sees the scene, and renders as the reference does.
 #[test]
 fn shipped_scene_files_render_as_the_reference_does() {
@@ -53,7 +53,7 @@ fn shipped_scene_files_render_as_the_reference_does() {
     }
     for file in files {
         let loaded = load_scene_file(&file)
-            .unwrap_or_else(|e| panic!("{e} (the shared scenes belong in ../shared/scenes/)"));
+            .unwrap_or_else(|e| panic!("{e} (the models ship in scenes/; see its README)"));
         let name = file.file_name().unwrap().to_string_lossy();
         // Sibenik has 8 triangles with collinear corners, dropped with a warning; nothing
         // else of the shipped scenes warns.
@@ -67,7 +67,7 @@ fn shipped_scene_files_render_as_the_reference_does() {
         let (gpu, cpu) = both(&scene, &camera("equidistant:f=0.45,fov=180", 64, 48));
         let (rays, hits) = gpu.counts();
         assert!(hits * 4 >= rays, "{name}: only {hits} of {rays} rays hit");
-        assert_agrees(&name, &gpu, &cpu);
+        assert_agrees(&name, &gpu, &cpu, real_scene(gpu.ids.len()));
     }
 }
 

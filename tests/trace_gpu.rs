@@ -1,18 +1,9 @@
-//! The GPU tracer against the f64 reference tracer, and its hard cases, by readback.
-//!
-//! Tolerances. The GPU traces f32 rays whose directions differ from the reference's by about
-//! 1e-7 rad, over the same f32 geometry, so:
-//! - primary ids agree except where a ray passes within that angle of a triangle edge: a
-//!   differing pixel must lie on an edge of the reference's id image, and there are few;
-//! - distances agree to a few f32 ulp, more at grazing angles: the 99.9th percentile of the
-//!   relative difference must be ≤ 1e-5, the maximum ≤ 1e-3;
-//! - colours agree to f32 rounding where every ray of the pixel's tree hits the same
-//!   triangles; reflections and shadows have silhouettes of their own, so we bound the mean
-//!   difference (≤ 2e-3) and the share of pixels off by more than 0.02 (≤ 1%).
+//! The GPU tracer against the f64 reference tracer, and its hard cases, by readback. The
+//! tolerances, and why they are what they are, are in `tests/common/mod.rs`.
 
 mod common;
 
-use common::{assert_agrees, assert_every_hit_is, both, camera, ctx};
+use common::{SYNTHETIC, assert_agrees, assert_every_hit_is, both, camera, ctx};
 use fisheye_rt::scene::{Camera, Light, Material, MeshBuilder, builtin};
 use fisheye_rt::trace::{NO_HIT, RenderOptions, cpu::Reference, render};
 use glam::{DVec3, Vec2, Vec3};
@@ -35,7 +26,7 @@ fn builtin_scenes_match_the_reference() {
         let (gpu, cpu) = both(&scene, &camera(spec, 128, 96));
         let (valid, hits) = gpu.counts();
         assert!(hits > valid / 3, "{name}: only {hits} hits of {valid}");
-        assert_agrees(&format!("{name} through {spec}"), &gpu, &cpu);
+        assert_agrees(&format!("{name} through {spec}"), &gpu, &cpu, SYNTHETIC);
     }
 }
 
@@ -217,21 +208,9 @@ fn far_from_origin_renders_the_same() {
     let cam = camera("equidistant:f=0.42,fov=180", 96, 72);
     let a = render(ctx(), &scene, &cam, &RenderOptions::default()).unwrap();
     let b = render(ctx(), &moved, &cam, &RenderOptions::default()).unwrap();
-    let same_ids = a.ids.iter().zip(&b.ids).filter(|(x, y)| x == y).count();
-    assert!(
-        same_ids * 1000 >= a.ids.len() * 999,
-        "{same_ids} of {}",
-        a.ids.len()
-    );
-    let worst = a
-        .colour
-        .iter()
-        .zip(&b.colour)
-        .zip(a.ids.iter().zip(&b.ids))
-        .filter(|(_, (x, y))| x == y)
-        .map(|((p, q), _)| (0..3).map(|k| (p[k] - q[k]).abs()).fold(0.0, f32::max))
-        .fold(0.0, f32::max);
-    assert!(worst < 0.02, "colour differs by {worst}");
+    // Positions become camera-relative in f64 before they are rounded to f32, so the shift
+    // changes them by at most an ulp: the two renders agree as the GPU and the reference do.
+    assert_agrees("shifted by 1e5", &b, &a, SYNTHETIC);
 }
 
 #[test]
@@ -277,9 +256,8 @@ fn empty_one_triangle_and_degenerate_scenes() {
         "a degenerate triangle was hit"
     );
     assert!(gpu.ids.iter().filter(|&&id| id == 0).count() > 200);
-    let agreement = assert_agrees("one triangle", &gpu, &cpu);
-    assert!(agreement.id_mismatches <= 20 && agreement.colour_outliers == 0);
-    assert!(agreement.mean_colour_error < 1e-6);
+    // Flat, unlit but for the ambient term: every compared colour is exact.
+    assert_eq!(assert_agrees("one triangle", &gpu, &cpu, SYNTHETIC), 0.0);
 }
 
 /// Glass: Fresnel splits, total internal reflection and the transmission filter agree with
@@ -314,12 +292,12 @@ fn glass_matches_the_reference() {
         },
     );
     let (gpu, cpu) = both(&scene, &camera("rectilinear:f=1.5", 96, 96));
-    assert_agrees("glass sphere", &gpu, &cpu);
+    assert_agrees("glass sphere", &gpu, &cpu, SYNTHETIC);
 }
 
 /// Primary rays read from the direction table render the same frame as rays computed per
-/// pixel: the table holds what the lens kernel computes (contraction may differ between the
-/// two kernels by an ulp, which moves at most an edge pixel).
+/// pixel: the table holds what the lens kernel computes (measured: identical; contraction may
+/// differ between the two kernels by an ulp, so they are held to the reference's tolerance).
 #[test]
 fn direction_table_renders_the_same_frame() {
     use fisheye_rt::lens::gpu::DirectionSource;
@@ -331,10 +309,7 @@ fn direction_table_renders_the_same_frame() {
         ..RenderOptions::default()
     };
     let table = render(ctx(), &scene, &cam, &options).unwrap();
-    let differing = (0..computed.ids.len())
-        .filter(|&i| computed.ids[i] != table.ids[i] || computed.colour[i] != table.colour[i])
-        .count();
-    assert!(differing <= 5, "{differing} pixels differ");
+    assert_agrees("direction table", &table, &computed, SYNTHETIC);
     assert!(table.counts().1 > 5000);
 }
 
@@ -399,7 +374,7 @@ fn partial_opacity_blends_and_dims_shadows() {
     assert!(scene.features().translucent);
     let cam = camera("rectilinear:f=0.7", 96, 72);
     let (gpu, cpu) = both(&scene, &cam);
-    assert_agrees("partial opacity", &gpu, &cpu);
+    assert_agrees("partial opacity", &gpu, &cpu, SYNTHETIC);
     let directions = fisheye_rt::trace::world_directions(&cam, &scene.camera);
     let (mut under, mut open) = (0, 0);
     for (i, id) in gpu.ids.iter().enumerate() {
@@ -443,39 +418,48 @@ fn partial_opacity_blends_and_dims_shadows() {
 }
 
 /// Exact ties: three copies of one quad (as some real OBJs have, the Cornell box's boxes
-/// among them) always show the first copy, whatever order the BVH visits them in.
+/// among them) always show the first copy, whatever order the BVH visits them in, and however
+/// the hit distance rounds: the quads are placed at round and at arbitrary coordinates, face
+/// on and oblique (the Cornell box's tall box, whose bottom face repeats a side).
 #[test]
 fn duplicated_triangles_show_the_first_copy() {
-    let mut b = MeshBuilder::new();
-    let colours = [Vec3::X, Vec3::Y, Vec3::Z];
-    for c in colours {
-        let m = b.material(Material::diffuse("copy", c));
-        b.quad(
-            DVec3::new(-1.0, -1.0, 2.0),
-            DVec3::X * 2.0,
-            DVec3::Y * 2.0,
-            Vec2::ONE,
-            m,
+    for (corner, u, v) in [
+        (DVec3::new(-1.0, -1.0, 2.0), DVec3::X * 2.0, DVec3::Y * 2.0),
+        (
+            DVec3::new(0.04, -1.0, 0.91),
+            DVec3::new(-0.57, 0.0, 0.18),
+            DVec3::Y * 1.2,
+        ),
+        (
+            DVec3::new(-0.71, -0.6, 0.51),
+            DVec3::new(0.57, 0.13, 0.31),
+            DVec3::new(0.05, 0.93, 0.22),
+        ),
+    ] {
+        let mut b = MeshBuilder::new();
+        for c in [Vec3::X, Vec3::Y, Vec3::Z] {
+            let m = b.material(Material::diffuse("copy", c));
+            b.quad(corner, u, v, Vec2::ONE, m);
+        }
+        let scene = b.finish(
+            Vec::new(),
+            Vec3::ZERO,
+            Vec3::ONE,
+            Camera {
+                position: DVec3::ZERO,
+                look_at: DVec3::Z,
+                up: DVec3::Y,
+            },
         );
-    }
-    let scene = b.finish(
-        Vec::new(),
-        Vec3::ZERO,
-        Vec3::ONE,
-        Camera {
-            position: DVec3::ZERO,
-            look_at: DVec3::Z,
-            up: DVec3::Y,
-        },
-    );
-    let (gpu, cpu) = both(&scene, &camera("rectilinear:f=1", 32, 32));
-    for out in [&gpu, &cpu] {
-        assert!(out.counts().1 > 100);
-        for (id, c) in out.ids.iter().zip(&out.colour) {
-            assert!(
-                *id == NO_HIT || (*id < 2 && c[..3] == [1.0, 0.0, 0.0]),
-                "{id} {c:?}"
-            );
+        let (gpu, cpu) = both(&scene, &camera("equidistant:f=0.4", 64, 64));
+        for out in [&gpu, &cpu] {
+            assert!(out.counts().1 > 50, "quad at {corner}: {:?}", out.counts());
+            for (id, c) in out.ids.iter().zip(&out.colour) {
+                assert!(
+                    *id == NO_HIT || (*id < 2 && c[..3] == [1.0, 0.0, 0.0]),
+                    "quad at {corner}: {id} {c:?}"
+                );
+            }
         }
     }
 }
@@ -502,8 +486,7 @@ fn camera_pose_set_on_a_pass_matches_a_fresh_upload() {
     let moved = pass.read(ctx()).unwrap();
     scene.camera = pose;
     let fresh = render(ctx(), &scene, &cam, &options).unwrap();
-    let agreement = assert_agrees("moved camera", &moved, &fresh);
-    assert!(agreement.id_mismatches * 200 < moved.ids.len());
+    assert_agrees("moved camera", &moved, &fresh, SYNTHETIC);
 }
 
 /// The same scene, lens and adapter give bit-identical outputs run to run, with the scene
@@ -529,4 +512,59 @@ fn renders_are_bit_identical_run_to_run() {
     };
     assert_eq!(bits(&first), bits(&second));
     assert_eq!(bits(&first), bits(&third));
+}
+
+/// `count` triangles nested about one axis, each 2% larger and 2 mm farther than the last:
+/// obvhs builds them into a chain (the smallest deepest), about one level per seven triangles
+/// (obvhs 0.4's `fast` preset gives 227 of them 32 levels).
+fn nested_triangles(count: i32) -> fisheye_rt::scene::Scene {
+    let mut b = MeshBuilder::new();
+    let m = b.material(Material::diffuse("nested", Vec3::ONE));
+    for k in 0..count {
+        let (s, z) = (1.02f64.powi(k), 0.002 * f64::from(k));
+        let corners = [
+            DVec3::new(-s, -s, z),
+            DVec3::new(s, -s, z),
+            DVec3::new(0.0, s, z),
+        ];
+        b.triangle(corners, None, None, m);
+    }
+    b.finish(
+        Vec::new(),
+        Vec3::ZERO,
+        Vec3::ONE,
+        Camera {
+            position: DVec3::new(0.1, 0.2, -1.0),
+            look_at: DVec3::ZERO,
+            up: DVec3::Y,
+        },
+    )
+}
+
+/// A BVH exactly as deep as the traversal stack renders as the reference does (a ray near
+/// the axis walks the whole chain to the smallest triangle); one level deeper is refused,
+/// never traversed wrongly.
+#[test]
+fn bvh_as_deep_as_the_stack_renders_and_deeper_is_refused() {
+    use fisheye_rt::bvh::{BvhQuality, SceneBvh, TRAVERSAL_STACK};
+    let full = nested_triangles(227);
+    let depth = |scene: &fisheye_rt::scene::Scene| {
+        SceneBvh::build(scene, scene.camera.position, BvhQuality::Fast).map(|b| b.depth)
+    };
+    assert_eq!(depth(&full).unwrap(), TRAVERSAL_STACK);
+    let (gpu, cpu) = both(&full, &camera("rectilinear:f=0.8", 64, 48));
+    assert!(gpu.counts().1 == 64 * 48, "every ray hits a triangle");
+    assert_agrees("a BVH as deep as the stack", &gpu, &cpu, SYNTHETIC);
+    let ids: std::collections::HashSet<_> = gpu.ids.iter().collect();
+    assert!(ids.len() > 20, "{} triangles seen", ids.len());
+
+    // Depth is not monotonic in the count (obvhs's clustering); 229 gives one level more.
+    let message = depth(&nested_triangles(229))
+        .expect_err("refused")
+        .to_string();
+    assert!(
+        message.contains(&format!("{} levels deep", TRAVERSAL_STACK + 1))
+            && message.contains(&format!("holds {TRAVERSAL_STACK}")),
+        "{message}"
+    );
 }

@@ -73,16 +73,15 @@ fn triangle_hit(slot: u32, ray: Ray, sh: Shear) -> vec4<f32> {
     if det == 0.0 {
         return vec4<f32>(0.0);
     }
-    let t_scaled = (u * a[sh.k.z] + v * b[sh.k.z] + w * c[sh.k.z]) * sh.s.z;
-    let sign_det = sign(det);
-    let abs_det = abs(det);
-    let t_signed = t_scaled * sign_det;
-    // tmax is inclusive so that the caller can break exact ties (see bvh_trace).
-    if t_signed <= ray.tmin * abs_det || t_signed > ray.tmax * abs_det {
+    let inv = 1.0 / det;
+    let t = (u * a[sh.k.z] + v * b[sh.k.z] + w * c[sh.k.z]) * sh.s.z * inv;
+    // tmax is inclusive so that the caller can break exact ties (see bvh_trace). The test is
+    // on t itself, the value the caller compares: testing t·det against tmax·det instead would
+    // reject a duplicate whose t rounds to exactly the current hit's.
+    if !(t > ray.tmin && t <= ray.tmax) {
         return vec4<f32>(0.0);
     }
-    let inv = 1.0 / det;
-    return vec4<f32>(t_scaled * inv, v * inv, w * inv, 1.0);
+    return vec4<f32>(t, v * inv, w * inv, 1.0);
 }
 
 fn byte_of(pair: vec2<u32>, i: u32) -> u32 {

@@ -239,6 +239,21 @@ impl GpuContext {
     /// As [`GpuContext::new`], but never enabling `features`: what an adapter without them
     /// gives (tests use it to check the errors such users see).
     pub fn without(features: wgpu::Features) -> Result<Self> {
+        Self::create(Self::choose_adapter()?, features, None)
+    }
+
+    /// As [`GpuContext::new`], but with storage bindings of at most `bytes`: what a smaller
+    /// adapter gives (tests use it to check the errors such users see, whatever the adapter).
+    pub fn with_binding_limit(bytes: u64) -> Result<Self> {
+        Self::create(
+            Self::choose_adapter()?,
+            wgpu::Features::empty(),
+            Some(bytes),
+        )
+    }
+
+    /// The adapter [`GpuContext::new`] uses.
+    fn choose_adapter() -> Result<wgpu::Adapter> {
         let instance =
             wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle_from_env());
         let backends = wgpu::Backends::from_env().unwrap_or_default();
@@ -271,15 +286,19 @@ impl GpuContext {
                 adapters.swap_remove(0)
             }
         };
-        Self::with_adapter_without(adapter, features)
+        Ok(adapter)
     }
 
     /// Creates the device on a given adapter (as [`GpuContext::new`] does once it has chosen).
     pub fn with_adapter(adapter: wgpu::Adapter) -> Result<Self> {
-        Self::with_adapter_without(adapter, wgpu::Features::empty())
+        Self::create(adapter, wgpu::Features::empty(), None)
     }
 
-    fn with_adapter_without(adapter: wgpu::Adapter, left_out: wgpu::Features) -> Result<Self> {
+    fn create(
+        adapter: wgpu::Adapter,
+        left_out: wgpu::Features,
+        binding_limit: Option<u64>,
+    ) -> Result<Self> {
         let wanted = OPTIONAL_FEATURES
             .iter()
             .fold(wgpu::Features::empty(), |all, (f, _)| all | *f)
@@ -293,6 +312,10 @@ impl GpuContext {
             // implementation may be undefined behaviour. We only use ray query through wgpu's
             // validated API, with acceleration structures built from checked, finite geometry.
             experimental = unsafe { wgpu::ExperimentalFeatures::enabled() };
+        }
+        if let Some(bytes) = binding_limit {
+            limits.max_storage_buffer_binding_size =
+                bytes.min(limits.max_storage_buffer_binding_size);
         }
         let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
             label: Some("fisheye.device"),
@@ -535,10 +558,10 @@ impl GpuContext {
             return Err(Error::Gpu {
                 during: what.to_string(),
                 message: format!(
-                    "needs a storage buffer of {} MiB, above this adapter's limit of {} MiB \
-                     per binding; use a smaller image",
-                    bytes.div_ceil(1 << 20),
-                    limit >> 20
+                    "needs a storage buffer of {:.2} MiB, above this adapter's limit of {:.2} \
+                     MiB per binding; use a smaller image",
+                    bytes as f64 / f64::from(1 << 20),
+                    limit as f64 / f64::from(1 << 20)
                 ),
             });
         }
