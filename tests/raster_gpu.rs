@@ -143,9 +143,9 @@ fn raster_faces_equal_traced_faces_on_diffuse_unshadowed_surfaces() {
         // third of the texels border another triangle; that still leaves over 15,000.
         assert!(skipped < 0.5, "{method:?}: {skipped}");
         // Measured: mean 2.3e-5, largest 7.3e-5 (f32 rounding of the hit point and the
-        // texture lookup); 1e-3 leaves room for other drivers' rounding, and is far below
+        // texture lookup); 2e-4 leaves room for other drivers' rounding, and is far below
         // any shading difference (a missed light or texture is > 1e-1).
-        assert!(worst < 1e-3, "{method:?}: {worst}");
+        assert!(worst < 2e-4, "{method:?}: {worst}");
     }
 }
 

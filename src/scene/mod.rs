@@ -81,7 +81,6 @@ impl Material {
     pub fn mirror(name: &str, tint: Vec3) -> Self {
         Self {
             surface: Surface::Mirror,
-            diffuse: Vec3::ZERO,
             specular: tint,
             ..Self::diffuse(name, Vec3::ZERO)
         }
@@ -91,7 +90,6 @@ impl Material {
     pub fn glass(name: &str, ior: f32) -> Self {
         Self {
             surface: Surface::Glass,
-            diffuse: Vec3::ZERO,
             ior,
             ..Self::diffuse(name, Vec3::ZERO)
         }
