@@ -4,17 +4,14 @@
 
 use std::time::{Duration, Instant};
 
-use bytemuck::{Pod, Zeroable};
+use bytemuck::Zeroable;
 use glam::{DVec3, Vec3A};
 use obvhs::BvhBuildParams;
 use obvhs::cwbvh::node::CwBvhNode;
 
 use crate::error::{Error, Result};
 use crate::scene::Scene;
-
-/// The traversal stack of `wgsl/bvh.wgsl` holds this many node groups; a BVH deeper than this
-/// is refused at build time rather than traversed wrongly.
-pub const TRAVERSAL_STACK: u32 = 32;
+pub use crate::shared::{GpuTriangle, TRAVERSAL_STACK};
 
 /// The widest extent, in scene units from the camera, of a scene the BVH is built for. obvhs
 /// computes surface areas in f32, and past about 1e19 they overflow and its build panics
@@ -71,26 +68,6 @@ impl BvhQuality {
     }
 }
 
-/// One triangle as `wgsl/bvh.wgsl` reads it: 48 bytes, three `vec4<f32>` whose `w` carry the
-/// scene triangle index and the material index (as bits).
-#[repr(C)]
-#[derive(Clone, Copy, Debug, PartialEq, Pod, Zeroable)]
-pub struct GpuTriangle {
-    /// First corner, camera-relative.
-    pub v0: [f32; 3],
-    /// Index of the triangle in [`Scene::triangles`].
-    pub triangle: u32,
-    /// Second corner.
-    pub v1: [f32; 3],
-    /// Index into [`Scene::materials`].
-    pub material: u32,
-    /// Third corner.
-    pub v2: [f32; 3],
-    /// Padding to 16-byte alignment.
-    pub pad: u32,
-}
-
-const _: () = assert!(std::mem::size_of::<GpuTriangle>() == 48);
 const _: () = assert!(std::mem::size_of::<CwBvhNode>() == 80);
 
 /// A built BVH with its triangles in leaf order, ready to upload.
@@ -210,6 +187,8 @@ fn node_depth(nodes: &[CwBvhNode], index: usize) -> u32 {
 
 #[cfg(test)]
 mod tests {
+    use std::mem::{offset_of, size_of};
+
     use glam::Vec3;
 
     use super::*;
@@ -276,5 +255,32 @@ mod tests {
             "{message}"
         );
         assert!(chain(58).is_ok());
+    }
+
+    /// `wgsl/bvh.wgsl` reads obvhs's 80-byte node as five `vec4<u32>`, words as documented
+    /// there: these offsets pin that reading to obvhs's struct.
+    #[test]
+    fn cwbvh_node_words_match_the_wgsl_reading() {
+        use obvhs::cwbvh::node::CwBvhNode as N;
+        assert_eq!(size_of::<N>(), 80);
+        let words = [
+            (offset_of!(N, p), 0),
+            (offset_of!(N, e), 3),
+            (offset_of!(N, imask), 3),
+            (offset_of!(N, child_base_idx), 4),
+            (offset_of!(N, primitive_base_idx), 5),
+            (offset_of!(N, child_meta), 6),
+            (offset_of!(N, child_min_x), 8),
+            (offset_of!(N, child_max_x), 10),
+            (offset_of!(N, child_min_y), 12),
+            (offset_of!(N, child_max_y), 14),
+            (offset_of!(N, child_min_z), 16),
+            (offset_of!(N, child_max_z), 18),
+        ];
+        for (offset, word) in words {
+            assert_eq!(offset / 4, word);
+        }
+        // e's three bytes, then imask as the word's top byte.
+        assert_eq!(offset_of!(N, imask), 15);
     }
 }

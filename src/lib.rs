@@ -7,6 +7,8 @@
 //!   and calibration files users name them by), and their WGSL twin on the GPU
 //!   ([`lens::gpu`]).
 //! - [`gpu`]: the one place that creates the adapter and device.
+//! - [`shared`]: what the GPU and Rust share (ids, limits, workgroup sizes, `repr(C)`
+//!   structs), read by everything and reading nothing.
 //! - [`shader`]: how WGSL files are assembled into modules.
 //! - [`scene`], [`bvh`], [`trace`]: scenes (built-in and OBJ), the CWBVH, and the GPU tracer
 //!   with its f64 reference.
@@ -49,6 +51,7 @@ pub mod raster;
 pub mod report;
 pub mod scene;
 pub mod shader;
+pub mod shared;
 pub mod trace;
 pub mod validate;
 

@@ -21,15 +21,17 @@
 
 use std::num::NonZeroU32;
 
-use bytemuck::{Pod, Zeroable};
+use bytemuck::Zeroable;
 use glam::{DAffine3, DMat3, DMat4, DVec3, DVec4};
 
-use crate::cube::{FACES, Region, bordered, bordered_focal};
+use crate::cube::faces::{Region, bordered, bordered_focal};
 use crate::error::{Error, Result};
 use crate::gpu::{GpuContext, Span, bind_group, layer_view, texture_array};
 use crate::scene::Camera;
 use crate::shader;
-use crate::trace::{GpuScene, LIGHT_KINDS, surface_constants};
+use crate::shared::{FACES, LIGHT_KINDS, WORKGROUP_2D};
+pub use crate::shared::{ShadowView, Views};
+use crate::trace::{GpuScene, surface_constants};
 
 /// How [`RasterFaces`] renders the faces.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -41,28 +43,6 @@ pub enum RasterMethod {
     Deferred,
     /// Every face in one multiview render pass, lighting in the fragment shader.
     SinglePass,
-}
-
-/// Per-frame face views as `wgsl/raster.wgsl` reads them (496 bytes).
-#[repr(C)]
-#[derive(Clone, Copy, Debug, PartialEq, Pod, Zeroable)]
-pub struct Views {
-    /// Per face: scene space to clip space (column-major).
-    pub clip: [[f32; 16]; 6],
-    /// Per face: the rendered texels `x0, y0, x1, y1`, empty for skipped faces.
-    pub regions: [[u32; 4]; 6],
-    /// The eye in scene space (xyz).
-    pub eye: [f32; 4],
-}
-
-/// One layer of the shadow maps as `wgsl/raster.wgsl` reads it (80 bytes).
-#[repr(C)]
-#[derive(Clone, Copy, Debug, PartialEq, Pod, Zeroable)]
-pub struct ShadowView {
-    /// Scene space to the layer's clip space (column-major), depth reversed.
-    pub clip: [f32; 16],
-    /// `x`: a texel's width in scene units, at unit distance for a point light's face.
-    pub texel: [f32; 4],
 }
 
 /// The near plane of every view, relative to the scene's size: with reversed f32 depth the
@@ -718,7 +698,7 @@ impl RasterFaces {
             pass.set_bind_group(0, group, &[]);
             pass.set_bind_group(1, &scene.bind_group, &[]);
             pass.set_bind_group(2, &self.shadows.lookup, &[]);
-            let tiles = self.side.div_ceil(shader::WORKGROUP_2D);
+            let tiles = self.side.div_ceil(WORKGROUP_2D);
             pass.dispatch_workgroups(tiles, tiles, 6);
         }
     }
@@ -731,33 +711,7 @@ fn scene_sky(scene: &GpuScene) -> wgpu::Color {
 
 #[cfg(test)]
 mod tests {
-    use std::mem::{offset_of, size_of};
-
     use super::*;
-    use crate::shader::assert_wgsl_layout;
-
-    #[test]
-    fn raster_structs_match_their_wgsl_twins() {
-        assert_wgsl_layout(
-            "raster",
-            "Views",
-            size_of::<Views>(),
-            &[
-                ("clip", offset_of!(Views, clip)),
-                ("regions", offset_of!(Views, regions)),
-                ("eye", offset_of!(Views, eye)),
-            ],
-        );
-        assert_wgsl_layout(
-            "raster",
-            "ShadowView",
-            size_of::<ShadowView>(),
-            &[
-                ("clip", offset_of!(ShadowView, clip)),
-                ("texel", offset_of!(ShadowView, texel)),
-            ],
-        );
-    }
 
     #[test]
     fn face_views_put_texel_centres_where_the_tracer_does() {

@@ -1,14 +1,11 @@
 //! WGSL assembly: every shader file is embedded, `#import NAME` lines pull in shared files
-//! (each once, dependencies first), and constants defined once in Rust are prepended as WGSL
-//! `const` lines. Pipeline specialisations (lens model, direction formula) are WGSL
+//! (each once, dependencies first), and constants defined once in Rust ([`crate::shared`]) are
+//! prepended as WGSL `const` lines. Pipeline specialisations (lens model, direction formula) are WGSL
 //! `override`s, set per pipeline.
 
 use std::fmt::Write;
 
-use crate::lens::DirectionFormula;
-use crate::lens::gpu::{DirectionSource, LensKind};
-use crate::scene::Surface;
-use crate::trace;
+use crate::shared::{wgsl_constants, wgsl_faces};
 
 /// Every WGSL file of the project, by name (its file stem under `wgsl/`).
 pub const FILES: [(&str, &str); 21] = [
@@ -37,47 +34,6 @@ pub const FILES: [(&str, &str); 21] = [
         include_str!("../wgsl/raster_multiview.wgsl"),
     ),
 ];
-
-/// Side of the square workgroups of per-pixel kernels.
-pub const WORKGROUP_2D: u32 = 8;
-/// Width of the workgroups of per-element kernels.
-pub const WORKGROUP_1D: u32 = 64;
-
-/// The constants every module sees, defined here once.
-pub fn constants() -> Vec<(String, u32)> {
-    let mut out = vec![
-        ("WORKGROUP_2D".to_string(), WORKGROUP_2D),
-        ("WORKGROUP_1D".to_string(), WORKGROUP_1D),
-    ];
-    out.extend(LensKind::ALL.iter().map(|k| (k.const_name(), *k as u32)));
-    out.push(("NEWTON_STEPS".into(), crate::lens::gpu::NEWTON_STEPS));
-    for formula in [DirectionFormula::Stable, DirectionFormula::Thesis] {
-        let name = format!("FORMULA_{}", formula.name().to_uppercase());
-        out.push((name, formula_id(formula)));
-    }
-    for source in [DirectionSource::Computed, DirectionSource::Table] {
-        out.push((source.const_name(), source as u32));
-    }
-    out.push(("TRAVERSAL_STACK".into(), crate::bvh::TRAVERSAL_STACK));
-    out.push(("MAX_DEPTH_LIMIT".into(), trace::MAX_DEPTH_LIMIT));
-    out.push(("NO_TEXTURE".into(), trace::NO_TEXTURE));
-    out.push(("MAX_SHADOW_LAYERS".into(), trace::MAX_SHADOW_LAYERS));
-    out.push(("NO_HIT".into(), trace::NO_HIT));
-    for surface in [Surface::Diffuse, Surface::Mirror, Surface::Glass] {
-        let name = format!("SURFACE_{:?}", surface).to_uppercase();
-        out.push((name, trace::surface_id(surface)));
-    }
-    out.extend(trace::LIGHT_KINDS.iter().map(|(n, v)| (n.to_string(), *v)));
-    out
-}
-
-/// The id WGSL's `DIRECTION_FORMULA` override takes for a formula.
-pub fn formula_id(formula: DirectionFormula) -> u32 {
-    match formula {
-        DirectionFormula::Stable => 0,
-        DirectionFormula::Thesis => 1,
-    }
-}
 
 fn file(name: &str) -> &'static str {
     FILES
@@ -143,11 +99,11 @@ pub fn compose(entry: &str) -> String {
     for enable in &c.enables {
         writeln!(out, "{enable}").unwrap();
     }
-    out.push_str("// ---- constants from fisheye_rt::shader::constants()\n");
-    for (name, value) in constants() {
+    out.push_str("// ---- constants from fisheye_rt::shared::wgsl_constants()\n");
+    for (name, value) in wgsl_constants() {
         writeln!(out, "const {name}: u32 = {value}u;").unwrap();
     }
-    out.push_str(&crate::cube::wgsl_faces());
+    out.push_str(&wgsl_faces());
     out.push_str(&c.body);
     out
 }

@@ -152,7 +152,7 @@ pub fn dispatch_over_image(
     for (index, group) in bind_groups.iter().enumerate() {
         pass.set_bind_group(index as u32, *group, &[]);
     }
-    let tile = crate::shader::WORKGROUP_2D;
+    let tile = crate::shared::WORKGROUP_2D;
     pass.dispatch_workgroups(size.width.div_ceil(tile), size.height.div_ceil(tile), 1);
 }
 
@@ -169,7 +169,7 @@ pub fn submit_over_elements(
         let mut pass = encoder.begin_compute_pass(&Default::default());
         pass.set_pipeline(pipeline);
         pass.set_bind_group(0, bind_group, &[]);
-        pass.dispatch_workgroups((count as u32).div_ceil(crate::shader::WORKGROUP_1D), 1, 1);
+        pass.dispatch_workgroups((count as u32).div_ceil(crate::shared::WORKGROUP_1D), 1, 1);
     }
     ctx.queue.submit([encoder.finish()]);
 }

@@ -2,68 +2,17 @@
 //! passes: [`LensRays`] (the direction of every pixel: the direction table) and
 //! [`LensPoints`] (project or unproject arbitrary points).
 
-use bytemuck::{Pod, Zeroable};
 use glam::{DVec2, DVec3, Vec2, Vec3};
 
+use super::DirectionFormula;
 use super::{CalibratedModel, Family, Lens, LensCamera, LensModel};
 use crate::error::Result;
 use crate::gpu::{GpuContext, dispatch_over_image};
-use crate::shader::{self, WORKGROUP_1D};
-
-/// Which WGSL code path a lens runs: the `LENS_KIND` override. The classic models keep their
-/// own closed forms; `General*` are the trigonometric paths of the general form.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-#[repr(u32)]
-pub enum LensKind {
-    /// `r = f tan θ`.
-    Rectilinear = 0,
-    /// `r = 2f tan(θ/2)`.
-    Stereographic = 1,
-    /// `r = f θ` (also the general form with `k2 = 0`).
-    Equidistant = 2,
-    /// `r = 2f sin(θ/2)`.
-    Equisolid = 3,
-    /// `r = f sin θ`.
-    Orthographic = 4,
-    /// `r = (f/k1) tan(k2 θ)`.
-    GeneralTan = 5,
-    /// `r = (f/k1) sin(|k2| θ)`.
-    GeneralSin = 6,
-    /// Kannala–Brandt (calibrated).
-    KannalaBrandt = 7,
-    /// Double sphere (calibrated).
-    DoubleSphere = 8,
-    /// Extended unified, and unified as its β = 1 case (calibrated).
-    ExtendedUnified = 9,
-    /// Devernay and Faugeras's FOV model (calibrated).
-    FovModel = 10,
-    /// Scaramuzza's polynomial (calibrated).
-    Scaramuzza = 11,
-    /// f-theta (calibrated).
-    FTheta = 12,
-    /// Radial-tangential (calibrated).
-    RadTan = 13,
-}
+use crate::shader;
+pub use crate::shared::{DirectionSource, LensKind, LensParams, NEWTON_STEPS, NEWTON_TOLERANCE};
+use crate::shared::{FORMULA_STABLE, FORMULA_THESIS, WORKGROUP_1D};
 
 impl LensKind {
-    /// Every kind, for emitting the WGSL constants.
-    pub const ALL: [LensKind; 14] = [
-        Self::Rectilinear,
-        Self::Stereographic,
-        Self::Equidistant,
-        Self::Equisolid,
-        Self::Orthographic,
-        Self::GeneralTan,
-        Self::GeneralSin,
-        Self::KannalaBrandt,
-        Self::DoubleSphere,
-        Self::ExtendedUnified,
-        Self::FovModel,
-        Self::Scaramuzza,
-        Self::FTheta,
-        Self::RadTan,
-    ];
-
     /// The code path of a lens.
     pub fn of(lens: &Lens) -> Self {
         let model = match lens {
@@ -95,95 +44,15 @@ impl LensKind {
             },
         }
     }
+}
 
-    /// The WGSL constant naming this kind, e.g. `LENS_GENERAL_TAN`.
-    pub fn const_name(&self) -> String {
-        let name = match self {
-            Self::Rectilinear => "RECTILINEAR",
-            Self::Stereographic => "STEREOGRAPHIC",
-            Self::Equidistant => "EQUIDISTANT",
-            Self::Equisolid => "EQUISOLID",
-            Self::Orthographic => "ORTHOGRAPHIC",
-            Self::GeneralTan => "GENERAL_TAN",
-            Self::GeneralSin => "GENERAL_SIN",
-            Self::KannalaBrandt => "KANNALA_BRANDT",
-            Self::DoubleSphere => "DOUBLE_SPHERE",
-            Self::ExtendedUnified => "EXTENDED_UNIFIED",
-            Self::FovModel => "FOV_MODEL",
-            Self::Scaramuzza => "SCARAMUZZA",
-            Self::FTheta => "FTHETA",
-            Self::RadTan => "RADTAN",
-        };
-        format!("LENS_{name}")
+/// The id WGSL's `DIRECTION_FORMULA` override takes for a formula.
+fn formula_id(formula: DirectionFormula) -> u32 {
+    match formula {
+        DirectionFormula::Stable => FORMULA_STABLE,
+        DirectionFormula::Thesis => FORMULA_THESIS,
     }
 }
-
-/// The tolerance of the WGSL root finder, relative to its bracket (`wgsl/calibrated.wgsl`).
-pub const NEWTON_TOLERANCE: f64 = 1.0 / (1 << 22) as f64;
-
-/// The most iterations the WGSL root finder takes: [`crate::lens::newton_bound`] at
-/// [`NEWTON_TOLERANCE`].
-pub const NEWTON_STEPS: u32 = 22;
-
-/// Where a kernel that consumes ray directions gets them: the `DIRECTION_SOURCE` override.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-#[repr(u32)]
-pub enum DirectionSource {
-    /// Evaluate the lens per pixel, every frame.
-    Computed = 0,
-    /// Read the direction table that [`LensRays`] computed once.
-    Table = 1,
-}
-
-impl DirectionSource {
-    /// The WGSL constant naming this source.
-    pub fn const_name(&self) -> String {
-        match self {
-            Self::Computed => "DIRECTIONS_COMPUTED".into(),
-            Self::Table => "DIRECTIONS_TABLE".into(),
-        }
-    }
-
-    /// The name used on the command line and in benchmark tables.
-    pub fn name(&self) -> &'static str {
-        match self {
-            Self::Computed => "computed",
-            Self::Table => "table",
-        }
-    }
-}
-
-/// The lens as WGSL's `LensParams` reads it (96 bytes; `wgsl/lens.wgsl` mirrors it and a test
-/// checks the layouts agree). See the WGSL struct for the fields' meaning; the first eight
-/// fields serve classic lenses, the last three calibrated ones (zero for classic lenses).
-#[repr(C)]
-#[derive(Clone, Copy, Debug, PartialEq, Pod, Zeroable)]
-pub struct LensParams {
-    /// Focal length.
-    pub f: f32,
-    /// `k1/f` of the general form.
-    pub k1_over_f: f32,
-    /// Rate `|k2|` of the general form.
-    pub rate: f32,
-    /// Radius of the domain edge, `f32::MAX` when unbounded.
-    pub r_max: f32,
-    /// Largest θ of a ray.
-    pub theta_max: f32,
-    /// Image width in pixels.
-    pub width: u32,
-    /// Image height in pixels.
-    pub height: u32,
-    /// `N_max` of [`LensCamera::mask_limit`].
-    pub mask_limit: u32,
-    /// Calibrated: fx, fy, cx, cy in pixels.
-    pub intrinsics: [f32; 4],
-    /// Calibrated: the model's parameters, packed per kind as `calibrated_coefficients` says.
-    pub coefficients: [[f32; 4]; 2],
-    /// Calibrated: Scaramuzza's affine c, d, e.
-    pub affine: [f32; 4],
-}
-
-const _: () = assert!(std::mem::size_of::<LensParams>() == 96);
 
 /// A calibrated model's parameters as WGSL reads them (`wgsl/calibrated.wgsl` documents each
 /// kind's packing), with derived constants precomputed in f64.
@@ -253,10 +122,7 @@ impl LensParams {
 pub fn lens_constants(camera: &LensCamera) -> [(&'static str, f64); 2] {
     [
         ("LENS_KIND", f64::from(LensKind::of(&camera.lens) as u32)),
-        (
-            "DIRECTION_FORMULA",
-            f64::from(shader::formula_id(camera.formula)),
-        ),
+        ("DIRECTION_FORMULA", f64::from(formula_id(camera.formula))),
     ]
 }
 
@@ -462,35 +328,5 @@ impl LensPoints {
             out.extend(ctx.read_buffer::<[f32; 4]>(&results)?);
         }
         Ok(out)
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use std::mem::{offset_of, size_of};
-
-    use super::*;
-
-    /// `LensParams` in Rust and WGSL have the same size and field offsets (naga's layout).
-    #[test]
-    fn lens_params_layout_matches_wgsl() {
-        shader::assert_wgsl_layout(
-            "lens",
-            "LensParams",
-            size_of::<LensParams>(),
-            &[
-                ("f", offset_of!(LensParams, f)),
-                ("k1_over_f", offset_of!(LensParams, k1_over_f)),
-                ("rate", offset_of!(LensParams, rate)),
-                ("r_max", offset_of!(LensParams, r_max)),
-                ("theta_max", offset_of!(LensParams, theta_max)),
-                ("width", offset_of!(LensParams, width)),
-                ("height", offset_of!(LensParams, height)),
-                ("mask_limit", offset_of!(LensParams, mask_limit)),
-                ("intrinsics", offset_of!(LensParams, intrinsics)),
-                ("coefficients", offset_of!(LensParams, coefficients)),
-                ("affine", offset_of!(LensParams, affine)),
-            ],
-        );
     }
 }

@@ -6,11 +6,16 @@ pub mod cpu;
 mod output;
 mod ray_query;
 
-use bytemuck::{Pod, Zeroable};
+use bytemuck::Pod;
 use glam::{DMat3, DVec3, Vec3};
 
 pub use output::{Channel, RenderOutput, colour_image, linear_to_srgb};
 pub use ray_query::RayQueryScene;
+
+pub use crate::shared::{
+    Frame, GpuLight, GpuMaterial, LIGHT_KINDS, MAX_DEPTH_LIMIT, MAX_SHADOW_LAYERS, NO_HIT,
+    NO_TEXTURE, Shading,
+};
 
 use crate::bvh::{BvhQuality, SceneBvh};
 use crate::error::{Error, Result};
@@ -26,98 +31,13 @@ use crate::shader;
 /// `min_uniform_buffer_offset_alignment`.
 const FRAME_SLOT: u64 = 256;
 
-/// The deepest Whitted recursion a kernel can run (its ray stack has one more entry).
-pub const MAX_DEPTH_LIMIT: u32 = 8;
-/// A shadow ray passes at most this many partially transparent surfaces; behind more, the
-/// light counts as blocked.
-pub const MAX_SHADOW_LAYERS: u32 = 8;
-/// `Material::texture` of an untextured material.
-pub const NO_TEXTURE: u32 = u32::MAX;
-/// The id of a miss or a masked pixel in [`RenderOutput::ids`].
-pub const NO_HIT: u32 = u32::MAX;
-
 /// The WGSL id of a surface kind.
 pub fn surface_id(surface: Surface) -> u32 {
     match surface {
-        Surface::Diffuse => 0,
-        Surface::Mirror => 1,
-        Surface::Glass => 2,
+        Surface::Diffuse => crate::shared::SURFACE_DIFFUSE,
+        Surface::Mirror => crate::shared::SURFACE_MIRROR,
+        Surface::Glass => crate::shared::SURFACE_GLASS,
     }
-}
-
-/// The WGSL id of a light kind: `LIGHT_POINT`, `LIGHT_DIRECTIONAL`.
-pub const LIGHT_KINDS: [(&str, u32); 2] = [("LIGHT_POINT", 0), ("LIGHT_DIRECTIONAL", 1)];
-
-/// A material as `wgsl/shade.wgsl` reads it (80 bytes).
-#[repr(C)]
-#[derive(Clone, Copy, Debug, PartialEq, Pod, Zeroable)]
-pub struct GpuMaterial {
-    /// `Kd`.
-    pub diffuse: [f32; 3],
-    /// [`surface_id`].
-    pub surface: u32,
-    /// `Ks`.
-    pub specular: [f32; 3],
-    /// `Ns`.
-    pub shininess: f32,
-    /// `Ke`.
-    pub emission: [f32; 3],
-    /// `Ni`.
-    pub ior: f32,
-    /// `Tf`.
-    pub transmission: [f32; 3],
-    /// Texture index or [`NO_TEXTURE`].
-    pub texture: u32,
-    /// `d`.
-    pub opacity: f32,
-    /// Padding.
-    pub pad: [u32; 3],
-}
-
-/// A light as `wgsl/shade.wgsl` reads it (32 bytes).
-#[repr(C)]
-#[derive(Clone, Copy, Debug, PartialEq, Pod, Zeroable)]
-pub struct GpuLight {
-    /// Camera-relative position (point) or travel direction (directional).
-    pub vector: [f32; 3],
-    /// A `LIGHT_KINDS` id.
-    pub kind: u32,
-    /// Intensity or irradiance.
-    pub colour: [f32; 3],
-    /// The light's first layer in the rasterizer's shadow maps: six for a point light (one
-    /// per cube face, in [`crate::cube::FACES`] order), one for a directional light.
-    pub shadow_layer: u32,
-}
-
-/// Per-scene shading constants (32 bytes).
-#[repr(C)]
-#[derive(Clone, Copy, Debug, PartialEq, Pod, Zeroable)]
-pub struct Shading {
-    /// Radiance of escaping rays.
-    pub sky: [f32; 3],
-    /// Number of lights.
-    pub light_count: u32,
-    /// Ambient term.
-    pub ambient: [f32; 3],
-    /// Deepest secondary ray.
-    pub max_depth: u32,
-}
-
-/// The camera pose of a frame (80 bytes): the camera-to-world rotation's columns (camera x, y,
-/// z axes in world space) and the eye relative to the scene's origin.
-#[repr(C)]
-#[derive(Clone, Copy, Debug, PartialEq, Pod, Zeroable)]
-pub struct Frame {
-    /// Camera x (right).
-    pub right: [f32; 4],
-    /// Camera y (down).
-    pub down: [f32; 4],
-    /// Camera z (forward).
-    pub forward: [f32; 4],
-    /// Eye position relative to [`GpuScene::origin`] (xyz).
-    pub eye: [f32; 4],
-    /// The pixel of the first invocation (x, y), for dispatches over a part of the image.
-    pub offset: [u32; 4],
 }
 
 /// How to render.
@@ -705,108 +625,4 @@ pub fn render(
 ) -> Result<RenderOutput> {
     let gpu_scene = GpuScene::new(ctx, scene, options)?;
     TracePass::new(ctx, camera, &gpu_scene, options.directions)?.trace(ctx, &gpu_scene, "tracing")
-}
-
-#[cfg(test)]
-mod tests {
-    use std::mem::{offset_of, size_of};
-
-    use super::*;
-    use crate::bvh::GpuTriangle;
-    use crate::shader::assert_wgsl_layout;
-
-    #[test]
-    fn gpu_structs_match_their_wgsl_twins() {
-        assert_wgsl_layout(
-            "triangles",
-            "BvhTriangle",
-            size_of::<crate::bvh::GpuTriangle>(),
-            &[
-                ("v0", offset_of!(GpuTriangle, v0)),
-                ("triangle", offset_of!(GpuTriangle, triangle)),
-                ("v1", offset_of!(GpuTriangle, v1)),
-                ("material", offset_of!(GpuTriangle, material)),
-                ("v2", offset_of!(GpuTriangle, v2)),
-                ("pad", offset_of!(GpuTriangle, pad)),
-            ],
-        );
-        assert_wgsl_layout(
-            "shade",
-            "Material",
-            size_of::<GpuMaterial>(),
-            &[
-                ("diffuse", offset_of!(GpuMaterial, diffuse)),
-                ("surface", offset_of!(GpuMaterial, surface)),
-                ("specular", offset_of!(GpuMaterial, specular)),
-                ("shininess", offset_of!(GpuMaterial, shininess)),
-                ("emission", offset_of!(GpuMaterial, emission)),
-                ("ior", offset_of!(GpuMaterial, ior)),
-                ("transmission", offset_of!(GpuMaterial, transmission)),
-                ("texture", offset_of!(GpuMaterial, texture)),
-                ("opacity", offset_of!(GpuMaterial, opacity)),
-                ("pad", offset_of!(GpuMaterial, pad)),
-            ],
-        );
-        assert_wgsl_layout(
-            "shade",
-            "Light",
-            size_of::<GpuLight>(),
-            &[
-                ("vector", offset_of!(GpuLight, vector)),
-                ("kind", offset_of!(GpuLight, kind)),
-                ("colour", offset_of!(GpuLight, colour)),
-                ("shadow_layer", offset_of!(GpuLight, shadow_layer)),
-            ],
-        );
-        assert_wgsl_layout(
-            "shade",
-            "Shading",
-            size_of::<Shading>(),
-            &[
-                ("sky", offset_of!(Shading, sky)),
-                ("light_count", offset_of!(Shading, light_count)),
-                ("ambient", offset_of!(Shading, ambient)),
-                ("max_depth", offset_of!(Shading, max_depth)),
-            ],
-        );
-        assert_wgsl_layout(
-            "trace",
-            "Frame",
-            size_of::<Frame>(),
-            &[
-                ("right", offset_of!(Frame, right)),
-                ("down", offset_of!(Frame, down)),
-                ("forward", offset_of!(Frame, forward)),
-                ("eye", offset_of!(Frame, eye)),
-                ("offset", offset_of!(Frame, offset)),
-            ],
-        );
-    }
-
-    /// `wgsl/bvh.wgsl` reads obvhs's 80-byte node as five `vec4<u32>`, words as documented
-    /// there: these offsets pin that reading to obvhs's struct.
-    #[test]
-    fn cwbvh_node_words_match_the_wgsl_reading() {
-        use obvhs::cwbvh::node::CwBvhNode as N;
-        assert_eq!(size_of::<N>(), 80);
-        let words = [
-            (offset_of!(N, p), 0),
-            (offset_of!(N, e), 3),
-            (offset_of!(N, imask), 3),
-            (offset_of!(N, child_base_idx), 4),
-            (offset_of!(N, primitive_base_idx), 5),
-            (offset_of!(N, child_meta), 6),
-            (offset_of!(N, child_min_x), 8),
-            (offset_of!(N, child_max_x), 10),
-            (offset_of!(N, child_min_y), 12),
-            (offset_of!(N, child_max_y), 14),
-            (offset_of!(N, child_min_z), 16),
-            (offset_of!(N, child_max_z), 18),
-        ];
-        for (offset, word) in words {
-            assert_eq!(offset / 4, word);
-        }
-        // e's three bytes, then imask as the word's top byte.
-        assert_eq!(offset_of!(N, imask), 15);
-    }
 }

@@ -1,0 +1,535 @@
+//! What the GPU and Rust share, in one leaf module that reads nothing else of the crate: ids,
+//! limits, workgroup sizes, the cube's face table, and the `repr(C)` structs the kernels read
+//! (each `Pod`, its size pinned here; `shader`'s tests check every one against naga's layout
+//! of its WGSL twin). [`wgsl_constants`] lists the constants that `shader` prepends to every
+//! WGSL module, so each is defined once, here.
+
+use bytemuck::{Pod, Zeroable};
+use glam::{DMat3, Vec3};
+
+/// Side of the square workgroups of per-pixel kernels.
+pub const WORKGROUP_2D: u32 = 8;
+/// Width of the workgroups of per-element kernels.
+pub const WORKGROUP_1D: u32 = 64;
+
+/// The traversal stack of `wgsl/bvh.wgsl` holds this many node groups; a BVH deeper than this
+/// is refused at build time rather than traversed wrongly.
+pub const TRAVERSAL_STACK: u32 = 32;
+
+/// The deepest Whitted recursion a kernel can run (its ray stack has one more entry).
+pub const MAX_DEPTH_LIMIT: u32 = 8;
+/// A shadow ray passes at most this many partially transparent surfaces; behind more, the
+/// light counts as blocked.
+pub const MAX_SHADOW_LAYERS: u32 = 8;
+/// [`GpuMaterial::texture`] of an untextured material.
+pub const NO_TEXTURE: u32 = u32::MAX;
+/// The id of a miss or a masked pixel (`RenderOutput::ids`, the `id` output).
+pub const NO_HIT: u32 = u32::MAX;
+/// The WGSL id of a diffuse surface (`Surface::Diffuse`).
+pub const SURFACE_DIFFUSE: u32 = 0;
+/// The WGSL id of a mirror.
+pub const SURFACE_MIRROR: u32 = 1;
+/// The WGSL id of glass.
+pub const SURFACE_GLASS: u32 = 2;
+
+/// The WGSL id of a light kind: `LIGHT_POINT`, `LIGHT_DIRECTIONAL`.
+pub const LIGHT_KINDS: [(&str, u32); 2] = [("LIGHT_POINT", 0), ("LIGHT_DIRECTIONAL", 1)];
+
+/// The WGSL id of the stable direction formula (`DirectionFormula::Stable`), for the
+/// `DIRECTION_FORMULA` override.
+pub const FORMULA_STABLE: u32 = 0;
+/// The WGSL id of the thesis's direction formula.
+pub const FORMULA_THESIS: u32 = 1;
+
+/// The tolerance of the WGSL root finder, relative to its bracket (`wgsl/calibrated.wgsl`).
+pub const NEWTON_TOLERANCE: f64 = 1.0 / (1 << 22) as f64;
+
+/// The most iterations the WGSL root finder takes: `lens::newton_bound` at
+/// [`NEWTON_TOLERANCE`].
+pub const NEWTON_STEPS: u32 = 22;
+
+/// Which WGSL code path a lens runs: the `LENS_KIND` override. The classic models keep their
+/// own closed forms; `General*` are the trigonometric paths of the general form.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[repr(u32)]
+pub enum LensKind {
+    /// `r = f tan θ`.
+    Rectilinear = 0,
+    /// `r = 2f tan(θ/2)`.
+    Stereographic = 1,
+    /// `r = f θ` (also the general form with `k2 = 0`).
+    Equidistant = 2,
+    /// `r = 2f sin(θ/2)`.
+    Equisolid = 3,
+    /// `r = f sin θ`.
+    Orthographic = 4,
+    /// `r = (f/k1) tan(k2 θ)`.
+    GeneralTan = 5,
+    /// `r = (f/k1) sin(|k2| θ)`.
+    GeneralSin = 6,
+    /// Kannala–Brandt (calibrated).
+    KannalaBrandt = 7,
+    /// Double sphere (calibrated).
+    DoubleSphere = 8,
+    /// Extended unified, and unified as its β = 1 case (calibrated).
+    ExtendedUnified = 9,
+    /// Devernay and Faugeras's FOV model (calibrated).
+    FovModel = 10,
+    /// Scaramuzza's polynomial (calibrated).
+    Scaramuzza = 11,
+    /// f-theta (calibrated).
+    FTheta = 12,
+    /// Radial-tangential (calibrated).
+    RadTan = 13,
+}
+
+impl LensKind {
+    /// Every kind, for emitting the WGSL constants.
+    pub const ALL: [LensKind; 14] = [
+        Self::Rectilinear,
+        Self::Stereographic,
+        Self::Equidistant,
+        Self::Equisolid,
+        Self::Orthographic,
+        Self::GeneralTan,
+        Self::GeneralSin,
+        Self::KannalaBrandt,
+        Self::DoubleSphere,
+        Self::ExtendedUnified,
+        Self::FovModel,
+        Self::Scaramuzza,
+        Self::FTheta,
+        Self::RadTan,
+    ];
+
+    /// The WGSL constant naming this kind, e.g. `LENS_GENERAL_TAN`.
+    pub fn const_name(&self) -> String {
+        let name = match self {
+            Self::Rectilinear => "RECTILINEAR",
+            Self::Stereographic => "STEREOGRAPHIC",
+            Self::Equidistant => "EQUIDISTANT",
+            Self::Equisolid => "EQUISOLID",
+            Self::Orthographic => "ORTHOGRAPHIC",
+            Self::GeneralTan => "GENERAL_TAN",
+            Self::GeneralSin => "GENERAL_SIN",
+            Self::KannalaBrandt => "KANNALA_BRANDT",
+            Self::DoubleSphere => "DOUBLE_SPHERE",
+            Self::ExtendedUnified => "EXTENDED_UNIFIED",
+            Self::FovModel => "FOV_MODEL",
+            Self::Scaramuzza => "SCARAMUZZA",
+            Self::FTheta => "FTHETA",
+            Self::RadTan => "RADTAN",
+        };
+        format!("LENS_{name}")
+    }
+}
+
+/// Where a kernel that consumes ray directions gets them: the `DIRECTION_SOURCE` override.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[repr(u32)]
+pub enum DirectionSource {
+    /// Evaluate the lens per pixel, every frame.
+    Computed = 0,
+    /// Read the direction table that `LensRays` computed once.
+    Table = 1,
+}
+
+impl DirectionSource {
+    /// The WGSL constant naming this source.
+    pub fn const_name(&self) -> String {
+        match self {
+            Self::Computed => "DIRECTIONS_COMPUTED".into(),
+            Self::Table => "DIRECTIONS_TABLE".into(),
+        }
+    }
+
+    /// The name used on the command line and in benchmark tables.
+    pub fn name(&self) -> &'static str {
+        match self {
+            Self::Computed => "computed",
+            Self::Table => "table",
+        }
+    }
+}
+
+/// One face of the cube: its name and its axes in camera space.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Face {
+    /// `+x`, `-x`, `+y`, `-y`, `+z`, `-z` (y is down: `+y` looks at the floor).
+    pub name: &'static str,
+    /// The face image's right (u) axis.
+    pub right: Vec3,
+    /// The face image's down (v) axis.
+    pub down: Vec3,
+    /// The axis the face looks along.
+    pub forward: Vec3,
+}
+
+impl Face {
+    /// Face-to-camera rotation: columns right, down, forward (a proper rotation).
+    pub fn rotation(&self) -> DMat3 {
+        DMat3::from_cols(
+            self.right.as_dvec3(),
+            self.down.as_dvec3(),
+            self.forward.as_dvec3(),
+        )
+    }
+}
+
+/// The faces in id order: the axis of largest magnitude picks `2 · axis + (negative ? 1 : 0)`.
+pub const FACES: [Face; 6] = [
+    Face {
+        name: "+x",
+        right: Vec3::NEG_Z,
+        down: Vec3::Y,
+        forward: Vec3::X,
+    },
+    Face {
+        name: "-x",
+        right: Vec3::Z,
+        down: Vec3::Y,
+        forward: Vec3::NEG_X,
+    },
+    Face {
+        name: "+y",
+        right: Vec3::X,
+        down: Vec3::NEG_Z,
+        forward: Vec3::Y,
+    },
+    Face {
+        name: "-y",
+        right: Vec3::X,
+        down: Vec3::Z,
+        forward: Vec3::NEG_Y,
+    },
+    Face {
+        name: "+z",
+        right: Vec3::X,
+        down: Vec3::Y,
+        forward: Vec3::Z,
+    },
+    Face {
+        name: "-z",
+        right: Vec3::NEG_X,
+        down: Vec3::Y,
+        forward: Vec3::NEG_Z,
+    },
+];
+
+/// The WGSL declaration of [`FACES`] as face-to-camera matrices (columns right, down,
+/// forward), prepended to every module.
+pub fn wgsl_faces() -> String {
+    let v = |v: Vec3| format!("vec3<f32>({:.1}, {:.1}, {:.1})", v.x, v.y, v.z);
+    let faces: Vec<String> = FACES
+        .iter()
+        .map(|f| {
+            format!(
+                "mat3x3<f32>({}, {}, {})",
+                v(f.right),
+                v(f.down),
+                v(f.forward)
+            )
+        })
+        .collect();
+    format!(
+        "const CUBE_FACES = array<mat3x3<f32>, 6>({});\n",
+        faces.join(", ")
+    )
+}
+
+/// The constants every WGSL module sees, as `const NAME: u32` lines (see `shader::compose`).
+pub fn wgsl_constants() -> Vec<(String, u32)> {
+    let mut out: Vec<(String, u32)> = [
+        ("WORKGROUP_2D", WORKGROUP_2D),
+        ("WORKGROUP_1D", WORKGROUP_1D),
+        ("NEWTON_STEPS", NEWTON_STEPS),
+        ("FORMULA_STABLE", FORMULA_STABLE),
+        ("FORMULA_THESIS", FORMULA_THESIS),
+        ("TRAVERSAL_STACK", TRAVERSAL_STACK),
+        ("MAX_DEPTH_LIMIT", MAX_DEPTH_LIMIT),
+        ("NO_TEXTURE", NO_TEXTURE),
+        ("MAX_SHADOW_LAYERS", MAX_SHADOW_LAYERS),
+        ("NO_HIT", NO_HIT),
+        ("SURFACE_DIFFUSE", SURFACE_DIFFUSE),
+        ("SURFACE_MIRROR", SURFACE_MIRROR),
+        ("SURFACE_GLASS", SURFACE_GLASS),
+    ]
+    .into_iter()
+    .chain(LIGHT_KINDS)
+    .map(|(n, v)| (n.to_string(), v))
+    .collect();
+    out.extend(LensKind::ALL.iter().map(|k| (k.const_name(), *k as u32)));
+    for source in [DirectionSource::Computed, DirectionSource::Table] {
+        out.push((source.const_name(), source as u32));
+    }
+    out
+}
+
+/// A material as `wgsl/shade.wgsl` reads it (80 bytes).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, PartialEq, Pod, Zeroable)]
+pub struct GpuMaterial {
+    /// `Kd`.
+    pub diffuse: [f32; 3],
+    /// [`surface_id`].
+    pub surface: u32,
+    /// `Ks`.
+    pub specular: [f32; 3],
+    /// `Ns`.
+    pub shininess: f32,
+    /// `Ke`.
+    pub emission: [f32; 3],
+    /// `Ni`.
+    pub ior: f32,
+    /// `Tf`.
+    pub transmission: [f32; 3],
+    /// Texture index or [`NO_TEXTURE`].
+    pub texture: u32,
+    /// `d`.
+    pub opacity: f32,
+    /// Padding.
+    pub pad: [u32; 3],
+}
+
+/// A light as `wgsl/shade.wgsl` reads it (32 bytes).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, PartialEq, Pod, Zeroable)]
+pub struct GpuLight {
+    /// Camera-relative position (point) or travel direction (directional).
+    pub vector: [f32; 3],
+    /// A `LIGHT_KINDS` id.
+    pub kind: u32,
+    /// Intensity or irradiance.
+    pub colour: [f32; 3],
+    /// The light's first layer in the rasterizer's shadow maps: six for a point light (one
+    /// per cube face, in [`crate::cube::FACES`] order), one for a directional light.
+    pub shadow_layer: u32,
+}
+
+/// Per-scene shading constants (32 bytes).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, PartialEq, Pod, Zeroable)]
+pub struct Shading {
+    /// Radiance of escaping rays.
+    pub sky: [f32; 3],
+    /// Number of lights.
+    pub light_count: u32,
+    /// Ambient term.
+    pub ambient: [f32; 3],
+    /// Deepest secondary ray.
+    pub max_depth: u32,
+}
+
+/// The camera pose of a frame (80 bytes): the camera-to-world rotation's columns (camera x, y,
+/// z axes in world space) and the eye relative to the scene's origin.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, PartialEq, Pod, Zeroable)]
+pub struct Frame {
+    /// Camera x (right).
+    pub right: [f32; 4],
+    /// Camera y (down).
+    pub down: [f32; 4],
+    /// Camera z (forward).
+    pub forward: [f32; 4],
+    /// Eye position relative to [`GpuScene::origin`] (xyz).
+    pub eye: [f32; 4],
+    /// The pixel of the first invocation (x, y), for dispatches over a part of the image.
+    pub offset: [u32; 4],
+}
+
+/// One triangle as `wgsl/bvh.wgsl` reads it: 48 bytes, three `vec4<f32>` whose `w` carry the
+/// scene triangle index and the material index (as bits).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, PartialEq, Pod, Zeroable)]
+pub struct GpuTriangle {
+    /// First corner, camera-relative.
+    pub v0: [f32; 3],
+    /// Index of the triangle in [`Scene::triangles`].
+    pub triangle: u32,
+    /// Second corner.
+    pub v1: [f32; 3],
+    /// Index into [`Scene::materials`].
+    pub material: u32,
+    /// Third corner.
+    pub v2: [f32; 3],
+    /// Padding to 16-byte alignment.
+    pub pad: u32,
+}
+
+const _: () = assert!(std::mem::size_of::<GpuTriangle>() == 48);
+
+/// The lens as WGSL's `LensParams` reads it (96 bytes; `wgsl/lens.wgsl` mirrors it and a test
+/// checks the layouts agree). See the WGSL struct for the fields' meaning; the first eight
+/// fields serve classic lenses, the last three calibrated ones (zero for classic lenses).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, PartialEq, Pod, Zeroable)]
+pub struct LensParams {
+    /// Focal length.
+    pub f: f32,
+    /// `k1/f` of the general form.
+    pub k1_over_f: f32,
+    /// Rate `|k2|` of the general form.
+    pub rate: f32,
+    /// Radius of the domain edge, `f32::MAX` when unbounded.
+    pub r_max: f32,
+    /// Largest θ of a ray.
+    pub theta_max: f32,
+    /// Image width in pixels.
+    pub width: u32,
+    /// Image height in pixels.
+    pub height: u32,
+    /// `N_max` of `LensCamera::mask_limit`.
+    pub mask_limit: u32,
+    /// Calibrated: fx, fy, cx, cy in pixels.
+    pub intrinsics: [f32; 4],
+    /// Calibrated: the model's parameters, packed per kind as `calibrated_coefficients` says.
+    pub coefficients: [[f32; 4]; 2],
+    /// Calibrated: Scaramuzza's affine c, d, e.
+    pub affine: [f32; 4],
+}
+
+const _: () = assert!(std::mem::size_of::<LensParams>() == 96);
+
+/// Per-frame face views as `wgsl/raster.wgsl` reads them (496 bytes).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, PartialEq, Pod, Zeroable)]
+pub struct Views {
+    /// Per face: scene space to clip space (column-major).
+    pub clip: [[f32; 16]; 6],
+    /// Per face: the rendered texels `x0, y0, x1, y1`, empty for skipped faces.
+    pub regions: [[u32; 4]; 6],
+    /// The eye in scene space (xyz).
+    pub eye: [f32; 4],
+}
+
+/// One layer of the shadow maps as `wgsl/raster.wgsl` reads it (80 bytes).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, PartialEq, Pod, Zeroable)]
+pub struct ShadowView {
+    /// Scene space to the layer's clip space (column-major), depth reversed.
+    pub clip: [f32; 16],
+    /// `x`: a texel's width in scene units, at unit distance for a point light's face.
+    pub texel: [f32; 4],
+}
+
+#[cfg(test)]
+mod tests {
+    use std::mem::{offset_of, size_of};
+
+    use super::*;
+    use crate::shader::assert_wgsl_layout;
+
+    #[test]
+    fn gpu_structs_match_their_wgsl_twins() {
+        assert_wgsl_layout(
+            "triangles",
+            "BvhTriangle",
+            size_of::<GpuTriangle>(),
+            &[
+                ("v0", offset_of!(GpuTriangle, v0)),
+                ("triangle", offset_of!(GpuTriangle, triangle)),
+                ("v1", offset_of!(GpuTriangle, v1)),
+                ("material", offset_of!(GpuTriangle, material)),
+                ("v2", offset_of!(GpuTriangle, v2)),
+                ("pad", offset_of!(GpuTriangle, pad)),
+            ],
+        );
+        assert_wgsl_layout(
+            "shade",
+            "Material",
+            size_of::<GpuMaterial>(),
+            &[
+                ("diffuse", offset_of!(GpuMaterial, diffuse)),
+                ("surface", offset_of!(GpuMaterial, surface)),
+                ("specular", offset_of!(GpuMaterial, specular)),
+                ("shininess", offset_of!(GpuMaterial, shininess)),
+                ("emission", offset_of!(GpuMaterial, emission)),
+                ("ior", offset_of!(GpuMaterial, ior)),
+                ("transmission", offset_of!(GpuMaterial, transmission)),
+                ("texture", offset_of!(GpuMaterial, texture)),
+                ("opacity", offset_of!(GpuMaterial, opacity)),
+                ("pad", offset_of!(GpuMaterial, pad)),
+            ],
+        );
+        assert_wgsl_layout(
+            "shade",
+            "Light",
+            size_of::<GpuLight>(),
+            &[
+                ("vector", offset_of!(GpuLight, vector)),
+                ("kind", offset_of!(GpuLight, kind)),
+                ("colour", offset_of!(GpuLight, colour)),
+                ("shadow_layer", offset_of!(GpuLight, shadow_layer)),
+            ],
+        );
+        assert_wgsl_layout(
+            "shade",
+            "Shading",
+            size_of::<Shading>(),
+            &[
+                ("sky", offset_of!(Shading, sky)),
+                ("light_count", offset_of!(Shading, light_count)),
+                ("ambient", offset_of!(Shading, ambient)),
+                ("max_depth", offset_of!(Shading, max_depth)),
+            ],
+        );
+        assert_wgsl_layout(
+            "trace",
+            "Frame",
+            size_of::<Frame>(),
+            &[
+                ("right", offset_of!(Frame, right)),
+                ("down", offset_of!(Frame, down)),
+                ("forward", offset_of!(Frame, forward)),
+                ("eye", offset_of!(Frame, eye)),
+                ("offset", offset_of!(Frame, offset)),
+            ],
+        );
+    }
+
+    /// `LensParams` in Rust and WGSL have the same size and field offsets (naga's layout).
+    #[test]
+    fn lens_params_layout_matches_wgsl() {
+        assert_wgsl_layout(
+            "lens",
+            "LensParams",
+            size_of::<LensParams>(),
+            &[
+                ("f", offset_of!(LensParams, f)),
+                ("k1_over_f", offset_of!(LensParams, k1_over_f)),
+                ("rate", offset_of!(LensParams, rate)),
+                ("r_max", offset_of!(LensParams, r_max)),
+                ("theta_max", offset_of!(LensParams, theta_max)),
+                ("width", offset_of!(LensParams, width)),
+                ("height", offset_of!(LensParams, height)),
+                ("mask_limit", offset_of!(LensParams, mask_limit)),
+                ("intrinsics", offset_of!(LensParams, intrinsics)),
+                ("coefficients", offset_of!(LensParams, coefficients)),
+                ("affine", offset_of!(LensParams, affine)),
+            ],
+        );
+    }
+
+    #[test]
+    fn raster_structs_match_their_wgsl_twins() {
+        assert_wgsl_layout(
+            "raster",
+            "Views",
+            size_of::<Views>(),
+            &[
+                ("clip", offset_of!(Views, clip)),
+                ("regions", offset_of!(Views, regions)),
+                ("eye", offset_of!(Views, eye)),
+            ],
+        );
+        assert_wgsl_layout(
+            "raster",
+            "ShadowView",
+            size_of::<ShadowView>(),
+            &[
+                ("clip", offset_of!(ShadowView, clip)),
+                ("texel", offset_of!(ShadowView, texel)),
+            ],
+        );
+    }
+}

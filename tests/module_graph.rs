@@ -1,0 +1,279 @@
+//! The library's modules depend on each other in one direction: read from the sources, the
+//! graph of which file names which (`crate::a::b`, `super::x`, and a `mod.rs` re-exporting its
+//! children) has no cycle, `shared` reads nothing of the crate, and `shader` reads only
+//! `shared`. Comments, the `#[cfg(test)] mod tests` at a file's end and test files (`tests.rs`)
+//! are left out: tests may reach anywhere.
+
+use std::collections::{BTreeMap, BTreeSet};
+use std::path::Path;
+
+/// Module path (`lens::gpu`; `` for lib.rs) of every file under `src/`, with its code.
+fn modules() -> BTreeMap<String, String> {
+    fn walk(dir: &Path, out: &mut BTreeMap<String, String>) {
+        for entry in std::fs::read_dir(dir).unwrap() {
+            let path = entry.unwrap().path();
+            if path.is_dir() {
+                walk(&path, out);
+            } else if path.extension().is_some_and(|e| e == "rs") {
+                let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("src");
+                let relative = path.strip_prefix(&src).unwrap().with_extension("");
+                let mut parts: Vec<String> = relative
+                    .iter()
+                    .map(|p| p.to_string_lossy().into_owned())
+                    .collect();
+                if matches!(parts.last().map(String::as_str), Some("mod" | "lib")) {
+                    parts.pop();
+                }
+                if parts == ["main"] || parts.last().is_some_and(|p| p == "tests") {
+                    continue; // the binary, and test modules kept in files of their own
+                }
+                out.insert(
+                    parts.join("::"),
+                    code(&std::fs::read_to_string(&path).unwrap()),
+                );
+            }
+        }
+    }
+    let mut out = BTreeMap::new();
+    walk(&Path::new(env!("CARGO_MANIFEST_DIR")).join("src"), &mut out);
+    out
+}
+
+/// A file's code without comments and without its trailing test module.
+fn code(text: &str) -> String {
+    let text = text.split("#[cfg(test)]\nmod tests").next().unwrap();
+    text.lines()
+        .map(|l| l.split("//").next().unwrap())
+        .collect::<Vec<_>>()
+        .join("\n")
+}
+
+/// The paths a `use` tree names, braces expanded, with the name each binds: `a::{b, c::d as
+/// e}` gives `(a::b, b)` and `(a::c::d, e)`.
+fn expand(tree: &str) -> Vec<(String, String)> {
+    let tree = tree.trim();
+    let Some(open) = tree.find('{') else {
+        let (path, alias) = match tree.split_once(" as ") {
+            Some((p, a)) => (p.trim(), a.trim()),
+            None => (tree, tree.rsplit("::").next().unwrap()),
+        };
+        return vec![(path.to_string(), alias.to_string())];
+    };
+    let prefix = &tree[..open];
+    let inner = &tree[open + 1..tree.rfind('}').unwrap()];
+    // The items at the top level of the braces.
+    let (mut depth, mut start, mut items) = (0, 0, Vec::new());
+    for (i, c) in inner.char_indices() {
+        match c {
+            '{' => depth += 1,
+            '}' => depth -= 1,
+            ',' if depth == 0 => {
+                items.push(&inner[start..i]);
+                start = i + 1;
+            }
+            _ => {}
+        }
+    }
+    items.push(&inner[start..]);
+    items
+        .into_iter()
+        .map(str::trim)
+        .filter(|i| !i.is_empty())
+        .flat_map(|i| match i {
+            "self" => vec![(
+                prefix.trim_end_matches("::").to_string(),
+                prefix
+                    .trim_end_matches("::")
+                    .rsplit("::")
+                    .next()
+                    .unwrap()
+                    .to_string(),
+            )],
+            _ => expand(&format!("{prefix}{i}")),
+        })
+        .collect()
+}
+
+/// The simple paths after each whole-word `prefix` (`crate::`, `super::`) in `code`.
+fn inline_paths<'a>(code: &'a str, prefix: &str) -> Vec<&'a str> {
+    code.match_indices(prefix)
+        .filter(|(i, _)| {
+            !code[..*i]
+                .chars()
+                .next_back()
+                .is_some_and(|c| c.is_alphanumeric() || c == '_')
+        })
+        .map(|(i, _)| {
+            let rest = &code[i..];
+            let end = rest
+                .find(|c: char| !(c.is_alphanumeric() || c == '_' || c == ':'))
+                .unwrap_or(rest.len());
+            rest[..end].trim_end_matches(':')
+        })
+        .collect()
+}
+
+/// A path (`crate::x`, `super::x`, `self::x`, or a child's `x::y`) written in module `name`,
+/// relative to the crate root; `None` for another crate's.
+fn absolute(name: &str, path: &str, modules: &BTreeMap<String, String>) -> Option<String> {
+    let join = |base: &str, rest: &str| match (base.is_empty(), rest.is_empty()) {
+        (true, _) => rest.to_string(),
+        (_, true) => base.to_string(),
+        _ => format!("{base}::{rest}"),
+    };
+    let parent = name.rsplit_once("::").map_or("", |(p, _)| p);
+    if let Some(rest) = path.strip_prefix("crate::") {
+        Some(rest.to_string())
+    } else if let Some(rest) = path.strip_prefix("super::") {
+        Some(join(parent, rest))
+    } else if let Some(rest) = path.strip_prefix("self::") {
+        Some(join(name, rest))
+    } else {
+        let first = path.split("::").next().unwrap();
+        modules
+            .contains_key(&join(name, first))
+            .then(|| join(name, path))
+    }
+}
+
+/// The modules and, per module, the names it re-exports (`pub use`) with their paths.
+struct Crate {
+    modules: BTreeMap<String, String>,
+    reexports: BTreeMap<String, BTreeMap<String, String>>,
+}
+
+impl Crate {
+    /// The module that defines what `path` names, following re-exports.
+    fn resolve(&self, path: &str, hops: u32) -> Option<String> {
+        let parts: Vec<&str> = path.split("::").collect();
+        let k = (1..=parts.len())
+            .rev()
+            .find(|&k| self.modules.contains_key(&parts[..k].join("::")))?;
+        let module = parts[..k].join("::");
+        let Some(target) = parts.get(k).and_then(|n| self.reexports[&module].get(*n)) else {
+            return Some(module);
+        };
+        if hops >= 8 {
+            return Some(module);
+        }
+        let full = std::iter::once(target.as_str())
+            .chain(parts[k + 1..].iter().copied())
+            .collect::<Vec<_>>()
+            .join("::");
+        self.resolve(&full, hops + 1).or(Some(module))
+    }
+}
+
+/// Which modules each module reads. A `pub use` passes names through and is no dependency of
+/// its own: readers of the name depend on the module that defines it.
+fn graph() -> BTreeMap<String, BTreeSet<String>> {
+    let modules = modules();
+    let mut uses = BTreeMap::new();
+    let mut reexports = BTreeMap::new();
+    for (name, code) in &modules {
+        let (mut used, mut exported) = (Vec::new(), BTreeMap::new());
+        for statement in code.split(';') {
+            let statement = statement.trim();
+            let Some((head, tree)) = statement.rsplit_once("use ") else {
+                continue;
+            };
+            let head = head.lines().last().unwrap_or("").trim();
+            let public = head.starts_with("pub");
+            if !(head.is_empty() || public) {
+                continue;
+            }
+            for (path, alias) in expand(tree) {
+                if let Some(path) = absolute(name, &path, &modules) {
+                    if public {
+                        exported.insert(alias, path);
+                    } else {
+                        used.push(path);
+                    }
+                }
+            }
+        }
+        for prefix in ["crate::", "super::"] {
+            let inline = inline_paths(code, prefix);
+            used.extend(
+                inline
+                    .into_iter()
+                    .filter_map(|p| absolute(name, p, &modules)),
+            );
+        }
+        uses.insert(name.clone(), used);
+        reexports.insert(name.clone(), exported);
+    }
+    let krate = Crate { modules, reexports };
+    uses.into_iter()
+        .map(|(name, used)| {
+            let to: BTreeSet<String> = used
+                .iter()
+                .filter_map(|p| krate.resolve(p, 0))
+                .filter(|m| *m != name)
+                .collect();
+            (name, to)
+        })
+        .collect()
+}
+
+/// A cycle of the graph, if it has one (depth-first).
+fn cycle(edges: &BTreeMap<String, BTreeSet<String>>) -> Option<Vec<String>> {
+    fn visit(
+        node: &str,
+        edges: &BTreeMap<String, BTreeSet<String>>,
+        path: &mut Vec<String>,
+        done: &mut BTreeSet<String>,
+    ) -> Option<Vec<String>> {
+        if let Some(i) = path.iter().position(|p| p == node) {
+            return Some(path[i..].to_vec());
+        }
+        if done.contains(node) {
+            return None;
+        }
+        path.push(node.to_string());
+        for next in &edges[node] {
+            if let Some(c) = visit(next, edges, path, done) {
+                return Some(c);
+            }
+        }
+        path.pop();
+        done.insert(node.to_string());
+        None
+    }
+    let mut done = BTreeSet::new();
+    edges
+        .keys()
+        .find_map(|start| visit(start, edges, &mut Vec::new(), &mut done))
+}
+
+#[test]
+fn modules_depend_one_way() {
+    let edges = graph();
+    // The reading sees what it should: the tracer reads the shader assembly and the BVH, and
+    // names re-exported by `lens` lead to the files that define them.
+    assert!(edges["trace"].contains("shader") && edges["trace"].contains("bvh"));
+    assert!(
+        edges["lens::gpu"].contains("lens::camera"),
+        "{:?}",
+        edges["lens::gpu"]
+    );
+    if let Some(c) = cycle(&edges) {
+        panic!("the modules form a cycle: {}", c.join(" -> "));
+    }
+    assert!(
+        edges["shared"].is_empty(),
+        "shared reads {:?}",
+        edges["shared"]
+    );
+    let shader: Vec<&String> = edges["shader"].iter().collect();
+    assert_eq!(shader, ["shared"], "shader reads more than shared");
+}
+
+/// The check itself finds a cycle where there is one.
+#[test]
+fn a_cycle_is_found() {
+    let mut edges = graph();
+    edges.get_mut("shared").unwrap().insert("trace".into());
+    let c = cycle(&edges).expect("shared -> trace -> ... -> shared");
+    assert!(c.contains(&"shared".to_string()) && c.contains(&"trace".to_string()));
+}
