@@ -2,9 +2,7 @@
 //! rings every 30° off the axis), rendered on the GPU. It is also the frame whose cost
 //! [`DirectionSource::Computed`] and [`DirectionSource::Table`] are benchmarked on.
 
-use std::path::Path;
-
-use crate::error::{Error, Result};
+use crate::error::Result;
 use crate::gpu::{GpuContext, dispatch_over_image, storage_entry, uniform_entry};
 use crate::lens::LensCamera;
 use crate::lens::gpu::{DirectionSource, LensRays, lens_constants, params_buffer};
@@ -109,18 +107,4 @@ impl LensDemo {
         Ok(image::RgbaImage::from_raw(size.width, size.height, bytes)
             .expect("the pixel buffer holds width × height RGBA8 pixels"))
     }
-}
-
-/// Writes an image as PNG, creating the parent folder.
-pub fn save_png(image: &image::RgbaImage, path: &Path) -> Result<()> {
-    if let Some(parent) = path.parent().filter(|p| !p.as_os_str().is_empty()) {
-        std::fs::create_dir_all(parent).map_err(|source| Error::Io {
-            path: parent.to_path_buf(),
-            source,
-        })?;
-    }
-    image.save(path).map_err(|source| Error::Image {
-        path: path.to_path_buf(),
-        source,
-    })
 }

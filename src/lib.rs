@@ -37,22 +37,30 @@
 //! # Ok(()) }
 //! ```
 
-pub mod bench;
 pub mod bvh;
-pub mod compare;
 pub mod cube;
-pub mod demo;
 mod error;
 pub mod gpu;
 pub mod lens;
-pub mod plot;
 pub mod precision;
 pub mod raster;
-pub mod report;
 pub mod scene;
 pub mod shader;
 pub mod shared;
 pub mod trace;
+
+// The tools of the `fisheye` command (the default `cli` feature).
+#[cfg(feature = "cli")]
+pub mod bench;
+#[cfg(feature = "cli")]
+pub mod compare;
+#[cfg(feature = "cli")]
+pub mod demo;
+#[cfg(feature = "cli")]
+pub mod plot;
+#[cfg(feature = "cli")]
+pub mod report;
+#[cfg(feature = "cli")]
 pub mod validate;
 
 pub use error::{Error, LensError, Result};

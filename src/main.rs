@@ -9,7 +9,7 @@ use clap::{Parser, Subcommand, ValueEnum};
 use fisheye_rt::bench::{self, PathKind, SceneSet, Setup};
 use fisheye_rt::bvh::BvhQuality;
 use fisheye_rt::cube::{CubeMap, CubeMethod, CubeSettings, FACES};
-use fisheye_rt::demo::{LensDemo, save_png};
+use fisheye_rt::demo::LensDemo;
 use fisheye_rt::gpu::{GpuContext, Queries};
 use fisheye_rt::lens::calib::{self, CalibFormat, Calibration};
 use fisheye_rt::lens::gpu::{DirectionSource, LensPoints};
@@ -21,7 +21,8 @@ use fisheye_rt::raster::RasterMethod;
 use fisheye_rt::report::{self, LensRun, Progress, Study};
 use fisheye_rt::scene::{Scene, builtin};
 use fisheye_rt::trace::{
-    Channel, GpuScene, RenderOptions, TracePass, Traversal, colour_image, world_directions,
+    Channel, GpuScene, RenderOptions, TracePass, Traversal, colour_image, save_png,
+    world_directions,
 };
 use fisheye_rt::validate;
 use glam::{DVec2, DVec3};

@@ -11,13 +11,12 @@ use crate::bench::{
     FrameStats, FrameTime, Machine, Method, Pass, Renderer, SceneSet, Setup, camera_path,
 };
 use crate::compare::{ImageError, error_map, image_error, pareto_front, supersampled};
-use crate::demo::save_png;
 use crate::error::{Error, Result};
 use crate::gpu::{GpuContext, median};
 use crate::lens::LensCamera;
 use crate::plot;
 use crate::scene::{Camera, Scene};
-use crate::trace::colour_image;
+use crate::trace::{colour_image, save_png};
 
 pub use crate::bench::PathKind;
 

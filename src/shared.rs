@@ -271,7 +271,7 @@ pub fn wgsl_constants() -> Vec<(String, u32)> {
 pub struct GpuMaterial {
     /// `Kd`.
     pub diffuse: [f32; 3],
-    /// [`surface_id`].
+    /// A `SURFACE_*` id.
     pub surface: u32,
     /// `Ks`.
     pub specular: [f32; 3],
@@ -302,7 +302,7 @@ pub struct GpuLight {
     /// Intensity or irradiance.
     pub colour: [f32; 3],
     /// The light's first layer in the rasterizer's shadow maps: six for a point light (one
-    /// per cube face, in [`crate::cube::FACES`] order), one for a directional light.
+    /// per cube face, in [`FACES`] order), one for a directional light.
     pub shadow_layer: u32,
 }
 
@@ -331,7 +331,7 @@ pub struct Frame {
     pub down: [f32; 4],
     /// Camera z (forward).
     pub forward: [f32; 4],
-    /// Eye position relative to [`GpuScene::origin`] (xyz).
+    /// Eye position relative to the scene's origin (`GpuScene::origin`), xyz.
     pub eye: [f32; 4],
     /// The pixel of the first invocation (x, y), for dispatches over a part of the image.
     pub offset: [u32; 4],
@@ -344,11 +344,11 @@ pub struct Frame {
 pub struct GpuTriangle {
     /// First corner, camera-relative.
     pub v0: [f32; 3],
-    /// Index of the triangle in [`Scene::triangles`].
+    /// Index of the triangle in `Scene::triangles`.
     pub triangle: u32,
     /// Second corner.
     pub v1: [f32; 3],
-    /// Index into [`Scene::materials`].
+    /// Index into `Scene::materials`.
     pub material: u32,
     /// Third corner.
     pub v2: [f32; 3],

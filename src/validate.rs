@@ -26,7 +26,6 @@ use serde::Serialize;
 
 use crate::bench::Machine;
 use crate::compare::{supersample_factor, supersampled};
-use crate::demo::save_png;
 use crate::error::Result;
 use crate::gpu::GpuContext;
 use crate::lens::gpu::DirectionSource;
@@ -35,7 +34,7 @@ use crate::plot;
 use crate::report::{file_stem, machine_lines, write_json, write_text};
 use crate::scene::Camera;
 use crate::scene::builtin::{GridCorner, grid_corners};
-use crate::trace::{GpuScene, RenderOptions, TracePass, colour_image};
+use crate::trace::{GpuScene, RenderOptions, TracePass, colour_image, save_png};
 
 /// Standard deviation, in pixels, of the Gaussian the detector weighs luminance with: the
 /// wider, the better it averages out the aliasing of area-sampled sharp edges (worst case on

@@ -214,6 +214,7 @@ fn written_files_read_back() {
     for spec in CalibratedModel::EXAMPLES.iter().copied().chain([
         "radtan:fx=300,cx=255.5,cy=255.5",
         "radtan:fx=300,cx=255.5,cy=255.5,k1=-0.2,k2=0.05,p1=0.001,p2=-0.002",
+        "radtan:fx=300,cx=255.5,cy=255.5,k1=-0.2,k2=0.05,p1=0.001,p2=-0.002,k3=0.01",
         "ucm:fx=300,cx=255.5,cy=255.5,alpha=1",
     ]) {
         let lens = *parse_spec(spec).unwrap().calibrated().unwrap();
@@ -227,6 +228,17 @@ fn written_files_read_back() {
             );
             match written {
                 Ok(text) => {
+                    if format == CalibFormat::Basalt {
+                        // Another reader (serde_json) sees the same document.
+                        let doc: serde_json::Value = serde_json::from_str(&text)
+                            .unwrap_or_else(|e| panic!("{spec}: not JSON to serde_json: {e}"));
+                        let camera = &doc["value0"]["intrinsics"][0];
+                        assert_eq!(
+                            camera["intrinsics"]["fx"].as_f64(),
+                            Some(lens.intrinsics().fx)
+                        );
+                        assert_eq!(doc["value0"]["resolution"][0][0].as_u64(), Some(512));
+                    }
                     let back = calib::parse(&text, format)
                         .unwrap_or_else(|e| panic!("{spec} as {name}: {e}\n{text}"));
                     let back = back[0];

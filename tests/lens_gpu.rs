@@ -12,7 +12,7 @@
 use std::sync::OnceLock;
 
 use fisheye_rt::gpu::GpuContext;
-use fisheye_rt::lens::gpu::{DirectionSource, LensPoints, LensRays};
+use fisheye_rt::lens::gpu::{LensPoints, LensRays};
 use fisheye_rt::lens::{
     CalibratedLens, CalibratedModel, DirectionFormula, ImageSize, Lens, LensCamera, PRESETS,
     parse_spec,
@@ -318,9 +318,11 @@ fn trig_replacements_are_accurate_here() {
 /// The demo frame is the same whether it reads the direction table or computes directions
 /// (the table holds exactly what the kernel computes; a pixel may differ only where f32
 /// contraction differs between the kernels and a grid line's threshold falls in between).
+#[cfg(feature = "cli")]
 #[test]
 fn direction_table_and_computed_directions_agree() {
     use fisheye_rt::demo::LensDemo;
+    use fisheye_rt::lens::gpu::DirectionSource;
     // A 180° circle of radius 0.66 half-widths: the corners have no ray.
     let cam = camera("canon-8-15mm@8mm", 640, 480);
     let computed = LensDemo::new(ctx(), &cam, DirectionSource::Computed)

@@ -22,6 +22,7 @@ use yaml_rust2::{Yaml, YamlLoader};
 
 use super::calibrated::{CalibratedLens, CalibratedModel, Intrinsics};
 use super::camera::ImageSize;
+use super::json::Json;
 use crate::error::LensError;
 
 /// One calibrated camera of a file: its lens and the image size it was calibrated at.
@@ -142,8 +143,7 @@ pub fn parse(text: &str, format: CalibFormat) -> Result<Vec<Calibration>, String
                 .collect()
         }
         CalibFormat::Basalt => {
-            let doc: serde_json::Value =
-                serde_json::from_str(text).map_err(|e| format!("not valid JSON: {e}"))?;
+            let doc = super::json::parse(text).map_err(|e| format!("not valid JSON: {e}"))?;
             let value = doc.get("value0").unwrap_or(&doc);
             let intrinsics = value["intrinsics"]
                 .as_array()
@@ -402,10 +402,7 @@ fn kalibr(camera: &Yaml) -> Result<Calibration, String> {
 }
 
 /// One camera of a Basalt calibration.
-fn basalt(
-    camera: &serde_json::Value,
-    resolution: Option<&serde_json::Value>,
-) -> Result<Calibration, String> {
+fn basalt(camera: &Json, resolution: Option<&Json>) -> Result<Calibration, String> {
     let kind = camera["camera_type"]
         .as_str()
         .ok_or("camera_type is missing")?;
@@ -415,7 +412,7 @@ fn basalt(
             .as_f64()
             .ok_or_else(|| format!("intrinsics.{key} is missing"))
     };
-    let size = match resolution.and_then(|r| r.as_array()).map(|r| &r[..]) {
+    let size = match resolution.and_then(Json::as_array) {
         Some([w, h]) => image_size(
             w.as_f64().ok_or("resolution width is not a number")?,
             h.as_f64().ok_or("resolution height is not a number")?,
@@ -559,20 +556,18 @@ pub fn write(calibration: &Calibration, format: CalibFormat) -> Result<String, L
                 }
                 _ => return Err(unsupported()),
             };
-            let mut values = serde_json::Map::new();
-            for (key, value) in [("fx", fx), ("fy", fy), ("cx", cx), ("cy", cy)]
+            // Rust's `{:e}` is the shortest form that reads back to the same f64.
+            let values: Vec<String> = [("fx", fx), ("fy", fy), ("cx", cx), ("cy", cy)]
                 .into_iter()
                 .chain(extra)
-            {
-                values.insert(key.into(), value.into());
-            }
-            let doc = serde_json::json!({
-                "value0": {
-                    "intrinsics": [{ "camera_type": kind, "intrinsics": values }],
-                    "resolution": [[w, h]],
-                }
-            });
-            Ok(serde_json::to_string_pretty(&doc).expect("JSON values serialise") + "\n")
+                .map(|(key, value)| format!("          \"{key}\": {value:e}"))
+                .collect();
+            Ok(format!(
+                "{{\n  \"value0\": {{\n    \"intrinsics\": [\n      {{\n        \"camera_type\": \
+                 \"{kind}\",\n        \"intrinsics\": {{\n{}\n        }}\n      }}\n    ],\n    \
+                 \"resolution\": [\n      [\n        {w},\n        {h}\n      ]\n    ]\n  }}\n}}\n",
+                values.join(",\n")
+            ))
         }
     }
 }

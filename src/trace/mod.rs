@@ -9,7 +9,7 @@ mod ray_query;
 use bytemuck::Pod;
 use glam::{DMat3, DVec3, Vec3};
 
-pub use output::{Channel, RenderOutput, colour_image, linear_to_srgb};
+pub use output::{Channel, RenderOutput, colour_image, linear_to_srgb, save_png};
 pub use ray_query::RayQueryScene;
 
 pub use crate::shared::{

@@ -54,6 +54,20 @@ pub fn colour_image(size: ImageSize, colour: &[[f32; 4]]) -> image::RgbaImage {
     image::RgbaImage::from_raw(size.width, size.height, out).expect("width × height RGBA8 pixels")
 }
 
+/// Writes an image as PNG, creating the parent folder.
+pub fn save_png(image: &image::RgbaImage, path: &Path) -> Result<()> {
+    if let Some(parent) = path.parent().filter(|p| !p.as_os_str().is_empty()) {
+        std::fs::create_dir_all(parent).map_err(|source| Error::Io {
+            path: parent.to_path_buf(),
+            source,
+        })?;
+    }
+    image.save(path).map_err(|source| Error::Image {
+        path: path.to_path_buf(),
+        source,
+    })
+}
+
 impl RenderOutput {
     /// Whether pixel `i` (row-major) has a ray.
     pub fn valid(&self, i: usize) -> bool {
