@@ -426,7 +426,7 @@ pub struct Machine {
 impl Machine {
     /// This machine and `ctx`'s adapter, today.
     pub fn describe(ctx: &GpuContext) -> Self {
-        let info = ctx.adapter.get_info();
+        let info = ctx.adapter_info();
         let cpu = std::fs::read_to_string("/proc/cpuinfo")
             .ok()
             .and_then(|text| {

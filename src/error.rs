@@ -150,6 +150,16 @@ pub enum Error {
         /// What went wrong, with the line and key where the parser knows them.
         message: String,
     },
+    /// The device's limits are below what the kernels need.
+    #[error(
+        "the device's limits are too low: {0}; create it with at least \
+         fisheye_rt::renderer::required_limits()"
+    )]
+    Limits(String),
+    /// A texture handed to [`crate::renderer::Renderer`] that it cannot write (format, size
+    /// or usage), with what it writes.
+    #[error("the renderer cannot write {0}")]
+    Target(String),
     /// A scene that cannot be rendered (with what is wrong).
     #[error("scene: {0}")]
     Scene(String),

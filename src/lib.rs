@@ -12,6 +12,7 @@
 //! - [`shader`]: how WGSL files are assembled into modules.
 //! - [`scene`], [`bvh`], [`trace`]: scenes (built-in and OBJ), the CWBVH, and the GPU tracer
 //!   with its f64 reference.
+//! - [`renderer`]: rendering on the caller's device into the caller's texture and encoder.
 //! - [`cube`], [`raster`]: the cube-map path (faces ray traced or rasterized, then resampled),
 //!   to compare with direct ray tracing.
 //!
@@ -44,6 +45,7 @@ pub mod gpu;
 pub mod lens;
 pub mod precision;
 pub mod raster;
+pub mod renderer;
 pub mod scene;
 pub mod shader;
 pub mod shared;

@@ -404,7 +404,7 @@ impl RasterFaces {
                 return Err(Error::MissingFeature {
                     what: "the single-pass cube (wgpu has no geometry shaders)",
                     feature: "MULTIVIEW",
-                    adapter: ctx.adapter.get_info().name,
+                    adapter: ctx.adapter_info().name,
                 });
             }
             let views = ctx.device.limits().max_multiview_view_count;

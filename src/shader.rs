@@ -8,7 +8,7 @@ use std::fmt::Write;
 use crate::shared::{wgsl_constants, wgsl_faces};
 
 /// Every WGSL file of the project, by name (its file stem under `wgsl/`).
-pub const FILES: [(&str, &str); 21] = [
+pub const FILES: [(&str, &str); 22] = [
     ("math", include_str!("../wgsl/math.wgsl")),
     ("calibrated", include_str!("../wgsl/calibrated.wgsl")),
     ("triangles", include_str!("../wgsl/triangles.wgsl")),
@@ -28,6 +28,7 @@ pub const FILES: [(&str, &str); 21] = [
     ("cube_probe", include_str!("../wgsl/cube_probe.wgsl")),
     ("cube_sample", include_str!("../wgsl/cube_sample.wgsl")),
     ("cube_store", include_str!("../wgsl/cube_store.wgsl")),
+    ("present", include_str!("../wgsl/present.wgsl")),
     ("raster", include_str!("../wgsl/raster.wgsl")),
     (
         "raster_multiview",
@@ -110,9 +111,13 @@ pub fn compose(entry: &str) -> String {
 
 /// Creates the shader module for `entry`, labelled `fisheye.<entry>`.
 pub fn module(device: &wgpu::Device, entry: &str) -> wgpu::ShaderModule {
+    module_from(device, entry, compose(entry))
+}
+
+fn module_from(device: &wgpu::Device, entry: &str, source: String) -> wgpu::ShaderModule {
     device.create_shader_module(wgpu::ShaderModuleDescriptor {
         label: Some(&format!("fisheye.{entry}")),
-        source: wgpu::ShaderSource::Wgsl(compose(entry).into()),
+        source: wgpu::ShaderSource::Wgsl(source.into()),
     })
 }
 
@@ -123,6 +128,20 @@ pub fn module(device: &wgpu::Device, entry: &str) -> wgpu::ShaderModule {
 pub fn compute_pipeline(
     device: &wgpu::Device,
     file: &str,
+    entry_point: &str,
+    constants: &[(&str, f64)],
+    layouts: &[&wgpu::BindGroupLayout],
+) -> wgpu::ComputePipeline {
+    compute_pipeline_edited(device, file, |s| s, entry_point, constants, layouts)
+}
+
+/// As [`compute_pipeline`], with the composed source passed through `edit` first: WGSL has no
+/// override for a storage texture's format, so a pass whose format is chosen at run time
+/// rewrites the one its file declares.
+pub fn compute_pipeline_edited(
+    device: &wgpu::Device,
+    file: &str,
+    edit: impl FnOnce(String) -> String,
     entry_point: &str,
     constants: &[(&str, f64)],
     layouts: &[&wgpu::BindGroupLayout],
@@ -140,7 +159,7 @@ pub fn compute_pipeline(
     device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
         label: Some(&label),
         layout: layout.as_ref(),
-        module: &module(device, file),
+        module: &module_from(device, file, edit(compose(file))),
         entry_point: Some(entry_point),
         compilation_options: wgpu::PipelineCompilationOptions {
             constants,

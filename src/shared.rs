@@ -16,6 +16,11 @@ pub const WORKGROUP_1D: u32 = 64;
 /// is refused at build time rather than traversed wrongly.
 pub const TRAVERSAL_STACK: u32 = 32;
 
+/// Storage buffers the trace kernel binds: the direction table and three outputs (group 0),
+/// and the scene's seven (group 1). wgpu's default limit is 8, so a device made for the tracer
+/// must ask for more (`renderer::required_limits`).
+pub const TRACE_STORAGE_BUFFERS: u32 = 11;
+
 /// The deepest Whitted recursion a kernel can run (its ray stack has one more entry).
 pub const MAX_DEPTH_LIMIT: u32 = 8;
 /// A shadow ray passes at most this many partially transparent surfaces; behind more, the

@@ -194,17 +194,19 @@ pub const OPTIONAL_FEATURES: [(wgpu::Features, &str); 6] = [
     (wgpu::Features::SHADER_F64, "f64 in shaders"),
 ];
 
-/// An adapter, its device and queue: the GPU everything else runs on.
+/// A device and its queue: the GPU everything else runs on. [`GpuContext::new`] creates
+/// one; [`GpuContext::from_device`] wraps a caller's (a renderer that embeds the library).
+#[derive(Clone)]
 pub struct GpuContext {
-    /// The adapter the device was created on.
-    pub adapter: wgpu::Adapter,
     /// The device; passes take `&Device`.
     pub device: wgpu::Device,
     /// The device's queue.
     pub queue: wgpu::Queue,
-    /// Why the device was lost, once it is.
+    /// Why the device was lost, once it is (devices we create; a caller's device keeps the
+    /// caller's own lost callback).
     lost: Arc<Mutex<Option<String>>>,
-    /// The first error outside every error scope (wgpu's default handler would panic).
+    /// The first error outside every error scope (wgpu's default handler would panic; a
+    /// caller's device keeps the caller's own handler).
     uncaptured: Arc<Mutex<Option<String>>>,
 }
 
@@ -345,7 +347,6 @@ impl GpuContext {
             first.lock().unwrap().get_or_insert(error.to_string());
         }));
         let ctx = Self {
-            adapter,
             device,
             queue,
             lost,
@@ -357,9 +358,27 @@ impl GpuContext {
         Ok(ctx)
     }
 
+    /// Wraps a device and queue the caller created (and keeps using). Every error of ours is
+    /// still caught by error scopes and returned; the caller's uncaptured-error handler and
+    /// device-lost callback are left as they are. What a pass needs beyond the defaults
+    /// (features, limits) it checks when it is created, naming what is missing.
+    pub fn from_device(device: &wgpu::Device, queue: &wgpu::Queue) -> Self {
+        Self {
+            device: device.clone(),
+            queue: queue.clone(),
+            lost: Arc::default(),
+            uncaptured: Arc::default(),
+        }
+    }
+
+    /// What the adapter says of itself.
+    pub fn adapter_info(&self) -> wgpu::AdapterInfo {
+        self.device.adapter_info()
+    }
+
     /// The adapter's name, backend and type, e.g. `llvmpipe (LLVM 19.1.7, 256 bits) (Vulkan, Cpu)`.
     pub fn adapter_name(&self) -> String {
-        describe(&self.adapter.get_info())
+        describe(&self.adapter_info())
     }
 
     /// Whether the device was created with `feature`.
@@ -369,7 +388,7 @@ impl GpuContext {
 
     /// A human-readable report of the adapter, driver, optional features and key limits.
     pub fn report(&self) -> String {
-        let info = self.adapter.get_info();
+        let info = self.adapter_info();
         let limits = self.device.limits();
         let mut out = format!(
             "adapter: {}\ndriver: {} {}\nfeatures:\n",
@@ -467,12 +486,22 @@ impl GpuContext {
         Ok(bytemuck::pod_collect_to_vec(&bytes))
     }
 
-    /// Copies every layer of a 2D (array) texture of 16-byte texels (`Rgba32Float`, which must
-    /// have `COPY_SRC`) to the CPU: layer by layer, rows top first.
+    /// Reads a 2D texture (or array) with four f32 channels back, layer after layer, row-major.
     pub fn read_texture(&self, texture: &wgpu::Texture) -> Result<Vec<[f32; 4]>> {
         assert_eq!(texture.format().block_copy_size(None), Some(16));
+        Ok(bytemuck::pod_collect_to_vec(
+            &self.read_texture_bytes(texture)?,
+        ))
+    }
+
+    /// Reads a 2D texture (or array) back as its texels' bytes, layer after layer, row-major.
+    pub fn read_texture_bytes(&self, texture: &wgpu::Texture) -> Result<Vec<u8>> {
+        let texel = texture
+            .format()
+            .block_copy_size(None)
+            .expect("a colour format with one texel a block") as usize;
         let size = texture.size();
-        let row = 16 * size.width as usize;
+        let row = texel * size.width as usize;
         // Copies pad each row to a multiple of 256 bytes.
         let padded = row.next_multiple_of(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT as usize);
         let rows = (size.height * size.depth_or_array_layers) as usize;
@@ -492,7 +521,8 @@ impl GpuContext {
         })?;
         Ok(bytes
             .chunks_exact(padded)
-            .flat_map(|r| bytemuck::pod_collect_to_vec::<u8, [f32; 4]>(&r[..row]))
+            .flat_map(|r| &r[..row])
+            .copied()
             .collect())
     }
 

@@ -542,10 +542,35 @@ impl TracePass {
         );
     }
 
+    /// Records a move of the camera to `pose` into `encoder`, for the frames recorded after
+    /// it: a copy of the 80-byte frame from a new buffer, so frames recorded into one encoder
+    /// may each have their own pose (see [`TracePass::set_pose`] for precision).
+    pub fn encode_pose(
+        &self,
+        device: &wgpu::Device,
+        encoder: &mut wgpu::CommandEncoder,
+        scene: &GpuScene,
+        pose: &Camera,
+    ) {
+        let frame = frame_for(scene.origin, pose);
+        let staging = crate::gpu::buffer_init(
+            device,
+            "fisheye.trace.pose",
+            bytemuck::bytes_of(&frame),
+            wgpu::BufferUsages::COPY_SRC,
+        );
+        encoder.copy_buffer_to_buffer(&staging, 0, &self.frame, 0, size_of::<Frame>() as u64);
+    }
+
     /// The colour output of the last frame (as [`RenderOutput::colour`]), for passes that
     /// read it on the GPU.
     pub fn colour_buffer(&self) -> &wgpu::Buffer {
         &self.colour
+    }
+
+    /// The colour, geometry and id outputs of the last frame (as [`RenderOutput`] reads them).
+    pub fn buffers(&self) -> [&wgpu::Buffer; 3] {
+        [&self.colour, &self.geometry, &self.ids]
     }
 
     /// Records one frame, optionally timed.

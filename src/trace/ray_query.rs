@@ -26,7 +26,7 @@ impl RayQueryScene {
             return Err(Error::MissingFeature {
                 what: "ray-query traversal (--method rq)",
                 feature: "EXPERIMENTAL_RAY_QUERY",
-                adapter: ctx.adapter.get_info().name,
+                adapter: ctx.adapter_info().name,
             });
         }
         let limit = ctx.device.limits().max_blas_primitive_count;

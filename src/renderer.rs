@@ -1,0 +1,225 @@
+//! Rendering inside an application's own frame loop: a [`Renderer`] is made on the caller's
+//! `wgpu::Device` and `Queue`, records each frame into the caller's `CommandEncoder`, and
+//! writes the image into the caller's texture, with no submission, no wait and no copy to the
+//! CPU. The scene is uploaded once; moving the camera between frames records an 80-byte copy.
+//!
+//! ```no_run
+//! # fn main() -> Result<(), fisheye_rt::Error> {
+//! use fisheye_rt::lens::{parse_spec, ImageSize, LensCamera};
+//! use fisheye_rt::renderer::Renderer;
+//! use fisheye_rt::scene::builtin;
+//! use fisheye_rt::trace::RenderOptions;
+//! # let (device, queue): (wgpu::Device, wgpu::Queue) = unimplemented!();
+//! // `device` and `queue` are the application's own, created with (at least)
+//! // `fisheye_rt::renderer::required_limits()`.
+//! let scene = builtin::scene("default").expect("a built-in scene");
+//! let camera = LensCamera::new(parse_spec("samyang-7.5mm")?, ImageSize::new(640, 480)?);
+//! let format = wgpu::TextureFormat::Rgba16Float;
+//! let renderer = Renderer::new(&device, &queue, &scene, &camera, &RenderOptions::default(), format)?;
+//! let target = device.create_texture(&wgpu::TextureDescriptor {
+//!     label: Some("fisheye view"),
+//!     size: wgpu::Extent3d { width: 640, height: 480, depth_or_array_layers: 1 },
+//!     mip_level_count: 1,
+//!     sample_count: 1,
+//!     dimension: wgpu::TextureDimension::D2,
+//!     format,
+//!     usage: wgpu::TextureUsages::STORAGE_BINDING | wgpu::TextureUsages::TEXTURE_BINDING,
+//!     view_formats: &[],
+//! });
+//! let mut encoder = device.create_command_encoder(&Default::default());
+//! renderer.encode(&mut encoder, &scene.camera, &target)?; // a frame, into `target`
+//! // ... the application's own passes read `target`, then it submits when it likes:
+//! queue.submit([encoder.finish()]);
+//! # Ok(()) }
+//! ```
+
+use crate::error::{Error, Result};
+use crate::gpu::{GpuContext, bind_group, dispatch_over_image, storage_entry};
+use crate::lens::LensCamera;
+use crate::scene::{Camera, Scene};
+use crate::shader;
+use crate::shared::TRACE_STORAGE_BUFFERS;
+use crate::trace::{GpuScene, RenderOptions, TracePass};
+
+/// The limits a device needs for the renderer: wgpu's downlevel defaults, with the storage
+/// buffers the trace kernel binds. Ask for these (or the adapter's own) when creating the
+/// device; ray queries also need `Features::EXPERIMENTAL_RAY_QUERY` and the adapter's
+/// acceleration-structure limits.
+pub fn required_limits() -> wgpu::Limits {
+    wgpu::Limits {
+        max_storage_buffers_per_shader_stage: TRACE_STORAGE_BUFFERS,
+        ..wgpu::Limits::downlevel_defaults()
+    }
+}
+
+/// The texture formats a [`Renderer`] writes, with their WGSL names: linear radiance in the
+/// float formats, sRGB-encoded display values (as the PNG) in `Rgba8Unorm`; alpha is the lens
+/// mask (1 where a pixel has a ray, 0 where not). Storage textures cannot be sRGB formats, so
+/// the encoding is done in the kernel.
+pub const TARGET_FORMATS: [(wgpu::TextureFormat, &str); 3] = [
+    (wgpu::TextureFormat::Rgba8Unorm, "rgba8unorm"),
+    (wgpu::TextureFormat::Rgba16Float, "rgba16float"),
+    (wgpu::TextureFormat::Rgba32Float, "rgba32float"),
+];
+
+/// A scene and a lens on the caller's device, ready to record frames into the caller's
+/// encoders and textures.
+pub struct Renderer {
+    ctx: GpuContext,
+    scene: GpuScene,
+    pass: TracePass,
+    present: wgpu::ComputePipeline,
+    present_layout: wgpu::BindGroupLayout,
+    format: wgpu::TextureFormat,
+    camera: LensCamera,
+}
+
+impl Renderer {
+    /// Builds the BVH, uploads `scene` (relative to its camera) and creates the kernels for
+    /// `camera` and textures of `format` (one of [`TARGET_FORMATS`]). Errors name what the
+    /// device lacks (a feature the options need, a limit the scene or image exceeds).
+    pub fn new(
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        scene: &Scene,
+        camera: &LensCamera,
+        options: &RenderOptions,
+        format: wgpu::TextureFormat,
+    ) -> Result<Self> {
+        let Some((_, wgsl_format)) = TARGET_FORMATS.iter().find(|(f, _)| *f == format) else {
+            return Err(Error::Target(format!(
+                "textures of format {format:?}; it writes {}",
+                format_names()
+            )));
+        };
+        let mut short = Vec::new();
+        required_limits().check_limits_with_fail_fn(&device.limits(), false, |name, need, has| {
+            short.push(format!("{name} is {has}, the renderer needs {need}"))
+        });
+        if !short.is_empty() {
+            return Err(Error::Limits(short.join("; ")));
+        }
+        let ctx = GpuContext::from_device(device, queue);
+        let gpu_scene = GpuScene::new(&ctx, scene, options)?;
+        let pass = TracePass::new(&ctx, camera, &gpu_scene, options.directions)?;
+        let (present, present_layout) = ctx.checked("creating the present pass", || {
+            let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+                label: Some("fisheye.present"),
+                entries: &[
+                    storage_entry(0, true),
+                    wgpu::BindGroupLayoutEntry {
+                        binding: 1,
+                        visibility: wgpu::ShaderStages::COMPUTE,
+                        ty: wgpu::BindingType::StorageTexture {
+                            access: wgpu::StorageTextureAccess::WriteOnly,
+                            format,
+                            view_dimension: wgpu::TextureViewDimension::D2,
+                        },
+                        count: None,
+                    },
+                ],
+            });
+            let encode_srgb = f64::from(u8::from(format == wgpu::TextureFormat::Rgba8Unorm));
+            let pipeline = shader::compute_pipeline_edited(
+                device,
+                "present",
+                |source| {
+                    source.replace(
+                        "texture_storage_2d<rgba32float, write>",
+                        &format!("texture_storage_2d<{wgsl_format}, write>"),
+                    )
+                },
+                "main",
+                &[("ENCODE_SRGB", encode_srgb)],
+                &[&layout],
+            );
+            (pipeline, layout)
+        })?;
+        Ok(Self {
+            ctx,
+            scene: gpu_scene,
+            pass,
+            present,
+            present_layout,
+            format,
+            camera: *camera,
+        })
+    }
+
+    /// The scene as uploaded (its BVH statistics, bounds, features).
+    pub fn scene(&self) -> &GpuScene {
+        &self.scene
+    }
+
+    /// Records one frame seen from `pose` into `encoder`, written into `target`: a 2D texture
+    /// of the camera's size, of the format given to [`Renderer::new`], with
+    /// `STORAGE_BINDING` usage. Frames recorded into one encoder may each have their own pose.
+    /// Nothing is submitted; the trace pass's own buffers hold the last frame's geometry and
+    /// ids too (see [`Renderer::outputs`]).
+    pub fn encode(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        pose: &Camera,
+        target: &wgpu::Texture,
+    ) -> Result<()> {
+        let size = self.camera.size;
+        let extent = target.size();
+        let wanted = (size.width, size.height, 1);
+        if (extent.width, extent.height, extent.depth_or_array_layers) != wanted
+            || target.format() != self.format
+            || !target
+                .usage()
+                .contains(wgpu::TextureUsages::STORAGE_BINDING)
+            || target.dimension() != wgpu::TextureDimension::D2
+        {
+            return Err(Error::Target(format!(
+                "a texture of {}x{}x{} {:?} texels with usage {:?}; it writes a 2D texture of \
+                 {size} {:?} texels with STORAGE_BINDING usage",
+                extent.width,
+                extent.height,
+                extent.depth_or_array_layers,
+                target.format(),
+                target.usage(),
+                self.format
+            )));
+        }
+        self.ctx.checked("recording a frame", || {
+            self.pass
+                .encode_pose(&self.ctx.device, encoder, &self.scene, pose);
+            self.pass.encode(encoder, &self.scene, None);
+            let view = target.create_view(&Default::default());
+            let group = bind_group(
+                &self.ctx.device,
+                "fisheye.present",
+                &self.present_layout,
+                [
+                    self.pass.colour_buffer().as_entire_binding(),
+                    wgpu::BindingResource::TextureView(&view),
+                ],
+            );
+            dispatch_over_image(
+                encoder,
+                "fisheye.present",
+                &self.present,
+                &[&group],
+                size,
+                None,
+            );
+        })
+    }
+
+    /// The trace pass's buffers, as the last recorded frame left them: colour (linear RGB, w
+    /// = the mask), geometry (world normal, w = distance) and ids (`u32`, `NO_HIT` on a miss),
+    /// row-major, as [`crate::trace::RenderOutput`] reads them; for passes of the caller's own.
+    pub fn outputs(&self) -> [&wgpu::Buffer; 3] {
+        self.pass.buffers()
+    }
+}
+
+fn format_names() -> String {
+    TARGET_FORMATS
+        .iter()
+        .map(|(f, _)| format!("{f:?}"))
+        .collect::<Vec<_>>()
+        .join(", ")
+}

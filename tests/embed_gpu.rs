@@ -1,0 +1,208 @@
+//! The library embedded in an application: the test makes its own device and queue (as a
+//! winit or Bevy app would), records several frames with different poses into one encoder,
+//! writing the application's textures, submits once, and finds each texture bit for bit what
+//! the one-call render (or the trace pass at that pose) gives.
+
+use fisheye_rt::gpu::GpuContext;
+use fisheye_rt::lens::{ImageSize, LensCamera, parse_spec};
+use fisheye_rt::renderer::Renderer;
+use fisheye_rt::scene::{Camera, builtin};
+use fisheye_rt::trace::{GpuScene, RenderOptions, TracePass, render};
+use glam::DVec3;
+
+/// A device and queue made the plain wgpu way, with no optional features and `limits`.
+fn device_with(limits: wgpu::Limits) -> (wgpu::Device, wgpu::Queue) {
+    let instance = wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle());
+    let adapter = pollster::block_on(instance.request_adapter(&Default::default()))
+        .expect("these tests need a GPU adapter (or lavapipe)");
+    let descriptor = wgpu::DeviceDescriptor {
+        required_limits: limits,
+        ..Default::default()
+    };
+    pollster::block_on(adapter.request_device(&descriptor)).unwrap()
+}
+
+/// A device with the limits the renderer documents.
+fn own_device() -> (wgpu::Device, wgpu::Queue) {
+    device_with(fisheye_rt::renderer::required_limits())
+}
+
+fn texture(device: &wgpu::Device, size: ImageSize, format: wgpu::TextureFormat) -> wgpu::Texture {
+    device.create_texture(&wgpu::TextureDescriptor {
+        label: Some("the application's view"),
+        size: wgpu::Extent3d {
+            width: size.width,
+            height: size.height,
+            depth_or_array_layers: 1,
+        },
+        mip_level_count: 1,
+        sample_count: 1,
+        dimension: wgpu::TextureDimension::D2,
+        format,
+        usage: wgpu::TextureUsages::STORAGE_BINDING | wgpu::TextureUsages::COPY_SRC,
+        view_formats: &[],
+    })
+}
+
+/// Asserts two images are equal bit for bit, saying how many pixels differ if not.
+fn assert_same(what: &str, a: &[[f32; 4]], b: &[[f32; 4]]) {
+    assert_eq!(a.len(), b.len(), "{what}: sizes");
+    let bits = |c: &[f32; 4]| c.map(f32::to_bits);
+    let differing = a.iter().zip(b).filter(|(x, y)| bits(x) != bits(y)).count();
+    assert_eq!(
+        differing,
+        0,
+        "{what}: {differing} of {} pixels differ",
+        a.len()
+    );
+}
+
+#[test]
+fn frames_recorded_into_the_callers_encoder_and_texture_match_the_one_call_render() {
+    let (device, queue) = own_device();
+    let scene = builtin::scene("default").unwrap();
+    let camera = LensCamera::new(
+        parse_spec("samyang-7.5mm").unwrap(),
+        ImageSize::new(96, 72).unwrap(),
+    );
+    let options = RenderOptions::default();
+    let format = wgpu::TextureFormat::Rgba32Float;
+    let renderer = Renderer::new(&device, &queue, &scene, &camera, &options, format).unwrap();
+    let home = scene.camera;
+    let moved = Camera {
+        position: home.position + DVec3::new(0.6, -0.2, 0.4),
+        look_at: home.look_at + DVec3::new(-0.8, 0.3, 0.0),
+        up: DVec3::Y,
+    };
+    let targets: Vec<wgpu::Texture> = (0..3)
+        .map(|_| texture(&device, camera.size, format))
+        .collect();
+    let mut encoder = device.create_command_encoder(&Default::default());
+    for (pose, target) in [home, moved, home].iter().zip(&targets) {
+        renderer.encode(&mut encoder, pose, target).unwrap();
+    }
+    queue.submit([encoder.finish()]);
+
+    // The library's own conveniences on the same device, for the expected images.
+    let ctx = GpuContext::from_device(&device, &queue);
+    let at_home = render(&ctx, &scene, &camera, &options).unwrap();
+    let gpu_scene = GpuScene::new(&ctx, &scene, &options).unwrap();
+    let pass = TracePass::new(&ctx, &camera, &gpu_scene, options.directions).unwrap();
+    pass.set_pose(&ctx, &gpu_scene, &moved);
+    let at_moved = pass.trace(&ctx, &gpu_scene, "tracing").unwrap();
+    // The trace pass's buffers hold the last frame's outputs.
+    let [colour, _, ids] = renderer.outputs();
+    assert_same(
+        "the last frame's colour buffer",
+        &ctx.read_buffer(colour).unwrap(),
+        &at_home.colour,
+    );
+    assert_eq!(ctx.read_buffer::<u32>(ids).unwrap(), at_home.ids);
+    let read = |t: &wgpu::Texture| ctx.read_texture(t).unwrap();
+    assert_same("the first frame", &read(&targets[0]), &at_home.colour);
+    assert_same("the moved frame", &read(&targets[1]), &at_moved.colour);
+    assert_same("the third frame", &read(&targets[2]), &at_home.colour);
+    assert_ne!(at_home.colour, at_moved.colour);
+}
+
+/// An 8-bit target holds what the PNG holds: sRGB-encoded, clamped, alpha the mask (the GPU's
+/// `pow` may round the last bit differently from Rust's, so a channel may differ by one).
+#[test]
+fn an_8_bit_target_holds_the_png_values() {
+    let (device, queue) = own_device();
+    let scene = builtin::scene("default").unwrap();
+    let camera = LensCamera::new(
+        parse_spec("canon-8-15mm@8mm").unwrap(),
+        ImageSize::new(64, 48).unwrap(),
+    );
+    let options = RenderOptions::default();
+    let format = wgpu::TextureFormat::Rgba8Unorm;
+    let renderer = Renderer::new(&device, &queue, &scene, &camera, &options, format).unwrap();
+    let target = texture(&device, camera.size, format);
+    let mut encoder = device.create_command_encoder(&Default::default());
+    renderer
+        .encode(&mut encoder, &scene.camera, &target)
+        .unwrap();
+    queue.submit([encoder.finish()]);
+    let ctx = GpuContext::from_device(&device, &queue);
+    let texels = ctx.read_texture_bytes(&target).unwrap();
+    let png = render(&ctx, &scene, &camera, &options).unwrap().to_image();
+    let mut masked = 0;
+    for (i, (t, p)) in texels.chunks_exact(4).zip(png.pixels()).enumerate() {
+        assert_eq!(t[3], p[3], "alpha (the mask) at {i}");
+        if p[3] == 0 {
+            masked += 1;
+            continue;
+        }
+        for k in 0..3 {
+            assert!(t[k].abs_diff(p[k]) <= 1, "pixel {i}: {t:?} vs {:?}", p.0);
+        }
+    }
+    assert!(masked > 0 && masked < texels.len() / 4);
+}
+
+/// A device one storage buffer short of the documented limits (wgpu's defaults have 8) is
+/// refused, naming the limit; with them, the trace pipeline is created (the other tests).
+#[test]
+fn a_device_below_the_required_limits_is_refused_naming_the_limit() {
+    let mut limits = fisheye_rt::renderer::required_limits();
+    limits.max_storage_buffers_per_shader_stage -= 1;
+    let (device, queue) = device_with(limits);
+    let scene = builtin::scene("grid").unwrap();
+    let camera = LensCamera::new(
+        parse_spec("equidistant:f=0.4").unwrap(),
+        ImageSize::new(32, 24).unwrap(),
+    );
+    let format = wgpu::TextureFormat::Rgba16Float;
+    let options = RenderOptions::default();
+    let message = Renderer::new(&device, &queue, &scene, &camera, &options, format)
+        .err()
+        .expect("refused")
+        .to_string();
+    assert!(
+        message.contains("max_storage_buffers_per_shader_stage is 10, the renderer needs 11"),
+        "{message}"
+    );
+}
+
+/// Textures the renderer cannot write are errors that say what it writes.
+#[test]
+fn unwritable_targets_are_errors_naming_what_is_wanted() {
+    let (device, queue) = own_device();
+    let scene = builtin::scene("grid").unwrap();
+    let camera = LensCamera::new(
+        parse_spec("equidistant:f=0.4").unwrap(),
+        ImageSize::new(32, 24).unwrap(),
+    );
+    let options = RenderOptions::default();
+    let message = Renderer::new(
+        &device,
+        &queue,
+        &scene,
+        &camera,
+        &options,
+        wgpu::TextureFormat::Bgra8UnormSrgb,
+    )
+    .err()
+    .expect("refused")
+    .to_string();
+    assert!(
+        message.contains("Bgra8UnormSrgb") && message.contains("Rgba16Float"),
+        "{message}"
+    );
+    let format = wgpu::TextureFormat::Rgba16Float;
+    let renderer = Renderer::new(&device, &queue, &scene, &camera, &options, format).unwrap();
+    let wrong_size = texture(&device, ImageSize::new(33, 24).unwrap(), format);
+    let wrong_format = texture(&device, camera.size, wgpu::TextureFormat::Rgba32Float);
+    let mut encoder = device.create_command_encoder(&Default::default());
+    for (target, wanted) in [(&wrong_size, "33x24x1"), (&wrong_format, "Rgba32Float")] {
+        let message = renderer
+            .encode(&mut encoder, &scene.camera, target)
+            .expect_err("refused")
+            .to_string();
+        assert!(
+            message.contains(wanted) && message.contains("32x24 Rgba16Float"),
+            "{message}"
+        );
+    }
+}
