@@ -124,13 +124,21 @@ fn repairable_input_warns_naming_what_was_done() {
     let obj = format!(
         "hello there\n{TRIANGLE}v 2 0 0\nvt 0 0\no flat\nusemtl ghost\nf 1/1 2/1 3/1\nf 1 2 4\n\
          o mixed\nf 1/1 2/1 3/1\nf 1 3 2\ncurv 0 1 1 2\n\
-         vn 0 0 1\no halfsmooth\nf 1//1 2//1 3//1\nf 1 3 4\n"
+         vn 0 0 1\no halfsmooth\nf 1//1 2//1 3//1\nf 1 3 4\n\
+         vn 0 0 0\no zero\nf 1//2 2//1 3//1\nf 1//1 3//1 4//1\n"
     );
     let path = write(&dir, "w.obj", obj.as_bytes());
     let loaded = load_obj(&path).unwrap();
-    assert_eq!(loaded.scene.len(), 5);
-    // No mesh kept its partial attributes.
-    assert!(loaded.scene.uvs.is_none() && loaded.scene.normals.is_none());
+    assert_eq!(loaded.scene.len(), 7);
+    // No mesh kept its partial attributes. A triangle with a zero vertex normal (mesh
+    // `zero`, triangle 5) gets its face normal at every corner; its neighbour keeps its own.
+    let scene = &loaded.scene;
+    assert!(scene.uvs.is_none());
+    let normals = scene.normals.as_ref().expect("mesh `zero` has normals");
+    let [a, b, c] = scene.triangles[5];
+    let face = (b - a).cross(c - a).normalize().as_vec3();
+    assert_eq!(normals[5], [face; 3]);
+    assert_eq!(normals[6], [glam::Vec3::Z; 3]);
     let warnings = loaded.warnings.join("\n");
     for wanted in [
         "line 1: `hello` skipped: not an OBJ statement",
@@ -159,7 +167,9 @@ fn empty_scenes_are_errors_saying_why() {
             "v 0 0 0\nv inf 0 0\nv 0 1 0\nf 1 2 3\n",
             "non-finite vertices",
         ),
-        ("v 0 0 0\nv 1 0 0\nv 2 0 0\nf 1 2 3\n", "of zero area"),
+        // Collinear corners away from the origin (at the origin, any mix-up of corner
+        // differences and sums would look collinear too).
+        ("v 1 1 1\nv 2 1 1\nv 3 1 1\nf 1 2 3\n", "of zero area"),
     ];
     for (i, (obj, wanted)) in cases.iter().enumerate() {
         let path = write(&dir, &format!("e{i}.obj"), obj.as_bytes());

@@ -215,6 +215,7 @@ fn written_files_read_back() {
         "radtan:fx=300,cx=255.5,cy=255.5",
         "radtan:fx=300,cx=255.5,cy=255.5,k1=-0.2,k2=0.05,p1=0.001,p2=-0.002",
         "radtan:fx=300,cx=255.5,cy=255.5,k1=-0.2,k2=0.05,p1=0.001,p2=-0.002,k3=0.01",
+        "radtan:fx=300,cx=255.5,cy=255.5,p1=0.001",
         "ucm:fx=300,cx=255.5,cy=255.5,alpha=1",
     ]) {
         let lens = *parse_spec(spec).unwrap().calibrated().unwrap();
