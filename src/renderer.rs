@@ -33,6 +33,7 @@
 //! # Ok(()) }
 //! ```
 
+use crate::cube::{CubeMap, CubeSettings, CubeSpans};
 use crate::error::{Error, Result};
 use crate::gpu::{GpuContext, bind_group, dispatch_over_image, storage_entry};
 use crate::lens::LensCamera;
@@ -62,12 +63,20 @@ pub const TARGET_FORMATS: [(wgpu::TextureFormat, &str); 3] = [
     (wgpu::TextureFormat::Rgba32Float, "rgba32float"),
 ];
 
+/// How a [`Renderer`] makes the lens image.
+enum Path {
+    /// Tracing the lens's rays (software traversal or ray queries, as the options say).
+    Direct(Box<TracePass>),
+    /// Through a cube map (faces traced or rasterized, then resampled).
+    Cube(Box<CubeMap>),
+}
+
 /// A scene and a lens on the caller's device, ready to record frames into the caller's
 /// encoders and textures.
 pub struct Renderer {
     ctx: GpuContext,
     scene: GpuScene,
-    pass: TracePass,
+    path: Path,
     present: wgpu::ComputePipeline,
     present_layout: wgpu::BindGroupLayout,
     format: wgpu::TextureFormat,
@@ -75,15 +84,43 @@ pub struct Renderer {
 }
 
 impl Renderer {
-    /// Builds the BVH, uploads `scene` (relative to its camera) and creates the kernels for
-    /// `camera` and textures of `format` (one of [`TARGET_FORMATS`]). Errors name what the
-    /// device lacks (a feature the options need, a limit the scene or image exceeds).
+    /// Builds the BVH, uploads `scene` (relative to its camera) and creates the kernels that
+    /// trace `camera`'s rays into textures of `format` (one of [`TARGET_FORMATS`]). Errors
+    /// name what the device lacks (a feature the options need, a limit the scene or image
+    /// exceeds).
     pub fn new(
         device: &wgpu::Device,
         queue: &wgpu::Queue,
         scene: &Scene,
         camera: &LensCamera,
         options: &RenderOptions,
+        format: wgpu::TextureFormat,
+    ) -> Result<Self> {
+        Self::build(device, queue, scene, camera, options, None, format)
+    }
+
+    /// As [`Renderer::new`], but making each image the way engines do: through a cube map
+    /// whose faces `cube` says how to render (traced or rasterized), then resampled. A cube's
+    /// pose is written at submission, so record one cube-map frame per submission.
+    pub fn through_cube(
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        scene: &Scene,
+        camera: &LensCamera,
+        options: &RenderOptions,
+        cube: &CubeSettings,
+        format: wgpu::TextureFormat,
+    ) -> Result<Self> {
+        Self::build(device, queue, scene, camera, options, Some(cube), format)
+    }
+
+    fn build(
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        scene: &Scene,
+        camera: &LensCamera,
+        options: &RenderOptions,
+        cube: Option<&CubeSettings>,
         format: wgpu::TextureFormat,
     ) -> Result<Self> {
         let Some((_, wgsl_format)) = TARGET_FORMATS.iter().find(|(f, _)| *f == format) else {
@@ -101,7 +138,17 @@ impl Renderer {
         }
         let ctx = GpuContext::from_device(device, queue);
         let gpu_scene = GpuScene::new(&ctx, scene, options)?;
-        let pass = TracePass::new(&ctx, camera, &gpu_scene, options.directions)?;
+        let path = match cube {
+            None => Path::Direct(Box::new(TracePass::new(
+                &ctx,
+                camera,
+                &gpu_scene,
+                options.directions,
+            )?)),
+            Some(settings) => {
+                Path::Cube(Box::new(CubeMap::new(&ctx, camera, &gpu_scene, settings)?))
+            }
+        };
         let (present, present_layout) = ctx.checked("creating the present pass", || {
             let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
                 label: Some("fisheye.present"),
@@ -138,7 +185,7 @@ impl Renderer {
         Ok(Self {
             ctx,
             scene: gpu_scene,
-            pass,
+            path,
             present,
             present_layout,
             format,
@@ -154,8 +201,8 @@ impl Renderer {
     /// Records one frame seen from `pose` into `encoder`, written into `target`: a 2D texture
     /// of the camera's size, of the format given to [`Renderer::new`], with
     /// `STORAGE_BINDING` usage. Frames recorded into one encoder may each have their own pose.
-    /// Nothing is submitted; the trace pass's own buffers hold the last frame's geometry and
-    /// ids too (see [`Renderer::outputs`]).
+    /// Nothing is submitted. Traced frames leave their geometry and ids in the trace pass's
+    /// buffers too (see [`Renderer::outputs`]).
     pub fn encode(
         &self,
         encoder: &mut wgpu::CommandEncoder,
@@ -184,16 +231,24 @@ impl Renderer {
             )));
         }
         self.ctx.checked("recording a frame", || {
-            self.pass
-                .encode_pose(&self.ctx.device, encoder, &self.scene, pose);
-            self.pass.encode(encoder, &self.scene, None);
+            let colour = match &self.path {
+                Path::Direct(pass) => {
+                    pass.encode_pose(&self.ctx.device, encoder, &self.scene, pose);
+                    pass.encode(encoder, &self.scene, None);
+                    pass.colour_buffer()
+                }
+                Path::Cube(cube) => {
+                    cube.encode(&self.ctx, encoder, &self.scene, pose, CubeSpans::default());
+                    cube.colour_buffer()
+                }
+            };
             let view = target.create_view(&Default::default());
             let group = bind_group(
                 &self.ctx.device,
                 "fisheye.present",
                 &self.present_layout,
                 [
-                    self.pass.colour_buffer().as_entire_binding(),
+                    colour.as_entire_binding(),
                     wgpu::BindingResource::TextureView(&view),
                 ],
             );
@@ -211,8 +266,12 @@ impl Renderer {
     /// The trace pass's buffers, as the last recorded frame left them: colour (linear RGB, w
     /// = the mask), geometry (world normal, w = distance) and ids (`u32`, `NO_HIT` on a miss),
     /// row-major, as [`crate::trace::RenderOutput`] reads them; for passes of the caller's own.
-    pub fn outputs(&self) -> [&wgpu::Buffer; 3] {
-        self.pass.buffers()
+    /// `None` through a cube map, which makes colour alone.
+    pub fn outputs(&self) -> Option<[&wgpu::Buffer; 3]> {
+        match &self.path {
+            Path::Direct(pass) => Some(pass.buffers()),
+            Path::Cube(_) => None,
+        }
     }
 }
 

@@ -91,7 +91,7 @@ fn frames_recorded_into_the_callers_encoder_and_texture_match_the_one_call_rende
     pass.set_pose(&ctx, &gpu_scene, &moved);
     let at_moved = pass.trace(&ctx, &gpu_scene, "tracing").unwrap();
     // The trace pass's buffers hold the last frame's outputs.
-    let [colour, _, ids] = renderer.outputs();
+    let [colour, _, ids] = renderer.outputs().expect("a traced frame");
     assert_same(
         "the last frame's colour buffer",
         &ctx.read_buffer(colour).unwrap(),
@@ -103,6 +103,53 @@ fn frames_recorded_into_the_callers_encoder_and_texture_match_the_one_call_rende
     assert_same("the moved frame", &read(&targets[1]), &at_moved.colour);
     assert_same("the third frame", &read(&targets[2]), &at_home.colour);
     assert_ne!(at_home.colour, at_moved.colour);
+}
+
+/// Through a cube map (traced and rasterized faces), one frame a submission: the caller's
+/// texture holds what the library's own cube-map render gives, bit for bit.
+#[test]
+fn cube_map_frames_match_the_cube_map_render() {
+    use fisheye_rt::cube::{CubeMap, CubeMethod, CubeSettings};
+    use fisheye_rt::raster::RasterMethod;
+    let (device, queue) = own_device();
+    let scene = builtin::scene("default").unwrap();
+    let camera = LensCamera::new(
+        parse_spec("canon-8-15mm@8mm").unwrap(),
+        ImageSize::new(64, 48).unwrap(),
+    );
+    let options = RenderOptions::default();
+    let format = wgpu::TextureFormat::Rgba32Float;
+    let ctx = GpuContext::from_device(&device, &queue);
+    let gpu_scene = GpuScene::new(&ctx, &scene, &options).unwrap();
+    for method in [
+        CubeMethod::Traced,
+        CubeMethod::Raster(RasterMethod::Forward),
+    ] {
+        let settings = CubeSettings {
+            shadow_size: 256,
+            ..CubeSettings::new(32, method)
+        };
+        let renderer = Renderer::through_cube(
+            &device, &queue, &scene, &camera, &options, &settings, format,
+        )
+        .unwrap();
+        assert!(renderer.outputs().is_none());
+        let target = texture(&device, camera.size, format);
+        let mut encoder = device.create_command_encoder(&Default::default());
+        renderer
+            .encode(&mut encoder, &scene.camera, &target)
+            .unwrap();
+        queue.submit([encoder.finish()]);
+        let expected = CubeMap::new(&ctx, &camera, &gpu_scene, &settings)
+            .unwrap()
+            .render(&ctx, &gpu_scene, &scene.camera)
+            .unwrap();
+        assert_same(
+            method.name(),
+            &ctx.read_texture(&target).unwrap(),
+            &expected,
+        );
+    }
 }
 
 /// An 8-bit target holds what the PNG holds: sRGB-encoded, clamped, alpha the mask (the GPU's

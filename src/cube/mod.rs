@@ -378,6 +378,13 @@ impl CubeMap {
         );
     }
 
+    /// The lens image's colour output (as
+    /// [`RenderOutput::colour`](crate::trace::RenderOutput::colour)), for passes that read it
+    /// on the GPU.
+    pub fn colour_buffer(&self) -> &wgpu::Buffer {
+        &self.colour
+    }
+
     /// The lens image's colours of the last submitted frame (as
     /// [`RenderOutput::colour`](crate::trace::RenderOutput::colour)).
     pub fn read(&self, ctx: &GpuContext) -> Result<Vec<[f32; 4]>> {
