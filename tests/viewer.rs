@@ -1,0 +1,100 @@
+//! The interactive viewer (`examples/viewer.rs`), run as a user runs it but under Xvfb: its
+//! window, after a few frames, shows what the library renders. `cargo test` builds the example
+//! next to this test's binary; `xvfb-run` comes from the `xvfb` package (which
+//! `.ci/install-lavapipe` installs).
+
+use std::path::PathBuf;
+use std::process::Command;
+
+use fisheye_rt::cube::{CubeMap, CubeMethod, CubeSettings};
+use fisheye_rt::gpu::GpuContext;
+use fisheye_rt::lens::{ImageSize, LensCamera, parse_spec};
+use fisheye_rt::scene::builtin;
+use fisheye_rt::trace::{GpuScene, RenderOptions, colour_image, render};
+
+/// The viewer example's binary, beside this test's (`target/<profile>/examples/viewer`).
+fn viewer() -> PathBuf {
+    let deps = std::env::current_exe()
+        .unwrap()
+        .parent()
+        .unwrap()
+        .to_path_buf();
+    let exe = deps.parent().unwrap().join("examples").join("viewer");
+    assert!(
+        exe.exists(),
+        "{} is missing: `cargo test` builds the examples",
+        exe.display()
+    );
+    exe
+}
+
+/// Runs the viewer under Xvfb for a few frames and returns its last frame.
+fn screenshot(args: &[&str]) -> image::RgbaImage {
+    let out = std::env::temp_dir().join(format!(
+        "fisheye-viewer-{}-{}.png",
+        std::process::id(),
+        args.join("_").replace(['/', ':', ','], "-")
+    ));
+    let result = Command::new("xvfb-run")
+        .args(["-a", "-s", "-screen 0 640x480x24"])
+        .arg(viewer())
+        .args(args)
+        .args(["--frames", "4", "--screenshot"])
+        .arg(&out)
+        .output()
+        .unwrap_or_else(|e| {
+            panic!("xvfb-run: {e} (install the xvfb package; .ci/install-lavapipe does)")
+        });
+    assert!(
+        result.status.success(),
+        "the viewer failed: {}",
+        String::from_utf8_lossy(&result.stderr)
+    );
+    let image = image::open(&out).unwrap().to_rgba8();
+    std::fs::remove_file(&out).unwrap();
+    image
+}
+
+/// Compares the window's pixels with the library's 8-bit image (masked pixels black): the
+/// window gets either the library's own sRGB values or half floats its surface encodes, so a
+/// channel may be a level or two off.
+fn assert_shows(what: &str, window: &image::RgbaImage, expected: &image::RgbaImage) {
+    assert_eq!(window.dimensions(), expected.dimensions(), "{what}");
+    let mut worst = 0;
+    let mut total = 0u64;
+    for (w, e) in window.pixels().zip(expected.pixels()) {
+        for k in 0..3 {
+            let d = w[k].abs_diff(if e[3] == 0 { 0 } else { e[k] });
+            worst = worst.max(d);
+            total += u64::from(d);
+        }
+    }
+    let mean = total as f64 / (3 * window.len() / 4) as f64;
+    eprintln!("{what}: largest channel difference {worst}, mean {mean:.3}");
+    assert!(
+        worst <= 2 && mean < 0.25,
+        "{what}: largest {worst}, mean {mean}"
+    );
+}
+
+#[test]
+fn the_viewer_shows_the_scene_under_xvfb() {
+    let scene = builtin::scene("default").unwrap();
+    let size = ImageSize::new(160, 120).unwrap();
+    let lens = "canon-8-15mm@8mm";
+    let camera = LensCamera::new(parse_spec(lens).unwrap(), size);
+    let ctx = GpuContext::new().unwrap();
+    let options = RenderOptions::default();
+    let args = ["builtin:default", "--lens", lens, "--size", "160x120"];
+
+    let traced = render(&ctx, &scene, &camera, &options).unwrap().to_image();
+    assert_shows("rt", &screenshot(&args), &traced);
+
+    // Through a cube map of the size the viewer picks: half the image's longer side.
+    let gpu_scene = GpuScene::new(&ctx, &scene, &options).unwrap();
+    let settings = CubeSettings::new(80, CubeMethod::Traced);
+    let cube = CubeMap::new(&ctx, &camera, &gpu_scene, &settings).unwrap();
+    let colour = cube.render(&ctx, &gpu_scene, &scene.camera).unwrap();
+    let window = screenshot(&[&args[..], &["--method", "cube-rt"]].concat());
+    assert_shows("cube-rt", &window, &colour_image(size, &colour));
+}
