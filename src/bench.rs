@@ -13,66 +13,12 @@ use crate::gpu::{GpuContext, Queries};
 use crate::lens::LensCamera;
 use crate::lens::gpu::DirectionSource;
 use crate::raster::RasterMethod;
+pub use crate::renderer::Method;
+use crate::renderer::Path;
 use crate::scene::{Camera, Scene};
-use crate::trace::{GpuScene, RenderOptions, TracePass, Traversal};
-
-/// A way of making the lens image.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Method {
-    /// Direct ray tracing of the lens's rays, software BVH traversal.
-    Rt,
-    /// Direct ray tracing with the adapter's hardware ray queries.
-    Rq,
-    /// A cube map, rendered as the method says, then resampled.
-    Cube(CubeMethod),
-}
+use crate::trace::{GpuScene, RenderOptions, RenderOutput, Traversal};
 
 impl Method {
-    /// Every method, in the order reports list them.
-    pub const ALL: [Method; 6] = [
-        Method::Rt,
-        Method::Rq,
-        Method::Cube(CubeMethod::Traced),
-        Method::Cube(CubeMethod::Raster(RasterMethod::Forward)),
-        Method::Cube(CubeMethod::Raster(RasterMethod::Deferred)),
-        Method::Cube(CubeMethod::Raster(RasterMethod::SinglePass)),
-    ];
-
-    /// The name `fisheye render --method` takes: `rt`, `rq`, `cube-rt`, `cube-forward`, ...
-    pub fn name(&self) -> &'static str {
-        match self {
-            Method::Rt => "rt",
-            Method::Rq => "rq",
-            Method::Cube(m) => m.name(),
-        }
-    }
-
-    /// The method called `name` (as [`Method::name`] writes it).
-    pub fn from_name(name: &str) -> Option<Method> {
-        Method::ALL.into_iter().find(|m| m.name() == name)
-    }
-
-    /// The BVH traversal the method's scene needs.
-    pub fn traversal(&self) -> Traversal {
-        match self {
-            Method::Rq => Traversal::RayQuery,
-            _ => Traversal::Software,
-        }
-    }
-
-    /// The device feature the method needs that `ctx` lacks, by name, if any (setting the
-    /// method up then fails with [`Error::MissingFeature`]).
-    pub fn missing_feature(&self, ctx: &GpuContext) -> Option<&'static str> {
-        let (feature, name) = match self {
-            Method::Rq => (wgpu::Features::EXPERIMENTAL_RAY_QUERY, "ray queries"),
-            Method::Cube(CubeMethod::Raster(RasterMethod::SinglePass)) => {
-                (wgpu::Features::MULTIVIEW, "multiview")
-            }
-            _ => return None,
-        };
-        (!ctx.has(feature)).then_some(name)
-    }
-
     /// The passes a frame of this method is timed in, in order.
     pub fn passes(&self) -> &'static [Pass] {
         match self {
@@ -198,15 +144,9 @@ impl SceneSet {
     }
 }
 
-/// What renders a frame (boxed: the two differ much in size).
-enum Kind {
-    Direct(Box<TracePass>),
-    Cube(Box<CubeMap>),
-}
-
 /// One setup ready to render frames of one lens: its pipelines, buffers and timestamp queries.
 pub struct Renderer {
-    kind: Kind,
+    path: Path,
     setup: Setup,
     queries: Option<Queries>,
 }
@@ -238,25 +178,37 @@ impl Renderer {
         setup: Setup,
         shadow_size: u32,
     ) -> Result<Self> {
+        Self::with_directions(
+            ctx,
+            camera,
+            scenes,
+            setup,
+            shadow_size,
+            DirectionSource::Computed,
+        )
+    }
+
+    /// As [`Renderer::new`], with direct tracing's primary rays from `directions`.
+    pub fn with_directions(
+        ctx: &GpuContext,
+        camera: &LensCamera,
+        scenes: &SceneSet,
+        setup: Setup,
+        shadow_size: u32,
+        directions: DirectionSource,
+    ) -> Result<Self> {
         let scene = scenes.for_method(setup.method);
-        let kind = match setup.method {
-            Method::Rt | Method::Rq => Kind::Direct(Box::new(TracePass::new(
-                ctx,
-                camera,
-                scene,
-                DirectionSource::Computed,
-            )?)),
-            Method::Cube(method) => {
-                let settings = CubeSettings {
-                    shadow_size,
-                    ..CubeSettings::new(setup.cube_size, method)
-                };
-                Kind::Cube(Box::new(CubeMap::new(ctx, camera, scene, &settings)?))
-            }
+        let cube = match setup.method {
+            Method::Cube(method) => Some(CubeSettings {
+                shadow_size,
+                ..CubeSettings::new(setup.cube_size, method)
+            }),
+            _ => None,
         };
+        let path = Path::new(ctx, camera, scene, directions, cube.as_ref())?;
         let queries = Queries::new(ctx, setup.method.passes().len() as u32);
         Ok(Self {
-            kind,
+            path,
             setup,
             queries,
         })
@@ -275,25 +227,17 @@ impl Renderer {
         let started = std::time::Instant::now();
         ctx.checked("rendering a frame", || {
             let mut encoder = ctx.device.create_command_encoder(&Default::default());
-            match &self.kind {
-                Kind::Direct(pass) => {
-                    pass.set_pose(ctx, scene, pose);
-                    pass.encode(&mut encoder, scene, q.map(|q| q.writes(0)));
-                }
-                Kind::Cube(cube) => {
-                    let passes = self.setup.method.passes();
-                    let span = |p: Pass| {
-                        let index = passes.iter().position(|&x| x == p)?;
-                        q.map(|q| q.span(index as u32))
-                    };
-                    let spans = CubeSpans {
-                        faces: span(Pass::Faces),
-                        lighting: span(Pass::Lighting),
-                        sampler: span(Pass::Sampler),
-                    };
-                    cube.encode(ctx, &mut encoder, scene, pose, spans);
-                }
-            }
+            let passes = self.setup.method.passes();
+            let index = |p: Pass| passes.iter().position(|&x| x == p).map(|i| i as u32);
+            let span = |p: Pass| index(p).and_then(|i| q.map(|q| q.span(i)));
+            let spans = CubeSpans {
+                faces: span(Pass::Faces),
+                lighting: span(Pass::Lighting),
+                sampler: span(Pass::Sampler),
+            };
+            let trace = index(Pass::Trace).and_then(|i| q.map(|q| q.writes(i)));
+            self.path
+                .encode(ctx, &mut encoder, scene, pose, trace, spans);
             if let Some(q) = q {
                 q.resolve(&mut encoder);
             }
@@ -308,12 +252,22 @@ impl Renderer {
         Ok(FrameTime { wall_ms, passes_ms })
     }
 
-    /// The lens image's linear colours of the last frame (as
-    /// [`RenderOutput::colour`](crate::trace::RenderOutput::colour)).
+    /// The lens image's linear colours of the last frame (as [`RenderOutput::colour`]).
     pub fn colour(&self, ctx: &GpuContext) -> Result<Vec<[f32; 4]>> {
-        match &self.kind {
-            Kind::Direct(pass) => Ok(pass.read(ctx)?.colour),
-            Kind::Cube(cube) => cube.read(ctx),
+        Ok(self.output(ctx)?.colour)
+    }
+
+    /// The last frame's outputs: all of them for direct tracing, the colour alone (geometry
+    /// zero, ids `NO_HIT`) through a cube map.
+    pub fn output(&self, ctx: &GpuContext) -> Result<RenderOutput> {
+        self.path.read(ctx)
+    }
+
+    /// The cube map, for a cube-map setup.
+    pub fn cube(&self) -> Option<&CubeMap> {
+        match &self.path {
+            Path::Cube(cube) => Some(cube),
+            Path::Direct(_) => None,
         }
     }
 }

@@ -33,14 +33,16 @@
 //! # Ok(()) }
 //! ```
 
-use crate::cube::{CubeMap, CubeSettings, CubeSpans};
+use crate::cube::{CubeMap, CubeMethod, CubeSettings, CubeSpans};
 use crate::error::{Error, Result};
 use crate::gpu::{GpuContext, bind_group, dispatch_over_image, storage_entry};
 use crate::lens::LensCamera;
+use crate::lens::gpu::DirectionSource;
+use crate::raster::RasterMethod;
 use crate::scene::{Camera, Scene};
 use crate::shader;
 use crate::shared::TRACE_STORAGE_BUFFERS;
-use crate::trace::{GpuScene, RenderOptions, TracePass};
+use crate::trace::{GpuScene, RenderOptions, RenderOutput, TracePass, Traversal};
 
 /// The limits a device needs for the renderer: wgpu's downlevel defaults, with the storage
 /// buffers the trace kernel binds. Ask for these (or the adapter's own) when creating the
@@ -50,6 +52,72 @@ pub fn required_limits() -> wgpu::Limits {
     wgpu::Limits {
         max_storage_buffers_per_shader_stage: TRACE_STORAGE_BUFFERS,
         ..wgpu::Limits::downlevel_defaults()
+    }
+}
+
+/// A way of making the lens image.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Method {
+    /// Direct ray tracing of the lens's rays, software BVH traversal.
+    Rt,
+    /// Direct ray tracing with the adapter's hardware ray queries.
+    Rq,
+    /// A cube map, rendered as the method says, then resampled.
+    Cube(CubeMethod),
+}
+
+impl Method {
+    /// Every method, in the order reports list them.
+    pub const ALL: [Method; 6] = [
+        Method::Rt,
+        Method::Rq,
+        Method::Cube(CubeMethod::Traced),
+        Method::Cube(CubeMethod::Raster(RasterMethod::Forward)),
+        Method::Cube(CubeMethod::Raster(RasterMethod::Deferred)),
+        Method::Cube(CubeMethod::Raster(RasterMethod::SinglePass)),
+    ];
+
+    /// The name `fisheye render --method` takes: `rt`, `rq`, `cube-rt`, `cube-forward`, ...
+    pub fn name(&self) -> &'static str {
+        match self {
+            Method::Rt => "rt",
+            Method::Rq => "rq",
+            Method::Cube(m) => m.name(),
+        }
+    }
+
+    /// The method called `name` (as [`Method::name`] writes it).
+    pub fn from_name(name: &str) -> Option<Method> {
+        Method::ALL.into_iter().find(|m| m.name() == name)
+    }
+
+    /// The cube-map method, `None` for direct tracing.
+    pub fn cube(&self) -> Option<CubeMethod> {
+        match self {
+            Method::Cube(m) => Some(*m),
+            _ => None,
+        }
+    }
+
+    /// The BVH traversal the method's scene needs.
+    pub fn traversal(&self) -> Traversal {
+        match self {
+            Method::Rq => Traversal::RayQuery,
+            _ => Traversal::Software,
+        }
+    }
+
+    /// The device feature the method needs that `ctx` lacks, by name, if any (setting the
+    /// method up then fails with [`Error::MissingFeature`]).
+    pub fn missing_feature(&self, ctx: &GpuContext) -> Option<&'static str> {
+        let (feature, name) = match self {
+            Method::Rq => (wgpu::Features::EXPERIMENTAL_RAY_QUERY, "ray queries"),
+            Method::Cube(CubeMethod::Raster(RasterMethod::SinglePass)) => {
+                (wgpu::Features::MULTIVIEW, "multiview")
+            }
+            _ => return None,
+        };
+        (!ctx.has(feature)).then_some(name)
     }
 }
 
@@ -63,12 +131,75 @@ pub const TARGET_FORMATS: [(wgpu::TextureFormat, &str); 3] = [
     (wgpu::TextureFormat::Rgba32Float, "rgba32float"),
 ];
 
-/// How a [`Renderer`] makes the lens image.
-enum Path {
-    /// Tracing the lens's rays (software traversal or ray queries, as the options say).
+/// How a frame is made, set up for one lens on one scene: the one dispatch that
+/// [`Renderer`] and the `fisheye` tool's commands (`render`, `bench`, `compare`) share.
+pub(crate) enum Path {
+    /// Tracing the lens's rays (software traversal or ray queries, as the scene was built).
     Direct(Box<TracePass>),
     /// Through a cube map (faces traced or rasterized, then resampled).
     Cube(Box<CubeMap>),
+}
+
+impl Path {
+    /// Direct tracing with `directions`, or a cube map made as `cube` says.
+    pub(crate) fn new(
+        ctx: &GpuContext,
+        camera: &LensCamera,
+        scene: &GpuScene,
+        directions: DirectionSource,
+        cube: Option<&CubeSettings>,
+    ) -> Result<Self> {
+        Ok(match cube {
+            None => Path::Direct(Box::new(TracePass::new(ctx, camera, scene, directions)?)),
+            Some(settings) => Path::Cube(Box::new(CubeMap::new(ctx, camera, scene, settings)?)),
+        })
+    }
+
+    /// Records a frame from `pose`; a traced frame's pass is timed by `trace`, a cube map's
+    /// passes by `spans`.
+    pub(crate) fn encode(
+        &self,
+        ctx: &GpuContext,
+        encoder: &mut wgpu::CommandEncoder,
+        scene: &GpuScene,
+        pose: &Camera,
+        trace: Option<wgpu::ComputePassTimestampWrites<'_>>,
+        spans: CubeSpans<'_>,
+    ) {
+        match self {
+            Path::Direct(pass) => {
+                pass.encode_pose(&ctx.device, encoder, scene, pose);
+                pass.encode(encoder, scene, trace);
+            }
+            Path::Cube(cube) => cube.encode(ctx, encoder, scene, pose, spans),
+        }
+    }
+
+    /// The lens image's colour output (linear RGB, w = the mask).
+    pub(crate) fn colour_buffer(&self) -> &wgpu::Buffer {
+        match self {
+            Path::Direct(pass) => pass.colour_buffer(),
+            Path::Cube(cube) => cube.colour_buffer(),
+        }
+    }
+
+    /// The last frame's outputs, read back: every output of a traced frame, the colour alone
+    /// (geometry zero, ids `NO_HIT`) through a cube map.
+    pub(crate) fn read(&self, ctx: &GpuContext) -> Result<RenderOutput> {
+        match self {
+            Path::Direct(pass) => pass.read(ctx),
+            Path::Cube(cube) => {
+                let colour = cube.read(ctx)?;
+                let size = cube.camera().size;
+                Ok(RenderOutput {
+                    size,
+                    geometry: vec![[0.0; 4]; colour.len()],
+                    ids: vec![crate::shared::NO_HIT; colour.len()],
+                    colour,
+                })
+            }
+        }
+    }
 }
 
 /// A scene and a lens on the caller's device, ready to record frames into the caller's
@@ -138,17 +269,7 @@ impl Renderer {
         }
         let ctx = GpuContext::from_device(device, queue);
         let gpu_scene = GpuScene::new(&ctx, scene, options)?;
-        let path = match cube {
-            None => Path::Direct(Box::new(TracePass::new(
-                &ctx,
-                camera,
-                &gpu_scene,
-                options.directions,
-            )?)),
-            Some(settings) => {
-                Path::Cube(Box::new(CubeMap::new(&ctx, camera, &gpu_scene, settings)?))
-            }
-        };
+        let path = Path::new(&ctx, camera, &gpu_scene, options.directions, cube)?;
         let (present, present_layout) = ctx.checked("creating the present pass", || {
             let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
                 label: Some("fisheye.present"),
@@ -231,17 +352,10 @@ impl Renderer {
             )));
         }
         self.ctx.checked("recording a frame", || {
-            let colour = match &self.path {
-                Path::Direct(pass) => {
-                    pass.encode_pose(&self.ctx.device, encoder, &self.scene, pose);
-                    pass.encode(encoder, &self.scene, None);
-                    pass.colour_buffer()
-                }
-                Path::Cube(cube) => {
-                    cube.encode(&self.ctx, encoder, &self.scene, pose, CubeSpans::default());
-                    cube.colour_buffer()
-                }
-            };
+            let (ctx, scene) = (&self.ctx, &self.scene);
+            self.path
+                .encode(ctx, encoder, scene, pose, None, CubeSpans::default());
+            let colour = self.path.colour_buffer();
             let view = target.create_view(&Default::default());
             let group = bind_group(
                 &self.ctx.device,

@@ -7,9 +7,7 @@ use std::path::Path;
 
 use serde::Serialize;
 
-use crate::bench::{
-    FrameStats, FrameTime, Machine, Method, Pass, Renderer, SceneSet, Setup, camera_path,
-};
+use crate::bench::{FrameStats, FrameTime, Machine, Pass, Renderer, SceneSet, Setup, camera_path};
 use crate::compare::{ImageError, error_map, image_error, pareto_front, supersampled};
 use crate::error::{Error, Result};
 use crate::gpu::{GpuContext, median};
@@ -19,6 +17,7 @@ use crate::scene::{Camera, Scene};
 use crate::trace::{colour_image, save_png};
 
 pub use crate::bench::PathKind;
+use crate::renderer::Method;
 
 /// A lens to measure, with the name reports give it.
 pub struct LensRun {

@@ -378,6 +378,11 @@ impl CubeMap {
         );
     }
 
+    /// The lens camera the cube is resampled for.
+    pub fn camera(&self) -> &LensCamera {
+        &self.camera
+    }
+
     /// The lens image's colour output (as
     /// [`RenderOutput::colour`](crate::trace::RenderOutput::colour)), for passes that read it
     /// on the GPU.

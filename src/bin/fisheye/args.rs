@@ -1,0 +1,330 @@
+//! The arguments several commands share: scene shading, lens and calibration, methods,
+//! output formats, and the camera pose.
+
+use std::path::PathBuf;
+
+use anyhow::{Context, Result, bail};
+use clap::ValueEnum;
+use fisheye_rt::bench;
+use fisheye_rt::bvh::BvhQuality;
+use fisheye_rt::cube::CubeMethod;
+use fisheye_rt::lens::calib::{self, CalibFormat};
+use fisheye_rt::lens::gpu::DirectionSource;
+use fisheye_rt::lens::{DirectionFormula, ImageSize, LensCamera, parse_spec};
+use fisheye_rt::raster::RasterMethod;
+use fisheye_rt::scene::Scene;
+use fisheye_rt::trace::Channel;
+use glam::DVec3;
+
+/// How the scene is built and shaded, for `render`, `bench` and `compare`.
+#[derive(clap::Args)]
+pub(crate) struct ShadingArgs {
+    /// Shadow-map size in texels per side and layer (rasterized `cube-*` methods).
+    #[arg(long, default_value_t = 2048)]
+    pub(crate) shadow_size: u32,
+    /// Deepest reflection/refraction bounce.
+    #[arg(long, default_value_t = 5)]
+    pub(crate) max_depth: u32,
+    /// BVH build preset.
+    #[arg(long, value_enum, default_value = "fast")]
+    pub(crate) bvh: Quality,
+}
+
+/// The scene, lenses, setups and outputs `bench` and `compare` share with `render`.
+#[derive(clap::Args)]
+pub(crate) struct StudyArgs {
+    /// The scene, as for `render`.
+    #[arg(default_value = "builtin:default")]
+    pub(crate) scene: String,
+    /// Lens specs to measure (repeatable); or give --calib.
+    #[arg(long, default_value = "canon-8-15mm@8mm")]
+    pub(crate) lens: Vec<String>,
+    /// The pinhole baseline measured beside the lenses, at the same image size.
+    #[arg(long, default_value = "rectilinear:f=1")]
+    pub(crate) pinhole: String,
+    /// Leave the pinhole baseline out.
+    #[arg(long)]
+    pub(crate) no_pinhole: bool,
+    /// Image size in pixels, WIDTHxHEIGHT.
+    #[arg(long, default_value = "1024x768")]
+    pub(crate) size: ImageSize,
+    #[command(flatten)]
+    pub(crate) calib: CalibArgs,
+    /// Camera pose instead of the scene's (as for `render`); the orbit path circles its
+    /// look-at point.
+    #[arg(long)]
+    pub(crate) camera: Option<String>,
+    /// Methods to measure (comma-separated); by default every one the adapter has.
+    #[arg(long, value_enum, value_delimiter = ',')]
+    pub(crate) method: Vec<Method>,
+    /// Cube face sizes to measure the cube-map methods at (comma-separated).
+    #[arg(long, value_delimiter = ',', default_value = "512,1024,1920")]
+    pub(crate) cube_size: Vec<u32>,
+    #[command(flatten)]
+    pub(crate) shading: ShadingArgs,
+    /// Folder for the results; by default a new folder `fisheye-COMMAND-N` here.
+    #[arg(long, short)]
+    pub(crate) out: Option<PathBuf>,
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+pub(crate) enum PathArg {
+    Walk,
+    Orbit,
+}
+
+#[derive(Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub(crate) enum Method {
+    Rt,
+    Rq,
+    CubeRt,
+    CubeForward,
+    CubeDeferred,
+    CubeSingle,
+}
+
+impl Method {
+    /// The library's method.
+    pub(crate) fn method(self) -> bench::Method {
+        let raster = |m| bench::Method::Cube(CubeMethod::Raster(m));
+        match self {
+            Self::Rt => bench::Method::Rt,
+            Self::Rq => bench::Method::Rq,
+            Self::CubeRt => bench::Method::Cube(CubeMethod::Traced),
+            Self::CubeForward => raster(RasterMethod::Forward),
+            Self::CubeDeferred => raster(RasterMethod::Deferred),
+            Self::CubeSingle => raster(RasterMethod::SinglePass),
+        }
+    }
+}
+
+#[derive(Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub(crate) enum ArrayFormat {
+    Npy,
+    Exr,
+}
+
+/// Parses `--camera`: `X,Y,Z:LX,LY,LZ` or `path:S`.
+pub(crate) fn parse_camera(text: &str, scene: &Scene) -> Result<fisheye_rt::scene::Camera> {
+    if let Some(s) = text.strip_prefix("path:") {
+        let s: f64 = s
+            .parse()
+            .ok()
+            .filter(|s: &f64| (0.0..=1.0).contains(s))
+            .with_context(|| format!("--camera {text:?}: S must be a number in [0, 1]"))?;
+        if scene.camera_path.is_empty() {
+            bail!("--camera {text:?}: this scene has no camera path");
+        }
+        return Ok(scene.camera_on_path(s));
+    }
+    let triple = |t: &str| -> Option<DVec3> {
+        let v: Vec<f64> = t
+            .split(',')
+            .map(|x| x.trim().parse().ok())
+            .collect::<Option<_>>()?;
+        (v.len() == 3 && v.iter().all(|x| x.is_finite())).then(|| DVec3::new(v[0], v[1], v[2]))
+    };
+    let pose = text
+        .split_once(':')
+        .and_then(|(p, l)| Some((triple(p)?, triple(l)?)))
+        .filter(|(p, l)| p != l)
+        .with_context(|| {
+            format!(
+                "--camera {text:?}: expected X,Y,Z:LX,LY,LZ (two different finite points) or path:S"
+            )
+        })?;
+    Ok(fisheye_rt::scene::Camera {
+        position: pose.0,
+        look_at: pose.1,
+        up: DVec3::Y,
+    })
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+pub(crate) enum Formula {
+    Stable,
+    Thesis,
+}
+
+impl From<Formula> for DirectionFormula {
+    fn from(f: Formula) -> Self {
+        match f {
+            Formula::Stable => DirectionFormula::Stable,
+            Formula::Thesis => DirectionFormula::Thesis,
+        }
+    }
+}
+
+/// A calibration file in place of `--lens` and `--size`.
+#[derive(clap::Args)]
+pub(crate) struct CalibArgs {
+    /// Calibration file (OpenCV YAML/XML, Kalibr camchain YAML or Basalt JSON): render
+    /// through that camera at its resolution, instead of --lens and --size.
+    #[arg(long, conflicts_with_all = ["lens", "size"])]
+    pub(crate) calib: Option<PathBuf>,
+    /// Which camera of a multi-camera calibration file (0 is the first).
+    #[arg(long, default_value_t = 0, requires = "calib")]
+    pub(crate) calib_camera: usize,
+}
+
+impl CalibArgs {
+    /// How reports name the camera of `--calib`: the file, and the camera if not the first.
+    pub(crate) fn describe(&self) -> String {
+        let path = self
+            .calib
+            .as_deref()
+            .map_or(String::new(), |p| p.display().to_string());
+        match self.calib_camera {
+            0 => path,
+            n => format!("{path}#{n}"),
+        }
+    }
+
+    /// The camera of `--calib`, or else `--lens` (required then) at `size`; warns when the
+    /// lens's field of view is clipped where its mapping turns.
+    pub(crate) fn camera(&self, lens: Option<&str>, size: ImageSize) -> Result<LensCamera> {
+        let camera = match &self.calib {
+            Some(path) => {
+                let cameras = calib::read(path)?;
+                let Some(c) = cameras.get(self.calib_camera) else {
+                    bail!(
+                        "{} holds {} camera(s); --calib-camera {} is not one",
+                        path.display(),
+                        cameras.len(),
+                        self.calib_camera
+                    );
+                };
+                LensCamera::new(c.lens, c.size)
+            }
+            None => {
+                let Some(spec) = lens else {
+                    bail!("give a lens: --lens SPEC or --calib FILE");
+                };
+                LensCamera::new(parse_spec(spec)?, size)
+            }
+        };
+        if let Some(turn) = camera.lens.calibrated().and_then(|l| l.turns_at()) {
+            eprintln!(
+                "warning: {}: the mapping stops increasing at θ = {:.2}°, so the field of view \
+                 is clipped to {:.2}° (pixels beyond have no ray)",
+                camera.lens.name(),
+                turn.to_degrees(),
+                2.0 * turn.to_degrees()
+            );
+        }
+        Ok(camera)
+    }
+}
+
+#[derive(clap::Args)]
+pub(crate) struct CameraArgs {
+    /// Lens spec: a model with parameters (`equisolid:f=0.93`, `general:f=1,k1=0.5,k2=0.5`,
+    /// `equidistant:f=0.42,fov=180`, `kb:fx=190,cx=255,cy=255,k1=0.003`), or a preset
+    /// (`samyang-7.5mm`); see `fisheye lens list`. Or give --calib.
+    #[arg(long)]
+    pub(crate) lens: Option<String>,
+    /// Image size in pixels, WIDTHxHEIGHT.
+    #[arg(long, default_value = "1024x768")]
+    pub(crate) size: ImageSize,
+    #[command(flatten)]
+    pub(crate) calib: CalibArgs,
+    /// How directions are built from θ: the stable default, or the thesis's formula.
+    #[arg(long, value_enum, default_value = "stable")]
+    pub(crate) formula: Formula,
+    /// Run the WGSL (f32) lens code on the GPU instead of the f64 reference.
+    #[arg(long)]
+    pub(crate) gpu: bool,
+}
+
+impl CameraArgs {
+    pub(crate) fn camera(&self) -> Result<LensCamera> {
+        let camera = self.calib.camera(self.lens.as_deref(), self.size)?;
+        Ok(camera.with_formula(self.formula.into()))
+    }
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+pub(crate) enum Quality {
+    Fastest,
+    VeryFast,
+    Fast,
+    Medium,
+    Slow,
+}
+
+impl From<Quality> for BvhQuality {
+    fn from(q: Quality) -> Self {
+        match q {
+            Quality::Fastest => BvhQuality::Fastest,
+            Quality::VeryFast => BvhQuality::VeryFast,
+            Quality::Fast => BvhQuality::Fast,
+            Quality::Medium => BvhQuality::Medium,
+            Quality::Slow => BvhQuality::Slow,
+        }
+    }
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+pub(crate) enum Output {
+    Range,
+    Normal,
+    Id,
+    Direction,
+    Mask,
+}
+
+impl From<Output> for Channel {
+    fn from(o: Output) -> Self {
+        match o {
+            Output::Range => Channel::Range,
+            Output::Normal => Channel::Normal,
+            Output::Id => Channel::Id,
+            Output::Direction => Channel::Direction,
+            Output::Mask => Channel::Mask,
+        }
+    }
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+pub(crate) enum Directions {
+    Computed,
+    Table,
+}
+
+impl From<Directions> for DirectionSource {
+    fn from(d: Directions) -> Self {
+        match d {
+            Directions::Computed => DirectionSource::Computed,
+            Directions::Table => DirectionSource::Table,
+        }
+    }
+}
+
+/// A scene from `builtin:NAME`, a scene file or an OBJ file; warnings go to stderr.
+pub(crate) fn load_scene(spec: &str) -> Result<Scene> {
+    let loaded = fisheye_rt::scene::load(spec)?;
+    for warning in &loaded.warnings {
+        eprintln!("warning: {warning}");
+    }
+    Ok(loaded.scene)
+}
+
+/// Calibration file formats, for `lens convert`.
+#[derive(Clone, Copy, ValueEnum)]
+pub(crate) enum Format {
+    OpencvYaml,
+    OpencvXml,
+    Kalibr,
+    Basalt,
+}
+
+impl From<Format> for CalibFormat {
+    fn from(f: Format) -> Self {
+        match f {
+            Format::OpencvYaml => CalibFormat::OpenCvYaml,
+            Format::OpencvXml => CalibFormat::OpenCvXml,
+            Format::Kalibr => CalibFormat::Kalibr,
+            Format::Basalt => CalibFormat::Basalt,
+        }
+    }
+}

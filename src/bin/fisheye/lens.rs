@@ -1,0 +1,274 @@
+//! `fisheye lens ...`: list, project, unproject, fit, convert and draw lens models.
+
+use std::io::{BufRead, Write};
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use anyhow::{Context, Result, bail};
+use clap::Subcommand;
+use fisheye_rt::demo::LensDemo;
+use fisheye_rt::gpu::{GpuContext, Queries};
+use fisheye_rt::lens::calib::{self, CalibFormat, Calibration};
+use fisheye_rt::lens::gpu::{DirectionSource, LensPoints};
+use fisheye_rt::lens::{
+    CalibratedModel, ImageSize, LensCamera, LensModel, PRESET_FOV_DEGREES, PRESETS, parse_spec,
+};
+use fisheye_rt::report;
+use fisheye_rt::trace::save_png;
+use glam::{DVec2, DVec3};
+
+use crate::args::{CameraArgs, Format};
+
+#[derive(Subcommand)]
+pub(crate) enum LensCommand {
+    /// List the lens models and the presets.
+    List,
+    /// Read `px py` lines on stdin (continuous pixel coordinates, origin at the top-left
+    /// corner of the image) and write the unit direction `dx dy dz` (x right, y down, z
+    /// forward) or `none` for each.
+    Unproject(CameraArgs),
+    /// Read `dx dy dz` lines on stdin and write the pixel `px py` each lands on, or `none`.
+    Project(CameraArgs),
+    /// Fit the thesis's classic mappings (equidistant, equisolid, orthographic,
+    /// stereographic) to a calibrated lens over the angles its image shows, and print each
+    /// one's focal length and radial residual in pixels, best first.
+    Fit(CameraArgs),
+    /// Write a lens (--lens SPEC at --size, or --calib FILE) as a calibration file: OpenCV
+    /// YAML or XML, a Kalibr camchain or Basalt JSON.
+    Convert {
+        #[command(flatten)]
+        camera: CameraArgs,
+        /// The output format.
+        #[arg(long, value_enum)]
+        format: Format,
+        /// The file to write.
+        #[arg(long, short)]
+        out: PathBuf,
+    },
+    /// Draw what lenses do to the sphere of directions (10° grid, rings every 30° off the
+    /// axis), one PNG per lens.
+    Demo {
+        /// Lens specs to draw (repeatable); by default one of each model and every preset.
+        #[arg(long)]
+        lens: Vec<String>,
+        /// Image size in pixels, WIDTHxHEIGHT.
+        #[arg(long, default_value = "1024x768")]
+        size: ImageSize,
+        /// Folder to write the PNGs into.
+        #[arg(long, short, default_value = "fisheye-demo")]
+        out: PathBuf,
+    },
+}
+
+pub(crate) fn list() {
+    println!("models (spec: NAME:f=F[,fov=DEGREES]; general also takes k1, k2):");
+    let general = LensModel::General { k1: 1.0, k2: 1.0 };
+    for model in [
+        LensModel::Rectilinear,
+        LensModel::Stereographic,
+        LensModel::Equidistant,
+        LensModel::Equisolid,
+        LensModel::Orthographic,
+        general,
+    ] {
+        println!("  {:<14} {}", model.name(), model.formula());
+    }
+    println!(
+        "\ncalibrated models (spec: NAME:fx=FX,fy=FY,cx=CX,cy=CY,...[,fov=DEGREES], pixels, \
+         OpenCV's centre convention):"
+    );
+    for ((name, keys), example) in CalibratedModel::NAMES.iter().zip(CalibratedModel::EXAMPLES) {
+        println!("  {name:<14} {keys}\n  {:<14} e.g. {example}", "");
+    }
+    println!("\npresets (limited to {PRESET_FOV_DEGREES}°; spec: NAME[:f=F,fov=DEGREES]):");
+    for p in PRESETS {
+        println!(
+            "  {:<24} {:<13} f={:<6} {}",
+            p.name,
+            p.model.name(),
+            p.f,
+            p.description
+        );
+    }
+}
+
+/// Parses stdin: one point per non-empty line, `N` numbers each; `#` starts a comment.
+pub(crate) fn read_points<const N: usize>() -> Result<Vec<[f64; N]>> {
+    let mut points = Vec::new();
+    for (number, line) in std::io::stdin().lock().lines().enumerate() {
+        let line = line.context("reading stdin")?;
+        let text = line.split('#').next().unwrap_or("").trim();
+        if text.is_empty() {
+            continue;
+        }
+        let values: Vec<f64> = text
+            .split_whitespace()
+            .map(str::parse)
+            .collect::<Result<_, _>>()
+            .with_context(|| format!("stdin line {}: {text:?} is not numbers", number + 1))?;
+        let Ok(point) = <[f64; N]>::try_from(values) else {
+            bail!(
+                "stdin line {}: expected {N} numbers, got {text:?}",
+                number + 1
+            );
+        };
+        points.push(point);
+    }
+    Ok(points)
+}
+
+pub(crate) fn write_lines(lines: impl Iterator<Item = String>) -> Result<()> {
+    let mut out = std::io::BufWriter::new(std::io::stdout().lock());
+    for line in lines {
+        writeln!(out, "{line}")?;
+    }
+    Ok(out.flush()?)
+}
+
+pub(crate) fn unproject(args: &CameraArgs) -> Result<()> {
+    let camera = args.camera()?;
+    let pixels: Vec<DVec2> = read_points::<2>()?.into_iter().map(DVec2::from).collect();
+    let dirs: Vec<Option<DVec3>> = if args.gpu {
+        let ctx = GpuContext::new()?;
+        LensPoints::new(&ctx, &camera)?
+            .unproject(&ctx, &pixels)?
+            .into_iter()
+            .map(|d| d.map(|d| d.as_dvec3()))
+            .collect()
+    } else {
+        pixels.iter().map(|&p| camera.unproject(p)).collect()
+    };
+    write_lines(dirs.into_iter().map(|d| match d {
+        Some(d) => format!("{:.9} {:.9} {:.9}", d.x, d.y, d.z),
+        None => "none".into(),
+    }))
+}
+
+pub(crate) fn project(args: &CameraArgs) -> Result<()> {
+    let camera = args.camera()?;
+    let dirs: Vec<DVec3> = read_points::<3>()?.into_iter().map(DVec3::from).collect();
+    let pixels: Vec<Option<DVec2>> = if args.gpu {
+        let ctx = GpuContext::new()?;
+        LensPoints::new(&ctx, &camera)?
+            .project(&ctx, &dirs)?
+            .into_iter()
+            .map(|p| p.map(|p| p.as_dvec2()))
+            .collect()
+    } else {
+        dirs.iter().map(|&d| camera.project(d)).collect()
+    };
+    write_lines(pixels.into_iter().map(|p| match p {
+        Some(p) => format!("{:.6} {:.6}", p.x, p.y),
+        None => "none".into(),
+    }))
+}
+
+pub(crate) fn fit(args: &CameraArgs) -> Result<()> {
+    let camera = args.camera()?;
+    let Some(lens) = camera.lens.calibrated() else {
+        bail!(
+            "{} is already a classic lens; fit takes a calibrated one",
+            camera.lens
+        );
+    };
+    let angles = fisheye_rt::lens::fit::fitted_angles(lens, camera.size);
+    let widest = angles.last().copied().unwrap_or(0.0).to_degrees();
+    println!(
+        "{} at {}: classic mappings fitted over θ ≤ {widest:.1}° (a {:.1}° field)",
+        lens.model().name(),
+        camera.size,
+        2.0 * widest
+    );
+    println!(
+        "{:<14} {:>10} {:>10} {:>12} {:>12}",
+        "model", "f (px)", "f (norm.)", "rms (px)", "max (px)"
+    );
+    for f in fisheye_rt::lens::fit::fit_classic(lens, camera.size) {
+        println!(
+            "{:<14} {:>10.3} {:>10.4} {:>12.4} {:>12.4}",
+            f.model.name(),
+            f.f_pixels,
+            f.f_pixels * 2.0 / f64::from(camera.size.width),
+            f.rms,
+            f.max
+        );
+    }
+    Ok(())
+}
+
+pub(crate) fn convert(args: &CameraArgs, format: CalibFormat, out: &Path) -> Result<()> {
+    let camera = args.camera()?;
+    let Some(lens) = camera.lens.calibrated() else {
+        bail!(
+            "{} is a classic lens; calibration files hold calibrated models (see `fisheye lens \
+             list`)",
+            camera.lens
+        );
+    };
+    let text = calib::write(
+        &Calibration {
+            lens: *lens,
+            size: camera.size,
+        },
+        format,
+    )?;
+    std::fs::write(out, text).with_context(|| format!("writing {}", out.display()))?;
+    println!("wrote {} ({})", out.display(), format.name());
+    Ok(())
+}
+
+/// One representative lens per model, then every preset.
+pub(crate) fn default_demo_lenses() -> Vec<String> {
+    let mut specs: Vec<String> = [
+        "rectilinear:f=0.5",
+        "stereographic:f=0.35",
+        "equidistant:f=0.3",
+        "equisolid:f=0.45",
+        "orthographic:f=0.66",
+        "general:f=0.4,k1=0.7,k2=0.7",
+    ]
+    .map(String::from)
+    .to_vec();
+    specs.extend(PRESETS.iter().map(|p| p.name.to_string()));
+    specs
+}
+
+pub(crate) fn demo(lenses: Vec<String>, size: ImageSize, out: PathBuf) -> Result<()> {
+    let lenses = if lenses.is_empty() {
+        default_demo_lenses()
+    } else {
+        lenses
+    };
+    // Check every spec before starting the GPU.
+    let cameras = lenses
+        .iter()
+        .map(|spec| Ok((spec, LensCamera::new(parse_spec(spec)?, size))))
+        .collect::<Result<Vec<_>>>()?;
+    let ctx = GpuContext::new()?;
+    println!("adapter: {}", ctx.adapter_name());
+    let queries = Queries::new(&ctx, 1);
+    for (spec, camera) in cameras {
+        let started = Instant::now();
+        let demo = LensDemo::new(&ctx, &camera, DirectionSource::Computed)?;
+        let mut encoder = ctx.device.create_command_encoder(&Default::default());
+        demo.encode(&mut encoder, queries.as_ref().map(|q| q.writes(0)));
+        if let Some(q) = &queries {
+            q.resolve(&mut encoder);
+        }
+        ctx.queue.submit([encoder.finish()]);
+        let gpu_ms = match &queries {
+            Some(q) => format!("{:.2} ms on the GPU", q.read_ns(&ctx)?[0] * 1e-6),
+            None => "no timestamps".into(),
+        };
+        let image = demo.render(&ctx)?;
+        let path = out.join(format!("{}.png", report::file_stem(spec)));
+        save_png(&image, &path)?;
+        println!(
+            "{:<36} -> {} ({gpu_ms}, {:.0} ms in all)",
+            camera.lens.to_string(),
+            path.display(),
+            started.elapsed().as_secs_f64() * 1e3
+        );
+    }
+    Ok(())
+}

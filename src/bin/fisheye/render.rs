@@ -1,0 +1,191 @@
+//! `fisheye render`: one image, and its ground truth, through a lens.
+
+use std::path::PathBuf;
+use std::time::Instant;
+
+use anyhow::{Result, bail};
+use fisheye_rt::bench::{Renderer, SceneSet, Setup};
+use fisheye_rt::cube::{CubeMap, FACES, bordered};
+use fisheye_rt::gpu::GpuContext;
+use fisheye_rt::lens::ImageSize;
+use fisheye_rt::lens::gpu::DirectionSource;
+use fisheye_rt::trace::{Channel, RenderOptions, save_png, world_directions};
+
+use crate::args::{
+    ArrayFormat, CalibArgs, Directions, Method, Output, ShadingArgs, load_scene, parse_camera,
+};
+
+#[derive(clap::Args)]
+pub(crate) struct RenderArgs {
+    /// The scene: `builtin:NAME` (see `fisheye scenes`), a scene file (`.toml`, see
+    /// `scenes/`), or an OBJ file, framed from the front with a headlight and a sun.
+    #[arg(default_value = "builtin:default")]
+    pub(crate) scene: String,
+    /// Lens spec (see `fisheye lens list`).
+    #[arg(long, default_value = "canon-8-15mm@8mm")]
+    pub(crate) lens: String,
+    /// Image size in pixels, WIDTHxHEIGHT.
+    #[arg(long, default_value = "1024x768")]
+    pub(crate) size: ImageSize,
+    #[command(flatten)]
+    pub(crate) calib: CalibArgs,
+    /// Camera pose instead of the scene's: `X,Y,Z:LX,LY,LZ` (eye and look-at point, y up),
+    /// or `path:S` for the point S ∈ [0, 1] along the scene file's camera path.
+    #[arg(long)]
+    pub(crate) camera: Option<String>,
+    /// How to make the image: `rt` traces the lens's rays directly, `rq` does too with the
+    /// adapter's hardware ray queries in place of the software BVH traversal (same lens and
+    /// shading code; an error where the adapter lacks them); the `cube-*` methods render
+    /// the faces of a cube map (those the lens reaches, and of them only the parts it reaches)
+    /// and resample it: `cube-rt` traces them; `cube-forward` (a render pass per face),
+    /// `cube-deferred` (G-buffer, then lighting in a compute pass) and `cube-single` (one
+    /// multiview pass) rasterize them, with shadow maps and no reflection or refraction.
+    #[arg(long, value_enum, default_value = "rt")]
+    pub(crate) method: Method,
+    /// Face size of the cube map in texels (`cube-*` methods).
+    #[arg(long, default_value_t = 1024)]
+    pub(crate) cube_size: u32,
+    #[command(flatten)]
+    pub(crate) shading: ShadingArgs,
+    /// Primary ray directions: evaluated per pixel, or read from a table made once.
+    #[arg(long, value_enum, default_value = "computed")]
+    pub(crate) directions: Directions,
+    /// The colour image (PNG; alpha is the validity mask).
+    #[arg(long, short, default_value = "fisheye.png")]
+    pub(crate) out: PathBuf,
+    /// Ground-truth arrays to write beside the image as OUT_STEM.NAME.npy (or .exr): range
+    /// (distance to the primary hit), normal, id (triangle), direction (world-space ray), mask.
+    #[arg(long, value_enum, value_delimiter = ',')]
+    pub(crate) outputs: Vec<Output>,
+    /// File format of the ground-truth arrays.
+    #[arg(long, value_enum, default_value = "npy")]
+    pub(crate) format: ArrayFormat,
+}
+
+pub(crate) fn render(args: &RenderArgs) -> Result<()> {
+    let started = Instant::now();
+    let setup = Setup {
+        method: args.method.method(),
+        cube_size: args.cube_size,
+    };
+    let directions = DirectionSource::from(args.directions);
+    if setup.method.cube().is_some() && directions == DirectionSource::Table {
+        bail!("--directions table applies to direct tracing (--method rt or rq)");
+    }
+    let options = RenderOptions {
+        max_depth: args.shading.max_depth,
+        bvh: args.shading.bvh.into(),
+        directions,
+        traversal: setup.method.traversal(),
+    };
+    if !args.outputs.is_empty() && setup.method.cube().is_some() {
+        bail!("--outputs come from direct tracing; use --method rt or rq for ground-truth arrays");
+    }
+    let camera = args.calib.camera(Some(&args.lens), args.size)?;
+    let out = &args.out;
+    let scene_spec = &args.scene;
+    let mut scene = load_scene(scene_spec)?;
+    if let Some(text) = &args.camera {
+        scene.camera = parse_camera(text, &scene)?;
+    }
+    let ctx = GpuContext::new()?;
+    println!("adapter: {}", ctx.adapter_name());
+    let scenes = SceneSet::new(&ctx, &scene, &options, &[setup])?;
+    let gpu_scene = scenes.for_method(setup.method);
+    println!(
+        "scene: {scene_spec}, {} triangles; BVH ({}) {} nodes, depth {}, built in {:.1} ms",
+        scene.len(),
+        options.bvh.name(),
+        gpu_scene.bvh_nodes,
+        gpu_scene.bvh_depth,
+        gpu_scene.bvh_build_time.as_secs_f64() * 1e3
+    );
+    if let Some(rq) = &gpu_scene.ray_query {
+        println!(
+            "ray queries: acceleration structure built by the driver in {:.1} ms",
+            rq.build_time.as_secs_f64() * 1e3
+        );
+    }
+    println!(
+        "lens: {} at {}; compiling the kernels...",
+        camera.lens, camera.size
+    );
+    let renderer = Renderer::with_directions(
+        &ctx,
+        &camera,
+        &scenes,
+        setup,
+        args.shading.shadow_size,
+        options.directions,
+    )?;
+    if let Some(cube) = renderer.cube() {
+        describe_cube(cube, setup, scene.lights.len());
+    }
+    let time = renderer.frame(&ctx, &scenes, &scene.camera)?;
+    let output = renderer.output(&ctx)?;
+    let (rays, hits) = output.counts();
+    let what = match renderer.cube() {
+        Some(_) => format!("{} (faces and resampling)", setup.label()),
+        None => format!("trace: {rays} primary rays ({hits} hit)"),
+    };
+    match time.gpu_ms() {
+        Some(ms) => println!(
+            "{what}, {ms:.1} ms on the GPU (one frame: some drivers compile kernels in it), {:.2} M pixels/s",
+            rays as f64 / ms * 1e-3
+        ),
+        None => println!("{what}; no GPU timestamps on this adapter"),
+    }
+    save_png(&output.to_image(), out)?;
+    if !args.outputs.is_empty() {
+        let directions = world_directions(&camera, &scene.camera);
+        for channel in args.outputs.iter().map(|&o| Channel::from(o)) {
+            let path = match args.format {
+                ArrayFormat::Npy => {
+                    let path = out.with_extension(format!("{}.npy", channel.name()));
+                    output.write_npy(channel, &directions, &path)?;
+                    path
+                }
+                ArrayFormat::Exr => {
+                    let path = out.with_extension(format!("{}.exr", channel.name()));
+                    output.write_exr(channel, &directions, &path)?;
+                    path
+                }
+            };
+            println!("wrote {}", path.display());
+        }
+    }
+    println!(
+        "wrote {} ({:.1} s in all)",
+        out.display(),
+        started.elapsed().as_secs_f64()
+    );
+    Ok(())
+}
+
+/// Which faces of the cube are rendered, how much of them, and the shadow maps.
+fn describe_cube(cube: &CubeMap, setup: Setup, lights: usize) {
+    let regions = cube.regions();
+    let faces: Vec<&str> = FACES
+        .iter()
+        .zip(regions)
+        .filter_map(|(f, r)| r.map(|_| f.name))
+        .collect();
+    let rendered: u64 = regions.iter().flatten().map(|r| r.texels()).sum();
+    let side = u64::from(bordered(setup.cube_size));
+    println!(
+        "cube map ({}): {} faces of {}² texels ({}); rendered {:.0}% of their texels (the parts \
+         the lens reaches), then resampled",
+        setup.method.name(),
+        faces.len(),
+        setup.cube_size,
+        faces.join(" "),
+        100.0 * rendered as f64 / (faces.len() as u64 * side * side) as f64
+    );
+    if let Some(maps) = cube.shadow_maps() {
+        println!(
+            "shadow maps: {} layers of {}² for {lights} lights",
+            maps.views().len(),
+            maps.size(),
+        );
+    }
+}

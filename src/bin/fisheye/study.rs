@@ -1,0 +1,223 @@
+//! `fisheye bench` and `fisheye compare`: every method measured, into a report folder.
+
+use std::path::PathBuf;
+
+use anyhow::{Context, Result, bail};
+use fisheye_rt::bench::{self, PathKind, SceneSet, Setup};
+use fisheye_rt::gpu::GpuContext;
+use fisheye_rt::lens::{LensCamera, parse_spec};
+use fisheye_rt::report::{self, LensRun, Progress, Study};
+use fisheye_rt::scene::Scene;
+use fisheye_rt::trace::RenderOptions;
+
+use crate::args::{PathArg, StudyArgs, load_scene, parse_camera};
+
+#[derive(clap::Args)]
+pub(crate) struct BenchArgs {
+    #[command(flatten)]
+    pub(crate) study: StudyArgs,
+    /// Timed frames per setup along the path.
+    #[arg(long, default_value_t = 60)]
+    pub(crate) frames: usize,
+    /// Untimed frames first, per setup.
+    #[arg(long, default_value_t = 3)]
+    pub(crate) warmup: usize,
+    /// Camera path: `walk` (the scene's keyframes; every built-in scene but `grid` has them)
+    /// or `orbit` (a circle around the camera's look-at point, for open scenes). Default:
+    /// walk where the scene has keyframes.
+    #[arg(long, value_enum)]
+    pub(crate) path: Option<PathArg>,
+}
+
+#[derive(clap::Args)]
+pub(crate) struct CompareArgs {
+    #[command(flatten)]
+    pub(crate) study: StudyArgs,
+    /// Timed frames per setup at the pose (the median is reported), after one untimed.
+    #[arg(long, default_value_t = 5)]
+    pub(crate) frames: usize,
+    /// Rays per pixel side of the supersampled reference (1 to 8); by default the most, up to
+    /// 4, whose image fits one storage binding.
+    #[arg(long)]
+    pub(crate) supersample: Option<u32>,
+}
+
+/// What `bench` and `compare` set up from their shared arguments.
+pub(crate) struct Prepared {
+    pub(crate) ctx: GpuContext,
+    pub(crate) scene: Scene,
+    pub(crate) scenes: SceneSet,
+    pub(crate) lenses: Vec<LensRun>,
+    pub(crate) setups: Vec<Setup>,
+    pub(crate) out: PathBuf,
+}
+
+impl Prepared {
+    pub(crate) fn study(&self, args: &StudyArgs) -> Study<'_> {
+        Study {
+            ctx: &self.ctx,
+            scene: &self.scene,
+            scene_name: args.scene.clone(),
+            scenes: &self.scenes,
+            lenses: &self.lenses,
+            setups: &self.setups,
+            shadow_size: args.shading.shadow_size,
+        }
+    }
+}
+
+/// Checks the arguments, loads the scene, makes the output folder and uploads the scene.
+pub(crate) fn prepare(args: &StudyArgs, command: &str) -> Result<Prepared> {
+    let mut lenses = match &args.calib.calib {
+        Some(_) => vec![LensRun {
+            name: args.calib.describe(),
+            camera: args.calib.camera(None, args.size)?,
+        }],
+        None => args
+            .lens
+            .iter()
+            .map(|spec| {
+                Ok(LensRun {
+                    name: spec.clone(),
+                    camera: LensCamera::new(parse_spec(spec)?, args.size),
+                })
+            })
+            .collect::<Result<Vec<_>>>()?,
+    };
+    // The calibration's resolution, or --size.
+    let size = lenses.first().map_or(args.size, |l| l.camera.size);
+    if !args.no_pinhole {
+        lenses.push(LensRun {
+            name: args.pinhole.clone(),
+            camera: LensCamera::new(parse_spec(&args.pinhole)?, size),
+        });
+    }
+    if let Some(&bad) = args.cube_size.iter().find(|&&s| s == 0) {
+        bail!("--cube-size {bad}: face sizes must be at least 1");
+    }
+    let methods: Vec<bench::Method> = if args.method.is_empty() {
+        bench::Method::ALL.to_vec()
+    } else {
+        args.method.iter().map(|m| m.method()).collect()
+    };
+    let setups = Setup::all(&methods, &args.cube_size);
+    let mut scene = load_scene(&args.scene)?;
+    if let Some(text) = &args.camera {
+        scene.camera = parse_camera(text, &scene)?;
+    }
+    let out = out_folder(args.out.as_deref(), command)?;
+    let ctx = GpuContext::new()?;
+    println!("adapter: {}", ctx.adapter_name());
+    let options = RenderOptions {
+        max_depth: args.shading.max_depth,
+        bvh: args.shading.bvh.into(),
+        ..RenderOptions::default()
+    };
+    let scenes = SceneSet::new(&ctx, &scene, &options, &setups)?;
+    println!(
+        "scene: {}, {} triangles; {} setups on {} lenses at {}",
+        args.scene,
+        scene.len(),
+        setups.len(),
+        lenses.len(),
+        size
+    );
+    Ok(Prepared {
+        ctx,
+        scene,
+        scenes,
+        lenses,
+        setups,
+        out,
+    })
+}
+
+/// `out`, or else a new folder `fisheye-COMMAND-N` here; created.
+pub(crate) fn out_folder(out: Option<&std::path::Path>, command: &str) -> Result<PathBuf> {
+    let out = match out {
+        Some(out) => out.to_path_buf(),
+        None => (1..)
+            .map(|n| PathBuf::from(format!("fisheye-{command}-{n}")))
+            .find(|p| !p.exists())
+            .expect("a free folder name"),
+    };
+    std::fs::create_dir_all(&out).with_context(|| format!("creating {}", out.display()))?;
+    Ok(out)
+}
+
+/// A progress bar on stderr when it is a terminal, else a line per new setup.
+pub(crate) fn progress_bar() -> impl FnMut(Progress<'_>) {
+    use std::io::IsTerminal;
+    let terminal = std::io::stderr().is_terminal();
+    let mut last = String::new();
+    move |p: Progress<'_>| {
+        if terminal {
+            let width = 30;
+            let filled = (width * p.done / p.total.max(1)).min(width);
+            eprint!(
+                "\r[{}{}] {:>5}/{} frames  {:<40}",
+                "#".repeat(filled),
+                ".".repeat(width - filled),
+                p.done,
+                p.total,
+                p.what
+            );
+            if p.done == p.total {
+                eprintln!();
+            }
+        } else if p.what != last {
+            eprintln!("[{}/{} frames] {}", p.done, p.total, p.what);
+        }
+        last = p.what.to_string();
+    }
+}
+
+/// Prints the table lines of a report's Markdown and where the files went.
+pub(crate) fn finish(markdown: &str, out: &std::path::Path, plot_warning: Option<String>) {
+    println!();
+    for line in markdown.lines().filter(|l| !l.starts_with('#')) {
+        println!("{line}");
+    }
+    if let Some(why) = plot_warning {
+        eprintln!("warning: no plots: {why}");
+    }
+    println!("\nwrote {}", out.display());
+}
+
+pub(crate) fn run_bench(args: &BenchArgs) -> Result<()> {
+    let p = prepare(&args.study, "bench")?;
+    let path = match args.path {
+        Some(PathArg::Walk) => PathKind::Walk,
+        Some(PathArg::Orbit) => PathKind::Orbit,
+        None if p.scene.camera_path.is_empty() => PathKind::Orbit,
+        None => PathKind::Walk,
+    };
+    let study = p.study(&args.study);
+    let report = report::bench(&study, path, args.frames, args.warmup, &mut progress_bar())?;
+    let warning = report.write(&p.out)?;
+    finish(&report.markdown(), &p.out, warning);
+    Ok(())
+}
+
+pub(crate) fn run_compare(args: &CompareArgs) -> Result<()> {
+    if let Some(s) = args.supersample.filter(|s| !(1..=8).contains(s)) {
+        bail!("--supersample {s}: must be 1 to 8");
+    }
+    let p = prepare(&args.study, "compare")?;
+    let supersample = args.supersample.unwrap_or_else(|| {
+        fisheye_rt::compare::supersample_factor(&p.ctx, p.lenses[0].camera.size)
+    });
+    let study = p.study(&args.study);
+    let pose = p.scene.camera;
+    let report = report::compare(
+        &study,
+        &pose,
+        args.frames,
+        supersample,
+        &p.out,
+        &mut progress_bar(),
+    )?;
+    let warning = report.write(&p.out)?;
+    finish(&report.markdown(), &p.out, warning);
+    Ok(())
+}
