@@ -161,7 +161,7 @@ impl SceneBvh {
             .collect();
         let depth = node_depth(&cwbvh.nodes, 0);
         if depth > TRAVERSAL_STACK {
-            return Err(Error::Scene(format!(
+            return Err(Error::Limit(format!(
                 "the BVH is {depth} levels deep; the GPU traversal stack holds {TRAVERSAL_STACK}"
             )));
         }

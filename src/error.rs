@@ -150,6 +150,11 @@ pub enum Error {
         /// What went wrong, with the line and key where the parser knows them.
         message: String,
     },
+    /// Something is larger than the adapter or the kernels allow (a storage binding, a
+    /// texture, the traversal stack, the bounce depth, an acceleration structure), with the
+    /// numbers.
+    #[error("{0}")]
+    Limit(String),
     /// The device's limits are below what the kernels need.
     #[error(
         "the device's limits are too low: {0}; create it with at least \

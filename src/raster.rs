@@ -150,13 +150,13 @@ impl ShadowMaps {
     pub fn new(ctx: &GpuContext, scene: &GpuScene, size: u32) -> Result<Self> {
         let limits = ctx.device.limits();
         if size == 0 || size > limits.max_texture_dimension_2d {
-            return Err(Error::Scene(format!(
+            return Err(Error::Limit(format!(
                 "shadow map size {size}: must be between 1 and the adapter's limit of {}",
                 limits.max_texture_dimension_2d
             )));
         }
         if scene.shadow_layers > limits.max_texture_array_layers {
-            return Err(Error::Scene(format!(
+            return Err(Error::Limit(format!(
                 "{} lights need {} shadow-map layers (6 per point light, 1 per sun); the \
                  adapter allows {}",
                 scene.lights.len(),

@@ -213,7 +213,7 @@ impl CubeMap {
         let size = settings.size;
         let max = ctx.device.limits().max_texture_dimension_2d;
         if size == 0 || bordered(size) > max {
-            return Err(Error::Scene(format!(
+            return Err(Error::Limit(format!(
                 "cube face size {size}: must be between 1 and {} (the adapter's limit of {max}, \
                  less the two-texel border)",
                 max - 2

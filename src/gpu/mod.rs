@@ -585,15 +585,12 @@ impl GpuContext {
     pub fn check_binding(&self, what: &str, bytes: u64) -> Result<()> {
         let limit = self.device.limits().max_storage_buffer_binding_size;
         if bytes > limit {
-            return Err(Error::Gpu {
-                during: what.to_string(),
-                message: format!(
-                    "needs a storage buffer of {:.2} MiB, above this adapter's limit of {:.2} \
-                     MiB per binding; use a smaller image",
-                    bytes as f64 / f64::from(1 << 20),
-                    limit as f64 / f64::from(1 << 20)
-                ),
-            });
+            return Err(Error::Limit(format!(
+                "{what} needs a storage buffer of {:.2} MiB, above this adapter's limit of \
+                 {:.2} MiB per binding; use a smaller image",
+                bytes as f64 / f64::from(1 << 20),
+                limit as f64 / f64::from(1 << 20)
+            )));
         }
         Ok(())
     }

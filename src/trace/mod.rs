@@ -143,7 +143,7 @@ fn check_scene_size(ctx: &GpuContext, scene: &Scene, features: Features) -> Resu
     ];
     for (what, each) in per_triangle {
         if each * triangles > limit {
-            return Err(Error::Scene(format!(
+            return Err(Error::Limit(format!(
                 "{triangles} triangles are too many for this adapter: their {what} takes \
                  {:.1} MiB ({each} bytes a triangle), above its limit of {:.0} MiB per storage \
                  binding; at most {} triangles fit",
@@ -160,7 +160,7 @@ fn check_scene_size(ctx: &GpuContext, scene: &Scene, features: Features) -> Resu
         .map(|t| 4 * u64::from(t.width) * u64::from(t.height))
         .sum();
     if texels > limit {
-        return Err(Error::Scene(format!(
+        return Err(Error::Limit(format!(
             "the scene's {} textures take {:.1} MiB, above this adapter's limit of {:.0} MiB \
              per storage binding; use smaller textures",
             scene.textures.len(),
@@ -264,7 +264,7 @@ impl GpuScene {
     /// Builds the BVH and uploads everything, relative to the scene camera's position.
     pub fn new(ctx: &GpuContext, scene: &Scene, options: &RenderOptions) -> Result<Self> {
         if options.max_depth > MAX_DEPTH_LIMIT {
-            return Err(Error::Scene(format!(
+            return Err(Error::Limit(format!(
                 "max depth {} is above the limit of {MAX_DEPTH_LIMIT}",
                 options.max_depth
             )));

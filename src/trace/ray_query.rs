@@ -24,14 +24,14 @@ impl RayQueryScene {
     pub(crate) fn check(ctx: &GpuContext, triangles: u64) -> Result<()> {
         if !ctx.has(wgpu::Features::EXPERIMENTAL_RAY_QUERY) {
             return Err(Error::MissingFeature {
-                what: "ray-query traversal (--method rq)",
+                what: "ray-query traversal",
                 feature: "EXPERIMENTAL_RAY_QUERY",
                 adapter: ctx.adapter_info().name,
             });
         }
         let limit = ctx.device.limits().max_blas_primitive_count;
         if triangles > u64::from(limit) {
-            return Err(Error::Scene(format!(
+            return Err(Error::Limit(format!(
                 "{triangles} triangles: this adapter's acceleration structures hold at most \
                  {limit} per bottom level"
             )));
