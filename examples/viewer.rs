@@ -2,13 +2,14 @@
 //! and winit: the window's device renders each frame into a texture the viewer then draws.
 //!
 //! ```sh
-//! cargo run --release --example viewer -- [SCENE] [--lens SPEC] [--method NAME] [--size WxH]
+//! cargo run --release --example viewer -- [SCENE] [--lens SPEC] [--method NAME] [--spp N]
+//!     [--size WxH]
 //! ```
 //!
 //! Keys: W A S D (or the arrows) move, Q and E go down and up, dragging with the left button
 //! looks around; L switches lens, M switches method (rt, rq, cube-rt, cube-forward,
-//! cube-deferred, cube-single: those the adapter has), R goes back to the scene's camera, Esc
-//! quits. The title shows the lens, the method and the frame time. For tests:
+//! cube-deferred, cube-single: those the adapter has), P switches the rays per pixel of the
+//! traced methods (1, 4, 16), R goes back to the scene's camera, Esc quits. The title shows the lens, the method and the frame time. For tests:
 //! `--frames N --screenshot FILE` renders N frames from the scene's camera, saves the window's
 //! last frame as a PNG and exits.
 
@@ -41,6 +42,9 @@ const LENSES: [&str; 5] = [
     "rectilinear:f=1",
 ];
 
+/// The rays per pixel P cycles through.
+const SPP: [u32; 3] = [1, 4, 16];
+
 /// The methods M cycles through.
 #[derive(Clone, Copy, PartialEq)]
 enum Method {
@@ -72,6 +76,7 @@ struct Args {
     scene: String,
     lenses: Vec<String>,
     method: usize,
+    spp: usize,
     size: PhysicalSize<u32>,
     frames: Option<u32>,
     screenshot: Option<PathBuf>,
@@ -82,6 +87,7 @@ fn args() -> Result<Args, String> {
         scene: "builtin:default".into(),
         lenses: LENSES.iter().map(|s| s.to_string()).collect(),
         method: 0,
+        spp: 0,
         size: PhysicalSize::new(960, 720),
         frames: None,
         screenshot: None,
@@ -97,6 +103,13 @@ fn args() -> Result<Args, String> {
                     .iter()
                     .position(|m| m.name() == name)
                     .ok_or(format!("unknown method {name:?}"))?;
+            }
+            "--spp" => {
+                let text = value("--spp")?;
+                out.spp = SPP
+                    .iter()
+                    .position(|s| s.to_string() == text)
+                    .ok_or(format!("--spp {text}: one of {SPP:?}"))?;
             }
             "--size" => {
                 let size: ImageSize = value("--size")?
@@ -128,6 +141,7 @@ struct State {
     pose: Camera,
     lens: usize,
     method: usize,
+    spp: usize,
     keys: HashSet<KeyCode>,
     dragging: bool,
     last_frame: Instant,
@@ -189,6 +203,7 @@ impl State {
             pose,
             lens: 0,
             method: 0,
+            spp: 0,
             keys: HashSet::new(),
             dragging: false,
             last_frame: Instant::now(),
@@ -236,6 +251,7 @@ impl State {
             } else {
                 Traversal::Software
             },
+            spp: SPP[self.spp],
             ..RenderOptions::default()
         };
         let (device, queue) = (&self.ctx.device, &self.ctx.queue);
@@ -395,10 +411,14 @@ impl State {
         };
         self.ctx.queue.present(surface);
         self.window.set_title(&format!(
-            "fisheye-rt: {} triangles through {}, {} ({:.1} ms a frame)",
+            "fisheye-rt: {} triangles through {}, {}{} ({:.1} ms a frame)",
             self.scene.len(),
             view.lens,
             METHODS[self.method].name(),
+            match METHODS[self.method] {
+                Method::Cube(_) => String::new(),
+                _ => format!(" at {} rays a pixel", SPP[self.spp]),
+            },
             self.frame_ms
         ));
         self.frames += 1;
@@ -468,6 +488,7 @@ impl ApplicationHandler for App {
         match State::new(window, scene) {
             Ok(mut state) => {
                 state.method = self.args.method;
+                state.spp = self.args.spp;
                 state.window.request_redraw();
                 self.state = Some(state);
             }
@@ -510,6 +531,10 @@ impl ApplicationHandler for App {
                     }
                     KeyCode::KeyM => {
                         state.method = (state.method + 1) % METHODS.len();
+                        state.view = None;
+                    }
+                    KeyCode::KeyP => {
+                        state.spp = (state.spp + 1) % SPP.len();
                         state.view = None;
                     }
                     KeyCode::KeyR => state.pose = state.scene.camera,

@@ -178,24 +178,19 @@ impl Renderer {
         setup: Setup,
         shadow_size: u32,
     ) -> Result<Self> {
-        Self::with_directions(
-            ctx,
-            camera,
-            scenes,
-            setup,
-            shadow_size,
-            DirectionSource::Computed,
-        )
+        let rays = (DirectionSource::Computed, 1);
+        Self::with_rays(ctx, camera, scenes, setup, shadow_size, rays)
     }
 
-    /// As [`Renderer::new`], with direct tracing's primary rays from `directions`.
-    pub fn with_directions(
+    /// As [`Renderer::new`], with direct tracing's primary rays from `rays.0` and `rays.1` of
+    /// them per pixel (see [`crate::trace::sampling`]).
+    pub fn with_rays(
         ctx: &GpuContext,
         camera: &LensCamera,
         scenes: &SceneSet,
         setup: Setup,
         shadow_size: u32,
-        directions: DirectionSource,
+        rays: (DirectionSource, u32),
     ) -> Result<Self> {
         let scene = scenes.for_method(setup.method);
         let cube = match setup.method {
@@ -205,7 +200,7 @@ impl Renderer {
             }),
             _ => None,
         };
-        let path = Path::new(ctx, camera, scene, directions, cube.as_ref())?;
+        let path = Path::new(ctx, camera, scene, rays, cube.as_ref())?;
         let queries = Queries::new(ctx, setup.method.passes().len() as u32);
         Ok(Self {
             path,

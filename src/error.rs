@@ -150,6 +150,9 @@ pub enum Error {
         /// What went wrong, with the line and key where the parser knows them.
         message: String,
     },
+    /// A render option out of its range (with the choices).
+    #[error("{0}")]
+    Option(String),
     /// Something is larger than the adapter or the kernels allow (a storage binding, a
     /// texture, the traversal stack, the bounce depth, an acceleration structure), with the
     /// numbers.

@@ -141,16 +141,19 @@ pub(crate) enum Path {
 }
 
 impl Path {
-    /// Direct tracing with `directions`, or a cube map made as `cube` says.
+    /// Direct tracing with `directions` and `spp` rays per pixel, or a cube map made as
+    /// `cube` says.
     pub(crate) fn new(
         ctx: &GpuContext,
         camera: &LensCamera,
         scene: &GpuScene,
-        directions: DirectionSource,
+        (directions, spp): (DirectionSource, u32),
         cube: Option<&CubeSettings>,
     ) -> Result<Self> {
         Ok(match cube {
-            None => Path::Direct(Box::new(TracePass::new(ctx, camera, scene, directions)?)),
+            None => Path::Direct(Box::new(TracePass::supersampled(
+                ctx, camera, scene, directions, spp,
+            )?)),
             Some(settings) => Path::Cube(Box::new(CubeMap::new(ctx, camera, scene, settings)?)),
         })
     }
@@ -269,7 +272,8 @@ impl Renderer {
         }
         let ctx = GpuContext::from_device(device, queue);
         let gpu_scene = GpuScene::new(&ctx, scene, options)?;
-        let path = Path::new(&ctx, camera, &gpu_scene, options.directions, cube)?;
+        let rays = (options.directions, options.spp);
+        let path = Path::new(&ctx, camera, &gpu_scene, rays, cube)?;
         let (present, present_layout) = ctx.checked("creating the present pass", || {
             let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
                 label: Some("fisheye.present"),

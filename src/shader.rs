@@ -8,7 +8,7 @@ use std::fmt::Write;
 use crate::shared::{wgsl_constants, wgsl_faces};
 
 /// Every WGSL file of the project, by name (its file stem under `wgsl/`).
-pub const FILES: [(&str, &str); 22] = [
+pub const FILES: [(&str, &str); 23] = [
     ("math", include_str!("../wgsl/math.wgsl")),
     ("calibrated", include_str!("../wgsl/calibrated.wgsl")),
     ("triangles", include_str!("../wgsl/triangles.wgsl")),
@@ -29,6 +29,7 @@ pub const FILES: [(&str, &str); 22] = [
     ("cube_sample", include_str!("../wgsl/cube_sample.wgsl")),
     ("cube_store", include_str!("../wgsl/cube_store.wgsl")),
     ("present", include_str!("../wgsl/present.wgsl")),
+    ("sampling", include_str!("../wgsl/sampling.wgsl")),
     ("raster", include_str!("../wgsl/raster.wgsl")),
     (
         "raster_multiview",

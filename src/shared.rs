@@ -21,6 +21,9 @@ pub const TRAVERSAL_STACK: u32 = 32;
 /// must ask for more (`renderer::required_limits`).
 pub const TRACE_STORAGE_BUFFERS: u32 = 11;
 
+/// The most samples per pixel side (`RenderOptions::spp` is a square of at most this).
+pub const MAX_SAMPLES_PER_SIDE: u32 = 16;
+
 /// The deepest Whitted recursion a kernel can run (its ray stack has one more entry).
 pub const MAX_DEPTH_LIMIT: u32 = 8;
 /// A shadow ray passes at most this many partially transparent surfaces; behind more, the

@@ -1,8 +1,15 @@
-// Traces the primary ray of every pixel through the lens and shades it Whitted-style; one
+// Traces the primary rays of every pixel through the lens and shades them Whitted-style; one
 // invocation per pixel, dispatched over the image in WORKGROUP_2D × WORKGROUP_2D tiles.
 // The same kernel serves every lens, pinhole included: only ray generation differs.
+//
+// With SAMPLES_PER_SIDE = s > 1 the colour is the mean radiance of s² jittered stratified
+// samples inside the pixel (a box filter), and w the share of them the lens covers; the
+// ground truth (geometry, id) stays the single ray through the pixel's centre.
 #import primary
+#import sampling
 #import shade
+
+override SAMPLES_PER_SIDE: u32 = 1u;
 
 // Mirrors `fisheye_rt::trace::Frame`: the camera-to-world rotation's columns (camera x right,
 // y down, z forward) and the eye. The scene is uploaded relative to its own camera, so the eye
@@ -34,17 +41,46 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     let ray = primary_ray(pixel);
     if ray.w == 0.0 {
         colour_out[index] = vec4<f32>(0.0);
+        if SAMPLES_PER_SIDE > 1u {
+            colour_out[index] = supersampled(pixel, index);
+        }
         geometry_out[index] = vec4<f32>(0.0);
         ids_out[index] = NO_HIT;
         return;
     }
-    let dir = frame.right.xyz * ray.x + frame.down.xyz * ray.y + frame.forward.xyz * ray.z;
-    let traced = shade(Ray(frame.eye.xyz, dir, 0.0, 3.0e38));
+    let traced = shade(Ray(frame.eye.xyz, world(ray.xyz), 0.0, 3.0e38));
     colour_out[index] = vec4<f32>(traced.colour, 1.0);
+    if SAMPLES_PER_SIDE > 1u {
+        colour_out[index] = supersampled(pixel, index);
+    }
     if traced.triangle == NO_HIT {
         geometry_out[index] = vec4<f32>(0.0);
     } else {
         geometry_out[index] = vec4<f32>(traced.normal, traced.hit.t);
     }
     ids_out[index] = traced.triangle;
+}
+
+// A camera-space direction in the world.
+fn world(d: vec3<f32>) -> vec3<f32> {
+    return frame.right.xyz * d.x + frame.down.xyz * d.y + frame.forward.xyz * d.z;
+}
+
+// The mean radiance of the pixel's samples that have a ray, and the share that do (w).
+fn supersampled(pixel: vec2<u32>, index: u32) -> vec4<f32> {
+    let count = SAMPLES_PER_SIDE * SAMPLES_PER_SIDE;
+    var sum = vec3<f32>(0.0);
+    var covered = 0u;
+    for (var k = 0u; k < count; k++) {
+        let p = vec2<f32>(pixel) + sample_offset(index, k, SAMPLES_PER_SIDE);
+        let d = lens_unproject(lens, p);
+        if d.w != 0.0 {
+            sum += shade(Ray(frame.eye.xyz, world(d.xyz), 0.0, 3.0e38)).colour;
+            covered += 1u;
+        }
+    }
+    if covered == 0u {
+        return vec4<f32>(0.0);
+    }
+    return vec4<f32>(sum / f32(covered), f32(covered) / f32(count));
 }

@@ -110,7 +110,7 @@ struct TracedFaces {
 impl TracedFaces {
     fn new(ctx: &GpuContext, scene: &GpuScene, size: u32, cube: &wgpu::Texture) -> Result<Self> {
         let camera = face_camera(size)?;
-        let pass = TracePass::with_views(ctx, &camera, scene, DirectionSource::Computed, 6)?;
+        let pass = TracePass::with_views(ctx, &camera, scene, DirectionSource::Computed, 6, 1)?;
         ctx.checked("creating the traced cube faces", || {
             let device = &ctx.device;
             let store = shader::compute_pipeline(device, "cube_store", "main", &[], &[]);

@@ -261,21 +261,36 @@ impl<'a> Reference<'a> {
         best
     }
 
-    /// Renders every pixel of `camera` (rows split over the machine's threads).
+    /// Renders every pixel of `camera` with one ray through its centre (rows split over the
+    /// machine's threads).
     pub fn render(&self, camera: &LensCamera) -> RenderOutput {
+        self.render_samples(camera, 1)
+    }
+
+    /// As [`Reference::render`] with `samples_per_side`² rays per pixel, placed as the GPU
+    /// places them ([`super::sampling`]): the colour is their mean over those the lens covers,
+    /// `w` the covered share; geometry and ids stay the centre ray's.
+    pub fn render_samples(&self, camera: &LensCamera, samples_per_side: u32) -> RenderOutput {
         let size = camera.size;
         let directions = camera.directions();
         let threads = std::thread::available_parallelism().map_or(1, |n| n.get());
         let chunk = directions.len().div_ceil(threads).max(1);
         let mut pixels = vec![([0.0f32; 4], [0.0f32; 4], NO_HIT); directions.len()];
         std::thread::scope(|s| {
-            for (out, dirs) in pixels.chunks_mut(chunk).zip(directions.chunks(chunk)) {
+            for (c, (out, dirs)) in pixels
+                .chunks_mut(chunk)
+                .zip(directions.chunks(chunk))
+                .enumerate()
+            {
                 s.spawn(move || {
-                    for (o, d) in out.iter_mut().zip(dirs) {
+                    for (j, (o, d)) in out.iter_mut().zip(dirs).enumerate() {
                         *o = match d {
                             Some(d) => self.pixel(self.rotation * *d),
                             None => ([0.0; 4], [0.0; 4], NO_HIT),
                         };
+                        if samples_per_side > 1 {
+                            o.0 = self.samples(camera, c * chunk + j, samples_per_side);
+                        }
                     }
                 });
             }
@@ -286,6 +301,26 @@ impl<'a> Reference<'a> {
             geometry: pixels.iter().map(|p| p.1).collect(),
             ids: pixels.iter().map(|p| p.2).collect(),
         }
+    }
+
+    /// The mean colour of pixel `index`'s samples that have a ray, with w their share.
+    fn samples(&self, camera: &LensCamera, index: usize, side: u32) -> [f32; 4] {
+        let width = camera.size.width as usize;
+        let corner = DVec2::new((index % width) as f64, (index / width) as f64);
+        let (mut sum, mut covered) = (DVec3::ZERO, 0);
+        for k in 0..side * side {
+            let p = corner + super::sampling::sample_offset(index as u32, k, side);
+            if let Some(d) = camera.unproject(p) {
+                let c = self.pixel(self.rotation * d).0;
+                sum += DVec3::new(c[0].into(), c[1].into(), c[2].into());
+                covered += 1;
+            }
+        }
+        if covered == 0 {
+            return [0.0; 4];
+        }
+        let c = (sum / f64::from(covered)).as_vec3();
+        [c.x, c.y, c.z, covered as f32 / (side * side) as f32]
     }
 
     /// One primary ray (world direction from the camera): colour with w = 1, geometry, id.

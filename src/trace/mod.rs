@@ -5,6 +5,7 @@
 pub mod cpu;
 mod output;
 mod ray_query;
+pub mod sampling;
 
 use bytemuck::Pod;
 use glam::{DMat3, DVec3, Vec3};
@@ -51,6 +52,9 @@ pub struct RenderOptions {
     pub directions: DirectionSource,
     /// How rays find their hits.
     pub traversal: Traversal,
+    /// Rays per pixel (a square: jittered stratified samples, box-filtered; see
+    /// [`sampling`]). Ground-truth outputs stay the one ray through the pixel's centre.
+    pub spp: u32,
 }
 
 /// How the tracer's rays find their hits; lens and shading code are the same for both.
@@ -71,6 +75,7 @@ impl Default for RenderOptions {
             bvh: BvhQuality::default(),
             directions: DirectionSource::Computed,
             traversal: Traversal::Software,
+            spp: 1,
         }
     }
 }
@@ -401,17 +406,32 @@ impl TracePass {
         scene: &GpuScene,
         source: DirectionSource,
     ) -> Result<Self> {
-        Self::with_views(ctx, camera, scene, source, 1)
+        Self::with_views(ctx, camera, scene, source, 1, 1)
+    }
+
+    /// As [`TracePass::new`], with `spp` rays per pixel (a square; see [`sampling`]): the
+    /// colour is their mean over those the lens covers, its `w` the covered share.
+    pub fn supersampled(
+        ctx: &GpuContext,
+        camera: &LensCamera,
+        scene: &GpuScene,
+        source: DirectionSource,
+        spp: u32,
+    ) -> Result<Self> {
+        let side = sampling::samples_per_side(spp)?;
+        Self::with_views(ctx, camera, scene, source, 1, side)
     }
 
     /// As [`TracePass::new`], with `views` camera poses (numbered from 0) that can be set
-    /// before one submission and traced in it, as the faces of a cube map are.
+    /// before one submission and traced in it, as the faces of a cube map are, and
+    /// `samples_per_side`² rays per pixel.
     pub fn with_views(
         ctx: &GpuContext,
         camera: &LensCamera,
         scene: &GpuScene,
         source: DirectionSource,
         views: u32,
+        samples_per_side: u32,
     ) -> Result<Self> {
         ctx.check_image(camera.size)?;
         let pixels = camera.size.pixels() as u64;
@@ -440,6 +460,7 @@ impl TracePass {
             constants.extend(surface_constants(scene.features));
             constants.extend([
                 ("DIRECTION_SOURCE", f64::from(source as u32)),
+                ("SAMPLES_PER_SIDE", f64::from(samples_per_side)),
                 (
                     "HAS_TRANSLUCENT",
                     f64::from(u8::from(scene.features.translucent)),
@@ -649,5 +670,6 @@ pub fn render(
     options: &RenderOptions,
 ) -> Result<RenderOutput> {
     let gpu_scene = GpuScene::new(ctx, scene, options)?;
-    TracePass::new(ctx, camera, &gpu_scene, options.directions)?.trace(ctx, &gpu_scene, "tracing")
+    let pass = TracePass::supersampled(ctx, camera, &gpu_scene, options.directions, options.spp)?;
+    pass.trace(ctx, &gpu_scene, "tracing")
 }

@@ -14,8 +14,8 @@ use super::NO_HIT;
 pub struct RenderOutput {
     /// Image size.
     pub size: ImageSize,
-    /// Linear RGB radiance; `w` is 1 where the pixel has a ray (the validity mask), else the
-    /// pixel is all zero.
+    /// Linear RGB radiance; `w` is the share of the pixel the lens covers (1 or 0 with one ray
+    /// per pixel: the validity mask), and the pixel is all zero where it covers none.
     pub colour: Vec<[f32; 4]>,
     /// World-space shading normal (xyz) and distance from the camera (w) of the primary hit;
     /// zero on a miss or a masked pixel.
@@ -36,16 +36,17 @@ pub fn linear_to_srgb(x: f32) -> f32 {
 /// Masked pixels' colour in [`RenderOutput::to_image`] (sRGB).
 pub const MASKED_RGB: [u8; 3] = [0, 0, 0];
 
-/// The image of linear colours whose `w` is the validity mask (as [`RenderOutput::colour`]):
-/// sRGB-encoded and clamped, opaque where a pixel has a ray, transparent (alpha 0) where not.
+/// The image of linear colours whose `w` is the lens's coverage (as [`RenderOutput::colour`]):
+/// sRGB-encoded and clamped, alpha the coverage (opaque where a pixel is covered, transparent
+/// where not, between at the edge of the image circle with several rays per pixel).
 pub fn colour_image(size: ImageSize, colour: &[[f32; 4]]) -> image::RgbaImage {
     let mut out = Vec::with_capacity(colour.len() * 4);
     for c in colour {
-        if c[3] == 1.0 {
+        if c[3] > 0.0 {
             for v in &c[..3] {
                 out.push((linear_to_srgb(v.clamp(0.0, 1.0)) * 255.0).round() as u8);
             }
-            out.push(255);
+            out.push((c[3].clamp(0.0, 1.0) * 255.0).round() as u8);
         } else {
             out.extend_from_slice(&MASKED_RGB);
             out.push(0);
@@ -69,9 +70,9 @@ pub fn save_png(image: &image::RgbaImage, path: &Path) -> Result<()> {
 }
 
 impl RenderOutput {
-    /// Whether pixel `i` (row-major) has a ray.
+    /// Whether pixel `i` (row-major) has a ray (with several per pixel: any).
     pub fn valid(&self, i: usize) -> bool {
-        self.colour[i][3] == 1.0
+        self.colour[i][3] > 0.0
     }
 
     /// The colour image, sRGB-encoded and clamped, opaque where a pixel has a ray and
@@ -176,13 +177,16 @@ impl RenderOutput {
                     .collect(),
             ),
             Channel::Mask => {
-                Values::U8(self.colour.iter().map(|c| u8::from(c[3] == 1.0)).collect())
+                // The lens's own mask at pixel centres (the GPU's agrees bit for bit), also
+                // where several rays per pixel make the colour's `w` a coverage.
+                Values::U8(directions.iter().map(|d| u8::from(d.is_some())).collect())
             }
         }
     }
 
     /// Writes one channel as an NPY file. `directions` gives each pixel's world-space ray
-    /// direction (`None` where masked) and is needed only for [`Channel::Direction`].
+    /// direction (`None` where the lens masks its centre: the `direction` and `mask`
+    /// channels read them).
     pub fn write_npy(
         &self,
         channel: Channel,
