@@ -18,13 +18,12 @@ use std::path::PathBuf;
 use std::sync::Arc;
 use std::time::Instant;
 
-use fisheye_rt::cube::{CubeMethod, CubeSettings};
+use fisheye_rt::cube::CubeSettings;
 use fisheye_rt::gpu::GpuContext;
 use fisheye_rt::lens::{ImageSize, LensCamera, parse_spec};
-use fisheye_rt::raster::RasterMethod;
-use fisheye_rt::renderer::Renderer;
+use fisheye_rt::renderer::{Method, Renderer};
 use fisheye_rt::scene::{Camera, Scene};
-use fisheye_rt::trace::{RenderOptions, Traversal};
+use fisheye_rt::trace::RenderOptions;
 use glam::DVec3;
 use winit::application::ApplicationHandler;
 use winit::dpi::PhysicalSize;
@@ -44,33 +43,6 @@ const LENSES: [&str; 5] = [
 
 /// The rays per pixel P cycles through.
 const SPP: [u32; 3] = [1, 4, 16];
-
-/// The methods M cycles through.
-#[derive(Clone, Copy, PartialEq)]
-enum Method {
-    Rt,
-    Rq,
-    Cube(CubeMethod),
-}
-
-const METHODS: [Method; 6] = [
-    Method::Rt,
-    Method::Rq,
-    Method::Cube(CubeMethod::Traced),
-    Method::Cube(CubeMethod::Raster(RasterMethod::Forward)),
-    Method::Cube(CubeMethod::Raster(RasterMethod::Deferred)),
-    Method::Cube(CubeMethod::Raster(RasterMethod::SinglePass)),
-];
-
-impl Method {
-    fn name(self) -> &'static str {
-        match self {
-            Method::Rt => "rt",
-            Method::Rq => "rq",
-            Method::Cube(m) => m.name(),
-        }
-    }
-}
 
 struct Args {
     scene: String,
@@ -99,7 +71,7 @@ fn args() -> Result<Args, String> {
             "--lens" => out.lenses.insert(0, value("--lens")?),
             "--method" => {
                 let name = value("--method")?;
-                out.method = METHODS
+                out.method = Method::ALL
                     .iter()
                     .position(|m| m.name() == name)
                     .ok_or(format!("unknown method {name:?}"))?;
@@ -215,15 +187,15 @@ impl State {
     /// Makes the renderer for the current lens, method and size if it is not there; a method
     /// the adapter lacks is skipped with a note.
     fn ensure_view(&mut self, lenses: &[String]) -> Result<(), String> {
-        for _ in 0..METHODS.len() {
+        for _ in 0..Method::ALL.len() {
             if self.view.is_some() {
                 return Ok(());
             }
             match self.make_view(&lenses[self.lens]) {
                 Ok(view) => self.view = Some(view),
                 Err(e) => {
-                    eprintln!("{}: {e}", METHODS[self.method].name());
-                    self.method = (self.method + 1) % METHODS.len();
+                    eprintln!("{}: {e}", Method::ALL[self.method].name());
+                    self.method = (self.method + 1) % Method::ALL.len();
                 }
             }
         }
@@ -244,13 +216,9 @@ impl State {
         } else {
             wgpu::TextureFormat::Rgba8Unorm
         };
-        let method = METHODS[self.method];
+        let method = Method::ALL[self.method];
         let options = RenderOptions {
-            traversal: if method == Method::Rq {
-                Traversal::RayQuery
-            } else {
-                Traversal::Software
-            },
+            traversal: method.traversal(),
             spp: SPP[self.spp],
             ..RenderOptions::default()
         };
@@ -414,8 +382,8 @@ impl State {
             "fisheye-rt: {} triangles through {}, {}{} ({:.1} ms a frame)",
             self.scene.len(),
             view.lens,
-            METHODS[self.method].name(),
-            match METHODS[self.method] {
+            Method::ALL[self.method].name(),
+            match Method::ALL[self.method] {
                 Method::Cube(_) => String::new(),
                 _ => format!(" at {} rays a pixel", SPP[self.spp]),
             },
@@ -530,7 +498,7 @@ impl ApplicationHandler for App {
                         state.view = None;
                     }
                     KeyCode::KeyM => {
-                        state.method = (state.method + 1) % METHODS.len();
+                        state.method = (state.method + 1) % Method::ALL.len();
                         state.view = None;
                     }
                     KeyCode::KeyP => {

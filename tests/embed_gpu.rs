@@ -6,7 +6,7 @@
 use fisheye_rt::gpu::GpuContext;
 use fisheye_rt::lens::{ImageSize, LensCamera, parse_spec};
 use fisheye_rt::renderer::Renderer;
-use fisheye_rt::scene::{Camera, builtin};
+use fisheye_rt::scene::{Camera, Scene, builtin};
 use fisheye_rt::trace::{GpuScene, RenderOptions, TracePass, render};
 use glam::DVec3;
 
@@ -44,6 +44,15 @@ fn texture(device: &wgpu::Device, size: ImageSize, format: wgpu::TextureFormat) 
     })
 }
 
+/// A built-in scene and a camera through `lens` at `width`×`height`.
+fn view(scene: &str, lens: &str, width: u32, height: u32) -> (Scene, LensCamera) {
+    let camera = LensCamera::new(
+        parse_spec(lens).unwrap(),
+        ImageSize::new(width, height).unwrap(),
+    );
+    (builtin::scene(scene).unwrap(), camera)
+}
+
 /// Asserts two images are equal bit for bit, saying how many pixels differ if not.
 fn assert_same(what: &str, a: &[[f32; 4]], b: &[[f32; 4]]) {
     assert_eq!(a.len(), b.len(), "{what}: sizes");
@@ -60,11 +69,7 @@ fn assert_same(what: &str, a: &[[f32; 4]], b: &[[f32; 4]]) {
 #[test]
 fn frames_recorded_into_the_callers_encoder_and_texture_match_the_one_call_render() {
     let (device, queue) = own_device();
-    let scene = builtin::scene("default").unwrap();
-    let camera = LensCamera::new(
-        parse_spec("samyang-7.5mm").unwrap(),
-        ImageSize::new(96, 72).unwrap(),
-    );
+    let (scene, camera) = view("default", "samyang-7.5mm", 96, 72);
     let options = RenderOptions::default();
     let format = wgpu::TextureFormat::Rgba32Float;
     let renderer = Renderer::new(&device, &queue, &scene, &camera, &options, format).unwrap();
@@ -112,11 +117,7 @@ fn cube_map_frames_match_the_cube_map_render() {
     use fisheye_rt::cube::{CubeMap, CubeMethod, CubeSettings};
     use fisheye_rt::raster::RasterMethod;
     let (device, queue) = own_device();
-    let scene = builtin::scene("default").unwrap();
-    let camera = LensCamera::new(
-        parse_spec("canon-8-15mm@8mm").unwrap(),
-        ImageSize::new(64, 48).unwrap(),
-    );
+    let (scene, camera) = view("default", "canon-8-15mm@8mm", 64, 48);
     let options = RenderOptions::default();
     let format = wgpu::TextureFormat::Rgba32Float;
     let ctx = GpuContext::from_device(&device, &queue);
@@ -157,11 +158,7 @@ fn cube_map_frames_match_the_cube_map_render() {
 #[test]
 fn an_8_bit_target_holds_the_png_values() {
     let (device, queue) = own_device();
-    let scene = builtin::scene("default").unwrap();
-    let camera = LensCamera::new(
-        parse_spec("canon-8-15mm@8mm").unwrap(),
-        ImageSize::new(64, 48).unwrap(),
-    );
+    let (scene, camera) = view("default", "canon-8-15mm@8mm", 64, 48);
     let options = RenderOptions::default();
     let format = wgpu::TextureFormat::Rgba8Unorm;
     let renderer = Renderer::new(&device, &queue, &scene, &camera, &options, format).unwrap();
@@ -195,11 +192,7 @@ fn a_device_below_the_required_limits_is_refused_naming_the_limit() {
     let mut limits = fisheye_rt::renderer::required_limits();
     limits.max_storage_buffers_per_shader_stage -= 1;
     let (device, queue) = device_with(limits);
-    let scene = builtin::scene("grid").unwrap();
-    let camera = LensCamera::new(
-        parse_spec("equidistant:f=0.4").unwrap(),
-        ImageSize::new(32, 24).unwrap(),
-    );
+    let (scene, camera) = view("grid", "equidistant:f=0.4", 32, 24);
     let format = wgpu::TextureFormat::Rgba16Float;
     let options = RenderOptions::default();
     let message = Renderer::new(&device, &queue, &scene, &camera, &options, format)
@@ -216,11 +209,7 @@ fn a_device_below_the_required_limits_is_refused_naming_the_limit() {
 #[test]
 fn unwritable_targets_are_errors_naming_what_is_wanted() {
     let (device, queue) = own_device();
-    let scene = builtin::scene("grid").unwrap();
-    let camera = LensCamera::new(
-        parse_spec("equidistant:f=0.4").unwrap(),
-        ImageSize::new(32, 24).unwrap(),
-    );
+    let (scene, camera) = view("grid", "equidistant:f=0.4", 32, 24);
     let options = RenderOptions::default();
     let message = Renderer::new(
         &device,
