@@ -5,7 +5,7 @@
 
 use std::fmt::Write;
 
-use crate::shared::{wgsl_constants, wgsl_faces};
+use crate::shared::{wgsl_constants, wgsl_faces, wgsl_float_constants};
 
 /// Every WGSL file of the project, by name (its file stem under `wgsl/`).
 pub const FILES: [(&str, &str); 23] = [
@@ -104,6 +104,10 @@ pub fn compose(entry: &str) -> String {
     out.push_str("// ---- constants from fisheye_rt::shared::wgsl_constants()\n");
     for (name, value) in wgsl_constants() {
         writeln!(out, "const {name}: u32 = {value}u;").unwrap();
+    }
+    for (name, value) in wgsl_float_constants() {
+        // `{:?}` writes a float that reads back exactly, always with a point or exponent.
+        writeln!(out, "const {name}: f32 = {value:?};").unwrap();
     }
     out.push_str(&wgsl_faces());
     out.push_str(&c.body);

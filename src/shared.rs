@@ -245,6 +245,24 @@ pub fn wgsl_faces() -> String {
     )
 }
 
+/// Rays whose weight falls below this are not traced (the GPU's and the reference's Whitted
+/// recursion alike).
+pub const MIN_WEIGHT: f32 = 1e-3;
+
+/// The least cosine between a reflected or refracted ray and the geometric surface it leaves
+/// (on its own side): interpolated normals lean away from the facets, and a reflection or
+/// refraction about one can cross the facet it leaves and see the object's inside, the black
+/// speckles along mirror and glass silhouettes. Such a ray is bent to graze the surface at
+/// this cosine instead (about 0.06°), as renderers adapt shading normals so that reflections
+/// stay above the geometry (Keller et al. 2017, "The Iray Light Transport Simulation and
+/// Rendering System", arXiv:1705.01263).
+pub const GRAZING_COSINE: f32 = 1e-3;
+
+/// The f32 constants every WGSL module sees, as `const NAME: f32` lines.
+pub fn wgsl_float_constants() -> [(&'static str, f32); 2] {
+    [("MIN_WEIGHT", MIN_WEIGHT), ("GRAZING_COSINE", GRAZING_COSINE)]
+}
+
 /// The constants every WGSL module sees, as `const NAME: u32` lines (see `shader::compose`).
 pub fn wgsl_constants() -> Vec<(String, u32)> {
     let mut out: Vec<(String, u32)> = [

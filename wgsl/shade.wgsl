@@ -6,8 +6,18 @@
 
 override HAS_TRANSLUCENT: bool;
 
-// Rays whose weight falls below this are not traced (the CPU reference prunes alike).
-const MIN_WEIGHT: f32 = 1e-3;
+// MIN_WEIGHT and GRAZING_COSINE come from `fisheye_rt::shared` (the reference uses them too).
+
+// `dir` kept on the `side` of the geometric surface `geometric` faces (1: the side the ray
+// came from, for reflections; -1: the other, for refractions), at least GRAZING_COSINE off
+// it: bent to graze the surface where it would cross it (see `shared::GRAZING_COSINE`).
+fn keep_side(dir: vec3<f32>, geometric: vec3<f32>, side: f32) -> vec3<f32> {
+    let c = side * dot(dir, geometric);
+    if c >= GRAZING_COSINE {
+        return dir;
+    }
+    return normalize(dir + side * (GRAZING_COSINE - c) * geometric);
+}
 
 // Wächter and Binder, "A Fast and Robust Method for Avoiding Self-Intersection" (Ray Tracing
 // Gems, ch. 6): move p off its surface along the normal n by a few ulp of p's magnitude, or by
@@ -119,7 +129,7 @@ fn shade(primary: Ray) -> Traced {
         if HAS_MIRRORS && s.material.surface == SURFACE_MIRROR {
             let weight = ray_in.weight * s.material.specular;
             if children && max(weight.x, max(weight.y, weight.z)) >= MIN_WEIGHT {
-                let dir = reflect(ray.dir, s.normal);
+                let dir = keep_side(reflect(ray.dir, s.normal), s.geometric, 1.0);
                 stack[count] = Pending(offset_origin(s.position, s.geometric), ray_in.depth + 1u, dir, weight);
                 count += 1u;
             }
@@ -129,13 +139,14 @@ fn shade(primary: Ray) -> Traced {
             if reflectance < 1.0 {
                 let weight = ray_in.weight * (1.0 - reflectance) * s.material.transmission;
                 if children && max(weight.x, max(weight.y, weight.z)) >= MIN_WEIGHT {
-                    stack[count] = Pending(offset_origin(s.position, -s.geometric), ray_in.depth + 1u, glass.refracted, weight);
+                    let dir = keep_side(glass.refracted, s.geometric, -1.0);
+                    stack[count] = Pending(offset_origin(s.position, -s.geometric), ray_in.depth + 1u, dir, weight);
                     count += 1u;
                 }
             }
             let weight = ray_in.weight * reflectance;
             if children && max(weight.x, max(weight.y, weight.z)) >= MIN_WEIGHT {
-                let dir = reflect(ray.dir, s.normal);
+                let dir = keep_side(reflect(ray.dir, s.normal), s.geometric, 1.0);
                 stack[count] = Pending(offset_origin(s.position, s.geometric), ray_in.depth + 1u, dir, weight);
                 count += 1u;
             }

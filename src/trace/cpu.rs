@@ -11,8 +11,8 @@ use super::{MAX_DEPTH_LIMIT, MAX_SHADOW_LAYERS, NO_HIT, RenderOutput};
 use crate::lens::LensCamera;
 use crate::scene::{Features, Scene, Surface, Texture};
 
-/// Rays whose weight falls below this are not traced (as in `wgsl/shade.wgsl`).
-const MIN_WEIGHT: f64 = 1e-3;
+/// Rays whose weight falls below this are not traced (as on the GPU).
+const MIN_WEIGHT: f64 = crate::shared::MIN_WEIGHT as f64;
 
 /// A hit: distance, barycentric weights of corners 1 and 2, scene triangle.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -359,7 +359,7 @@ impl<'a> Reference<'a> {
                     push(
                         &mut stack,
                         above,
-                        reflect(dir, s.normal),
+                        keep_side(reflect(dir, s.normal), s.geometric, 1.0),
                         weight * v3(m.specular),
                     );
                 }
@@ -377,12 +377,12 @@ impl<'a> Reference<'a> {
                         reflectance = fresnel(cos_i, cos_t, 1.0 / eta);
                         let refracted = (eta * dir + (eta * cos_i - cos_t) * s.normal).normalize();
                         let w = weight * (1.0 - reflectance) * v3(m.transmission);
-                        push(&mut stack, below, refracted, w);
+                        push(&mut stack, below, keep_side(refracted, s.geometric, -1.0), w);
                     }
                     push(
                         &mut stack,
                         above,
-                        reflect(dir, s.normal),
+                        keep_side(reflect(dir, s.normal), s.geometric, 1.0),
                         weight * reflectance,
                     );
                 }
@@ -507,6 +507,17 @@ fn closer(hit: &Hit, best: Option<&Hit>, tmax: f64) -> bool {
 
 fn reflect(d: DVec3, n: DVec3) -> DVec3 {
     d - 2.0 * d.dot(n) * n
+}
+
+/// As `keep_side` in `wgsl/shade.wgsl`: `dir` kept on the `side` of the geometric surface
+/// (1: where the ray came from; -1: beyond), at least `GRAZING_COSINE` off it.
+fn keep_side(dir: DVec3, geometric: DVec3, side: f64) -> DVec3 {
+    let graze = f64::from(crate::shared::GRAZING_COSINE);
+    let c = side * dir.dot(geometric);
+    if c >= graze {
+        return dir;
+    }
+    (dir + side * (graze - c) * geometric).normalize()
 }
 
 fn fresnel(cos_i: f64, cos_t: f64, eta: f64) -> f64 {
