@@ -69,8 +69,9 @@ fn closed_sphere_does_not_leak() {
                 up: DVec3::X,
             },
         );
-        // 360°: every direction; odd size: the centre ray is the optical axis itself.
-        let cam = camera("equidistant:f=0.2", 161, 161);
+        // A 360° field, every direction (θ up to 180°, a circle of radius 0.4π half-widths);
+        // odd size: the centre ray is the optical axis itself.
+        let cam = camera("equidistant:f=0.4", 161, 161);
         let out = render(ctx(), &scene, &cam, &RenderOptions::default()).unwrap();
         let (valid, hits) = out.counts();
         assert!(valid > 15_000);

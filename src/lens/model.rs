@@ -203,12 +203,13 @@ impl ClassicLens {
         let (family, _, rate) = self.model.general_form();
         let end = match family {
             Family::Tan => DomainEnd::Pole(FRAC_PI_2 / rate),
-            Family::Linear => DomainEnd::Closed(TAU),
+            Family::Linear => DomainEnd::Closed(PI),
             Family::Sin => DomainEnd::Closed(FRAC_PI_2 / rate),
         };
-        // No ray turns further than a full circle: every family stops at 2π.
+        // θ = π looks straight back: every family stops there, having covered the whole
+        // sphere once (past it, a linear mapping would show the sphere a second time).
         match end {
-            DomainEnd::Pole(t) | DomainEnd::Closed(t) if t > TAU => DomainEnd::Closed(TAU),
+            DomainEnd::Pole(t) | DomainEnd::Closed(t) if t > PI => DomainEnd::Closed(PI),
             e => e,
         }
     }
