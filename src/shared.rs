@@ -260,7 +260,10 @@ pub const GRAZING_COSINE: f32 = 1e-3;
 
 /// The f32 constants every WGSL module sees, as `const NAME: f32` lines.
 pub fn wgsl_float_constants() -> [(&'static str, f32); 2] {
-    [("MIN_WEIGHT", MIN_WEIGHT), ("GRAZING_COSINE", GRAZING_COSINE)]
+    [
+        ("MIN_WEIGHT", MIN_WEIGHT),
+        ("GRAZING_COSINE", GRAZING_COSINE),
+    ]
 }
 
 /// The constants every WGSL module sees, as `const NAME: u32` lines (see `shader::compose`).

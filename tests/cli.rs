@@ -520,6 +520,9 @@ fn render_takes_scene_files_and_camera_poses() {
     };
     let own = png("own.png", None);
     assert_eq!(own, png("same.png", Some("0,1,0.95:0,1,0")));
+    // Negative coordinates are coordinates, not flags: the same pose, looked at from the
+    // other side of the eye's x = 0 plane, is a different picture.
+    assert_ne!(own, png("negative.png", Some("-0.3,1,0.95:-0.1,1,-1")));
     assert_eq!(own, png("start.png", Some("path:0")));
     assert_ne!(own, png("middle.png", Some("path:0.5")));
     for (camera, wanted) in [

@@ -154,3 +154,48 @@ fn bad_obj_files_are_errors_or_warnings_naming_the_problem() {
     );
     std::fs::remove_dir_all(dir).unwrap();
 }
+
+/// A bare OBJ's headlight follows the camera: seen from behind, the bunny is lit by the
+/// light at the eye (it faces every visible surface), not left a dark silhouette by a
+/// headlight still at the automatic camera in front.
+#[test]
+fn the_headlight_follows_the_camera() {
+    use fisheye_rt::scene::{Camera, Light};
+    let mut scene = load_obj(&shared("scanned/stanford-bunny.obj"))
+        .unwrap()
+        .scene;
+    let (lo, hi) = scene.bounds().unwrap();
+    let centre = (lo + hi) / 2.0;
+    let behind = Camera {
+        position: 2.0 * centre - scene.camera.position,
+        look_at: centre,
+        up: glam::DVec3::Y,
+    };
+    let mut stale = scene.clone();
+    stale.camera = behind;
+    scene.set_camera(behind);
+    assert!(matches!(
+        scene.lights[scene.headlight.unwrap()],
+        Light::Point { position, .. } if position == behind.position
+    ));
+    let brightness = |scene: &fisheye_rt::scene::Scene| {
+        let out = render(
+            ctx(),
+            scene,
+            &camera("rectilinear:f=1", 64, 48),
+            &Default::default(),
+        )
+        .unwrap();
+        let hits: Vec<f32> = (0..out.ids.len())
+            .filter(|&i| out.ids[i] != fisheye_rt::trace::NO_HIT)
+            .map(|i| out.colour[i][..3].iter().sum::<f32>() / 3.0)
+            .collect();
+        assert!(hits.len() > 300, "{} pixels see the bunny", hits.len());
+        hits.iter().sum::<f32>() / hits.len() as f32
+    };
+    let (followed, left) = (brightness(&scene), brightness(&stale));
+    eprintln!(
+        "mean radiance from behind: {followed:.3} with the headlight at the eye, {left:.3} without"
+    );
+    assert!(followed > 2.0 * left, "{followed} vs {left}");
+}

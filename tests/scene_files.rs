@@ -313,5 +313,19 @@ fn bad_scene_files_are_clear_errors() {
             .join("")
             .contains("nothing lights")
     );
+    // One lit by its sky and ambient term alone renders flat: a warning says so, and what to
+    // add; a light silences it.
+    let flat = write(&dir, "flat.toml", "[[mesh]]\npath = \"tri.obj\"\n");
+    let warnings = load_scene_file(&flat).unwrap().warnings.join("");
+    assert!(
+        warnings.contains("no [[light]]") && warnings.contains("renders flat"),
+        "{warnings}"
+    );
+    let lit = write(
+        &dir,
+        "lit.toml",
+        "[[mesh]]\npath = \"tri.obj\"\n[[light]]\ntype = \"sun\"\ndirection = [0.0, -1.0, 0.0]\nirradiance = [1.0, 1.0, 1.0]\n",
+    );
+    assert!(load_scene_file(&lit).unwrap().warnings.is_empty());
     std::fs::remove_dir_all(dir).unwrap();
 }

@@ -661,7 +661,16 @@ fn speckles(scene: &fisheye_rt::scene::Scene, out: &fisheye_rt::trace::RenderOut
                 continue;
             }
             let mut around: Vec<f32> = Vec::new();
-            for (dx, dy) in [(-1, -1), (0, -1), (1, -1), (-1, 0), (1, 0), (-1, 1), (0, 1), (1, 1)] {
+            for (dx, dy) in [
+                (-1, -1),
+                (0, -1),
+                (1, -1),
+                (-1, 0),
+                (1, 0),
+                (-1, 1),
+                (0, 1),
+                (1, 1),
+            ] {
                 let j = (y as isize + dy) as usize * w + (x as isize + dx) as usize;
                 if material(j) != Some(m) {
                     break;

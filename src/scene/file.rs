@@ -403,6 +403,13 @@ pub fn load_scene_file_from(path: &Path, read: ReadFile) -> Result<Loaded> {
     if scene.lights.is_empty() && !emits && sky.max_element() == 0.0 && ambient.max_element() == 0.0
     {
         warnings.push("nothing lights this scene: no lights, emission, sky or ambient".into());
+    } else if scene.lights.is_empty() {
+        // Emission and the sky light nothing else under Whitted shading.
+        warnings.push(
+            "no [[light]]: surfaces get the ambient term alone, so the scene renders flat and \
+             casts no shadows; add a [[light]] (point or sun)"
+                .into(),
+        );
     }
     Ok(Loaded { scene, warnings })
 }

@@ -197,6 +197,9 @@ pub struct Scene {
     pub camera: Camera,
     /// Keyframes of a camera path (for benchmarks); empty if the scene has none.
     pub camera_path: Vec<Camera>,
+    /// The point light (index into `lights`) that sits at the camera, as a bare OBJ's
+    /// headlight does: [`Scene::set_camera`] moves it with the eye.
+    pub headlight: Option<usize>,
 }
 
 impl Scene {
@@ -208,6 +211,16 @@ impl Scene {
     /// Whether the scene has no triangles.
     pub fn is_empty(&self) -> bool {
         self.triangles.is_empty()
+    }
+
+    /// Puts the camera at `pose`, and the headlight, if the scene has one, at its eye.
+    pub fn set_camera(&mut self, pose: Camera) {
+        self.camera = pose;
+        if let Some(Light::Point { position, .. }) =
+            self.headlight.and_then(|i| self.lights.get_mut(i))
+        {
+            *position = pose.position;
+        }
     }
 
     /// The axis-aligned bounds of all triangles (`None` when empty).

@@ -274,7 +274,8 @@ pub const DEFAULT_SKY: Vec3 = Vec3::new(0.35, 0.4, 0.5);
 pub const DEFAULT_AMBIENT: Vec3 = Vec3::splat(0.08);
 
 /// A camera that frames the box `lo`..`hi` from the front (+z, slightly above) at 1.3 bounding
-/// radii, whatever its units or offset, with a headlight at the camera and a sun.
+/// radii, whatever its units or offset, with a headlight at the camera (the first light) and
+/// a sun.
 pub fn framing(lo: DVec3, hi: DVec3) -> (Camera, Vec<Light>) {
     let centre = (lo + hi) / 2.0;
     // Scaled so that the length of a box beyond 1e154 does not overflow.
@@ -320,7 +321,8 @@ pub fn load_obj_from(path: &Path, read: ReadFile) -> Result<Loaded> {
     }
     let (lo, hi) = b.bounds().unwrap_or((DVec3::ZERO, DVec3::ZERO));
     let (camera, lights) = framing(lo, hi);
-    let scene = b.finish(lights, DEFAULT_SKY, DEFAULT_AMBIENT, camera);
+    let mut scene = b.finish(lights, DEFAULT_SKY, DEFAULT_AMBIENT, camera);
+    scene.headlight = Some(0);
     Ok(Loaded { scene, warnings })
 }
 

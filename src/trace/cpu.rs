@@ -377,7 +377,12 @@ impl<'a> Reference<'a> {
                         reflectance = fresnel(cos_i, cos_t, 1.0 / eta);
                         let refracted = (eta * dir + (eta * cos_i - cos_t) * s.normal).normalize();
                         let w = weight * (1.0 - reflectance) * v3(m.transmission);
-                        push(&mut stack, below, keep_side(refracted, s.geometric, -1.0), w);
+                        push(
+                            &mut stack,
+                            below,
+                            keep_side(refracted, s.geometric, -1.0),
+                            w,
+                        );
                     }
                     push(
                         &mut stack,

@@ -52,7 +52,7 @@ pub(crate) struct StudyArgs {
     pub(crate) calib: CalibArgs,
     /// Camera pose instead of the scene's (as for `render`); the orbit path circles its
     /// look-at point.
-    #[arg(long)]
+    #[arg(long, allow_hyphen_values = true)]
     pub(crate) camera: Option<String>,
     /// Methods to measure (comma-separated); by default every one the adapter has.
     #[arg(long, value_enum, value_delimiter = ',')]

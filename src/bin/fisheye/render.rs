@@ -30,8 +30,9 @@ pub(crate) struct RenderArgs {
     #[command(flatten)]
     pub(crate) calib: CalibArgs,
     /// Camera pose instead of the scene's: `X,Y,Z:LX,LY,LZ` (eye and look-at point, y up),
-    /// or `path:S` for the point S ∈ [0, 1] along the scene file's camera path.
-    #[arg(long)]
+    /// or `path:S` for the point S ∈ [0, 1] along the scene file's camera path. Coordinates
+    /// may be negative (`--camera -16,-11.5,0:0,-9,0`).
+    #[arg(long, allow_hyphen_values = true)]
     pub(crate) camera: Option<String>,
     /// How to make the image: `rt` traces the lens's rays directly, `rq` does too with the
     /// adapter's hardware ray queries in place of the software BVH traversal (same lens and
@@ -93,7 +94,8 @@ pub(crate) fn render(args: &RenderArgs) -> Result<()> {
     let scene_spec = &args.scene;
     let mut scene = load_scene(scene_spec)?;
     if let Some(text) = &args.camera {
-        scene.camera = parse_camera(text, &scene)?;
+        let pose = parse_camera(text, &scene)?;
+        scene.set_camera(pose);
     }
     let ctx = GpuContext::new()?;
     println!("adapter: {}", ctx.adapter_name());

@@ -103,7 +103,8 @@ pub(crate) fn prepare(args: &StudyArgs, command: &str) -> Result<Prepared> {
     let setups = Setup::all(&methods, &args.cube_size);
     let mut scene = load_scene(&args.scene)?;
     if let Some(text) = &args.camera {
-        scene.camera = parse_camera(text, &scene)?;
+        let pose = parse_camera(text, &scene)?;
+        scene.set_camera(pose);
     }
     let out = out_folder(args.out.as_deref(), command)?;
     let ctx = GpuContext::new()?;
