@@ -10,6 +10,7 @@ use std::io::{Error, ErrorKind, Result};
 use std::path::Path;
 
 use fisheye_rt::bvh::{BvhQuality, SceneBvh};
+use fisheye_rt::input::InputKind;
 use fisheye_rt::lens::calib::{self, CalibFormat};
 use fisheye_rt::lens::{ImageSize, Lens, LensCamera, parse_spec};
 use fisheye_rt::scene::Scene;
@@ -28,36 +29,40 @@ fn not_found(path: &Path) -> Error {
     )
 }
 
-fn extension(path: &Path) -> &str {
-    path.extension().and_then(|e| e.to_str()).unwrap_or("")
+/// Paths under `/dev/` go to the disk, as they would from the command line: a fuzzed
+/// `mtllib /dev/zero` must be refused (a device), not read for ever.
+fn special(path: &Path, kind: InputKind) -> Option<Result<Vec<u8>>> {
+    path.starts_with("/dev")
+        .then(|| fisheye_rt::scene::disk(path, kind))
 }
 
 /// The bytes up to the first NUL are an OBJ file; the bytes after it are every MTL file the
-/// OBJ names. Textures are missing.
+/// OBJ names. Textures are missing. Paths under `/dev/` are read from the disk.
 pub fn obj(data: &[u8]) {
     let split = data.iter().position(|&b| b == 0).unwrap_or(data.len());
     let (obj, mtl) = (&data[..split], data.get(split + 1..).unwrap_or(&[]));
-    let read = |path: &Path| -> Result<Vec<u8>> {
-        match extension(path) {
-            "obj" => Ok(obj.to_vec()),
-            "mtl" => Ok(mtl.to_vec()),
+    let read = |path: &Path, kind: InputKind| -> Result<Vec<u8>> {
+        special(path, kind).unwrap_or_else(|| match kind {
+            InputKind::Obj => Ok(obj.to_vec()),
+            InputKind::Mtl => Ok(mtl.to_vec()),
             _ => Err(not_found(path)),
-        }
+        })
     };
     if let Ok(loaded) = load_obj_from(Path::new("fuzz.obj"), &read) {
         check_scene(&loaded.scene);
     }
 }
 
-/// The bytes are a scene file; every OBJ it names is one triangle.
+/// The bytes are a scene file; every OBJ it names is one triangle (or, under `/dev/`, read
+/// from the disk).
 pub fn scene_file(data: &[u8]) {
-    let read = |path: &Path| -> Result<Vec<u8>> {
-        match extension(path) {
-            "toml" => Ok(data.to_vec()),
-            "obj" => Ok(TRIANGLE_OBJ.to_vec()),
-            "mtl" => Ok(TRIANGLE_MTL.to_vec()),
+    let read = |path: &Path, kind: InputKind| -> Result<Vec<u8>> {
+        special(path, kind).unwrap_or_else(|| match kind {
+            InputKind::SceneFile => Ok(data.to_vec()),
+            InputKind::Obj => Ok(TRIANGLE_OBJ.to_vec()),
+            InputKind::Mtl => Ok(TRIANGLE_MTL.to_vec()),
             _ => Err(not_found(path)),
-        }
+        })
     };
     if let Ok(loaded) = load_scene_file_from(Path::new("fuzz.toml"), &read) {
         check_scene(&loaded.scene);

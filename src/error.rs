@@ -106,12 +106,12 @@ pub enum Error {
         available: String,
     },
     /// The adapter refused to create a device.
-    #[error("could not create a device on {adapter}: {source}")]
+    #[error("could not create a device on {adapter}: {reason}")]
     RequestDevice {
         /// The adapter's name.
         adapter: String,
-        /// wgpu's reason.
-        source: wgpu::RequestDeviceError,
+        /// wgpu's reason (in the message, not a separate source: said once).
+        reason: wgpu::RequestDeviceError,
     },
     /// An operation needs a device feature the adapter lacks.
     #[error("{what} needs the GPU feature {feature}, which {adapter} does not have")]
@@ -175,12 +175,12 @@ pub enum Error {
     #[error(transparent)]
     Lens(#[from] LensError),
     /// A file could not be read or written.
-    #[error("{path}: {source}")]
+    #[error("{path}: {reason}")]
     Io {
         /// The file.
         path: std::path::PathBuf,
-        /// The OS's reason.
-        source: std::io::Error,
+        /// The OS's reason (in the message, not a separate source: said once).
+        reason: std::io::Error,
     },
     /// A plot could not be drawn.
     #[error("{path}: {message}")]
@@ -191,12 +191,12 @@ pub enum Error {
         message: String,
     },
     /// An image could not be encoded or written.
-    #[error("{path}: {source}")]
+    #[error("{path}: {reason}")]
     Image {
         /// The file.
         path: std::path::PathBuf,
-        /// The encoder's reason.
-        source: image::ImageError,
+        /// The encoder's reason (in the message, not a separate source: said once).
+        reason: image::ImageError,
     },
 }
 

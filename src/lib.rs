@@ -42,6 +42,7 @@ pub mod bvh;
 pub mod cube;
 mod error;
 pub mod gpu;
+pub mod input;
 pub mod lens;
 pub mod precision;
 pub mod raster;

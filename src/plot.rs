@@ -81,9 +81,13 @@ fn write_png(
             })?;
     }
     let image = image::RgbImage::from_raw(WIDTH, HEIGHT, rgb).expect("a full buffer");
-    image.save(path).map_err(|source| Error::Image {
-        path: path.to_path_buf(),
-        source,
+    crate::trace::write_atomically(path, |temporary| {
+        image
+            .save_with_format(temporary, image::ImageFormat::Png)
+            .map_err(|reason| Error::Image {
+                path: path.to_path_buf(),
+                reason,
+            })
     })
 }
 

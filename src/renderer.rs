@@ -391,6 +391,13 @@ impl Renderer {
             Path::Cube(_) => None,
         }
     }
+
+    /// The last submitted frame's outputs, read back to the CPU (waiting for the device): all
+    /// of them for a traced frame, the colour alone (geometry zero, ids `NO_HIT`) through a
+    /// cube map. For screenshots and tests, not for every frame.
+    pub fn read_back(&self) -> Result<RenderOutput> {
+        self.path.read(&self.ctx)
+    }
 }
 
 fn format_names() -> String {

@@ -196,7 +196,10 @@ fn unreadable_files_and_unknown_kinds_are_errors() {
     let folder = dir.join("folder.obj");
     std::fs::create_dir_all(&folder).unwrap();
     let message = error_of(load_obj(&folder));
-    assert!(message.contains("folder.obj: cannot open"), "{message}");
+    assert!(
+        message.contains("folder.obj: cannot read the file: a folder, not a regular file"),
+        "{message}"
+    );
     let latin1 = write(&dir, "l.toml", b"# caf\xe9\n[[mesh]]\nshape = \"box\"\n");
     let message = error_of(load_scene_file(&latin1));
     assert!(
@@ -490,4 +493,154 @@ fn the_readme_table_names_tests_that_exist() {
         }
     }
     assert!(rows >= 20, "the table has {rows} rows");
+}
+
+/// Runs the CLI with its address space capped at `MIB` MiB (so that reading an endless
+/// file would fail, not eat the machine) and kills it after a minute (so that a blocking read
+/// fails the test instead of hanging it): the exit status and stderr.
+fn fisheye_bounded(args: &[&str], env: &[(&str, &str)]) -> (Option<i32>, String) {
+    use std::os::unix::process::CommandExt;
+    const MIB: u64 = 256;
+    let mut command = std::process::Command::new(env!("CARGO_BIN_EXE_fisheye"));
+    command
+        .args(args)
+        .envs(env.iter().copied())
+        .stdout(std::process::Stdio::null())
+        .stderr(std::process::Stdio::piped());
+    // SAFETY: setrlimit is async-signal-safe, as a pre_exec closure must be.
+    unsafe {
+        command.pre_exec(|| {
+            let limit = libc::rlimit {
+                rlim_cur: MIB << 20,
+                rlim_max: MIB << 20,
+            };
+            if libc::setrlimit(libc::RLIMIT_AS, &limit) != 0 {
+                return Err(std::io::Error::last_os_error());
+            }
+            Ok(())
+        });
+    }
+    let mut child = command.spawn().unwrap();
+    let started = std::time::Instant::now();
+    while child.try_wait().unwrap().is_none() {
+        if started.elapsed() > std::time::Duration::from_secs(60) {
+            child.kill().unwrap();
+            panic!("{args:?} still running after a minute");
+        }
+        std::thread::sleep(std::time::Duration::from_millis(20));
+    }
+    let output = child.wait_with_output().unwrap();
+    let stderr = String::from_utf8_lossy(&output.stderr).into_owned();
+    (output.status.code(), stderr)
+}
+
+/// Endless, special and oversized inputs: each is refused before it is read, with an error
+/// naming the file and what it is (once), by a process held to 256 MiB of address space that
+/// never gets to the GPU; budgets come from `FISHEYE_MAX_INPUT_MIB`.
+#[test]
+fn special_and_oversized_inputs_are_refused_within_bounds() {
+    let dir = temp_dir("special");
+    let at = |name: &str| dir.join(name).to_str().unwrap().to_string();
+    let mkfifo = |name: &str| {
+        let status = std::process::Command::new("mkfifo")
+            .arg(at(name))
+            .status()
+            .unwrap();
+        assert!(status.success());
+    };
+    mkfifo("pipe.obj");
+    mkfifo("pipe.toml");
+    let triangle = format!("{TRIANGLE}f 1 2 3\n");
+    write(
+        &dir,
+        "zero-mtl.obj",
+        format!("mtllib /dev/zero\n{triangle}").as_bytes(),
+    );
+    write(&dir, "zero.mtl", b"newmtl m\nKd 1 1 1\nmap_Kd /dev/zero\n");
+    let textured = format!("mtllib zero.mtl\nusemtl m\nvt 0 0\n{triangle}");
+    write(&dir, "zero-texture.obj", textured.as_bytes());
+    let light = "[[light]]\ntype = \"sun\"\ndirection = [0, -1, 0]\nirradiance = [1, 1, 1]\n";
+    let scene = format!("[[mesh]]\npath = \"/dev/zero\"\n{light}");
+    write(&dir, "zero-mesh.toml", scene.as_bytes());
+    // 29 × 65,536 bytes (1.8 MiB) of comments and a triangle.
+    let big = format!(
+        "{}{triangle}",
+        "# padding to make it larger.\n".repeat(65_536)
+    );
+    write(&dir, "big.obj", big.as_bytes());
+    let one_mib = [("FISHEYE_MAX_INPUT_MIB", "1")];
+    type Case<'a> = (Vec<String>, &'a [(&'a str, &'a str)], &'a str);
+    let render = |extra: &[&str]| {
+        let mut args = vec!["render".to_string(), "-o".into(), at("out.png")];
+        args.extend(extra.iter().map(|s| s.to_string()));
+        args
+    };
+    let cases: Vec<Case> = vec![
+        (
+            render(&[&at("pipe.obj")]),
+            &[],
+            "pipe.obj: cannot read the file: a named pipe, not a regular file",
+        ),
+        (
+            render(&[&at("pipe.toml")]),
+            &[],
+            "pipe.toml: a named pipe, not a regular file",
+        ),
+        (render(&[&at("zero-mtl.obj")]), &[], "/dev/zero: the MTL of"),
+        (
+            render(&[&at("zero-texture.obj")]),
+            &[],
+            "/dev/zero: texture of material m: a device, not a regular file",
+        ),
+        (
+            render(&[&at("zero-mesh.toml")]),
+            &[],
+            "/dev/zero: cannot read the file: a device, not a regular file",
+        ),
+        (
+            render(&["--calib", "/dev/zero"]),
+            &[],
+            "/dev/zero: cannot read it: a device, not a regular file",
+        ),
+        (
+            render(&[&at("big.obj")]),
+            &one_mib,
+            "big.obj: cannot read the file: 1.8 MiB, over the 1.0 MiB budget for OBJ files \
+             (FISHEYE_MAX_INPUT_MIB sets it, in MiB)",
+        ),
+        (
+            render(&[&at("big.obj")]),
+            &[("FISHEYE_MAX_INPUT_MIB", "lots")],
+            "FISHEYE_MAX_INPUT_MIB=\"lots\": give the budget as a whole number of MiB",
+        ),
+    ];
+    for (args, env, needle) in cases {
+        let args: Vec<&str> = args.iter().map(String::as_str).collect();
+        let (code, stderr) = fisheye_bounded(&args, env);
+        assert_eq!(code, Some(1), "{args:?}: {stderr}");
+        assert_eq!(stderr.matches(needle).count(), 1, "{args:?}: {stderr:?}");
+        assert!(!stderr.contains("panicked"), "{args:?}: {stderr}");
+        assert!(!Path::new(&at("out.png")).exists(), "{args:?}");
+    }
+    // Within the budget the same file renders.
+    let output = std::process::Command::new(env!("CARGO_BIN_EXE_fisheye"))
+        .args([
+            "render",
+            &at("big.obj"),
+            "--size",
+            "16x12",
+            "--spp",
+            "1",
+            "-o",
+        ])
+        .arg(at("out.png"))
+        .env("FISHEYE_MAX_INPUT_MIB", "3")
+        .output()
+        .unwrap();
+    assert!(
+        output.status.success(),
+        "{}",
+        String::from_utf8_lossy(&output.stderr)
+    );
+    std::fs::remove_dir_all(dir).unwrap();
 }

@@ -103,6 +103,10 @@ fn frames_recorded_into_the_callers_encoder_and_texture_match_the_one_call_rende
         &at_home.colour,
     );
     assert_eq!(ctx.read_buffer::<u32>(ids).unwrap(), at_home.ids);
+    let read_back = renderer.read_back().unwrap();
+    assert_same("the read-back colour", &read_back.colour, &at_home.colour);
+    assert_eq!(read_back.ids, at_home.ids);
+    assert_eq!(read_back.geometry, at_home.geometry);
     let read = |t: &wgpu::Texture| ctx.read_texture(t).unwrap();
     assert_same("the first frame", &read(&targets[0]), &at_home.colour);
     assert_same("the moved frame", &read(&targets[1]), &at_moved.colour);
@@ -149,6 +153,14 @@ fn cube_map_frames_match_the_cube_map_render() {
             method.name(),
             &ctx.read_texture(&target).unwrap(),
             &expected,
+        );
+        let read_back = renderer.read_back().unwrap();
+        assert_same(method.name(), &read_back.colour, &expected);
+        assert!(
+            read_back
+                .ids
+                .iter()
+                .all(|&id| id == fisheye_rt::trace::NO_HIT)
         );
     }
 }

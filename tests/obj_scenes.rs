@@ -106,7 +106,7 @@ fn bad_obj_files_are_errors_or_warnings_naming_the_problem() {
     let missing = dir.join("missing.obj");
     let message = load_obj(&missing).err().unwrap().to_string();
     assert!(
-        message.contains("missing.obj") && message.contains("cannot open"),
+        message.contains("missing.obj") && message.contains("cannot read the file"),
         "{message}"
     );
 
@@ -198,4 +198,105 @@ fn the_headlight_follows_the_camera() {
         "mean radiance from behind: {followed:.3} with the headlight at the eye, {left:.3} without"
     );
     assert!(followed > 2.0 * left, "{followed} vs {left}");
+}
+
+/// A bare OBJ framed for a lens: its bounding sphere fills `FRAME_FILL` of the picture, for
+/// lenses from a 90° rectilinear to a 360° equidistant (which stops at `WIDEST_FRAMING`) and
+/// a calibrated one. Measured through
+/// the lens's f64 pixel directions, apart from the framing's own projections: along the row
+/// and column through the sphere's centre, the share of the lit pixels (those inside the
+/// picture) whose rays meet the sphere.
+#[test]
+fn bare_objs_fill_the_same_share_of_every_lens() {
+    use fisheye_rt::scene::{FRAME_FILL, WIDEST_FRAMING};
+    use fisheye_rt::trace::world_directions;
+    use glam::DVec3;
+    let loaded = load_obj(&shared("scanned/stanford-bunny.obj"))
+        .unwrap()
+        .scene;
+    let (lo, hi) = loaded.framed.expect("a bare OBJ's camera is placed for it");
+    let centre = (lo + hi) / 2.0;
+    let radius = (hi - lo).length() / 2.0;
+    let lenses = [
+        "canon-8-15mm@8mm",
+        "samyang-7.5mm",
+        "rectilinear:f=1",
+        "stereographic:f=0.4",
+        "equidistant:f=0.6",
+        "equidistant:f=0.3",
+        "orthographic:f=1.54",
+        "kb:fx=190.978,fy=190.973,cx=254.932,cy=256.897,k1=0.0034824,k2=0.00071503,\
+         k3=-0.0020532,k4=0.00020294",
+    ];
+    for spec in lenses {
+        let size = if spec.starts_with("kb") {
+            (512, 512)
+        } else {
+            (320, 240)
+        };
+        let lens = camera(spec, size.0, size.1);
+        let mut scene = loaded.clone();
+        let angle = scene.frame_for(&lens).expect("framed");
+        let eye = scene.camera.position;
+        assert_eq!(scene.camera.look_at, centre);
+        // The sphere as seen from the eye: the cone of half-angle asin(R / distance).
+        let seen = (radius / eye.distance(centre)).asin();
+        assert!((seen - angle).abs() < 1e-9, "{spec}: {seen} vs {angle}");
+        let Some(fisheye_rt::scene::Light::Point {
+            position,
+            intensity,
+        }) = scene.headlight.map(|i| scene.lights[i])
+        else {
+            panic!("a headlight")
+        };
+        assert_eq!(position, eye);
+        let irradiance = f64::from(intensity.x) / eye.distance_squared(centre);
+        assert!((irradiance - 0.6).abs() < 1e-5, "{spec}: {irradiance}");
+
+        let directions = world_directions(&lens, &scene.camera);
+        let axis = (centre - eye).normalize();
+        let meets = |d: DVec3| d.angle_between(axis) <= seen;
+        // The pixel whose ray is nearest the sphere's centre, then outwards from it.
+        let (w, h) = (size.0 as i64, size.1 as i64);
+        let nearest = (0..directions.len())
+            .filter_map(|i| directions[i].map(|d| (i, d.angle_between(axis))))
+            .min_by(|a, b| a.1.total_cmp(&b.1))
+            .unwrap()
+            .0 as i64;
+        let (ci, cj) = (nearest % w, nearest / w);
+        let mut shares = Vec::new();
+        for (di, dj) in [(1, 0), (-1, 0), (0, 1), (0, -1)] {
+            let (mut lit, mut inside) = (0, 0);
+            let (mut i, mut j) = (ci, cj);
+            while (0..w).contains(&i) && (0..h).contains(&j) {
+                match directions[(j * w + i) as usize] {
+                    Some(d) => {
+                        lit += 1;
+                        inside += usize::from(meets(d));
+                    }
+                    None => break,
+                }
+                i += di;
+                j += dj;
+            }
+            shares.push((inside as f64 / lit as f64, lit));
+        }
+        // The tightest direction is at the fill, to a pixel; the others within it. A lens
+        // past 200° would need the eye inside the sphere: it stops at the widest framing.
+        let (widest, lit) = shares
+            .iter()
+            .copied()
+            .max_by(|a, b| a.0.total_cmp(&b.0))
+            .unwrap();
+        let pixel = 1.5 / lit as f64;
+        let message = format!("{spec}: the sphere fills {shares:?} of the picture along its axes");
+        if angle == WIDEST_FRAMING.to_radians() {
+            assert!(
+                spec == "equidistant:f=0.3" && widest < FRAME_FILL,
+                "{message}"
+            );
+        } else {
+            assert!((widest - FRAME_FILL).abs() <= pixel, "{message}");
+        }
+    }
 }

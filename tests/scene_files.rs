@@ -250,7 +250,7 @@ fn bad_scene_files_are_clear_errors() {
         ),
         (
             "[[mesh]]\npath = \"missing.obj\"\n",
-            &["missing.obj", "cannot open"],
+            &["missing.obj", "cannot read the file"],
         ),
         (
             "[[mesh]]\npath = \"tri.obj\"\nshape = \"box\"\n",

@@ -329,7 +329,7 @@ impl GpuContext {
         }))
         .map_err(|source| Error::RequestDevice {
             adapter: describe(&adapter.get_info()),
-            source,
+            reason: source,
         })?;
         let lost = Arc::new(Mutex::new(None));
         let flag = lost.clone();

@@ -88,7 +88,14 @@ pub fn read(path: &Path) -> Result<Vec<Calibration>, LensError> {
         path: path.display().to_string(),
         reason,
     };
-    let text = std::fs::read_to_string(path).map_err(|e| bad(format!("cannot read it: {e}")))?;
+    let bytes = crate::input::read(path, crate::input::InputKind::Calibration)
+        .map_err(|e| bad(format!("cannot read it: {e}")))?;
+    let text = String::from_utf8(bytes).map_err(|e| {
+        bad(format!(
+            "not UTF-8 text (byte {})",
+            e.utf8_error().valid_up_to()
+        ))
+    })?;
     let format = CalibFormat::detect(&text).ok_or_else(|| {
         bad(
             "not a calibration this tool reads (OpenCV YAML/XML with camera_matrix, a Kalibr \

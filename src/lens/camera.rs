@@ -301,4 +301,47 @@ impl LensCamera {
         };
         Some(self.denormalized(n)).filter(|p| inside(*p))
     }
+
+    /// The half-angle about the optical axis whose image reaches `fraction` (in (0, 1]) of
+    /// the way from the axis's image to the edge of the picture (the image circle or the
+    /// frame, whichever comes first) along the image's axes, in the tightest of the four
+    /// directions: a sphere seen under this half-angle, centred on the axis, fills `fraction`
+    /// of the picture. `None` if the axis is outside the picture.
+    pub fn fill_angle(&self, fraction: f64) -> Option<f64> {
+        let centre = self.project(DVec3::Z)?;
+        // Camera space: x right, y down, z forward.
+        let towards = |theta: f64, (x, y): (f64, f64)| {
+            let (sin, cos) = theta.sin_cos();
+            DVec3::new(sin * x, sin * y, cos)
+        };
+        [(1.0, 0.0), (-1.0, 0.0), (0.0, 1.0), (0.0, -1.0)]
+            .into_iter()
+            .map(|axis| {
+                let reach = |theta| {
+                    self.project(towards(theta, axis))
+                        .map(|p| (p - centre).length())
+                };
+                let edge = last_true(0.0, std::f64::consts::PI, |t| reach(t).is_some());
+                let target = fraction * reach(edge).unwrap_or(0.0);
+                last_true(0.0, edge, |t| reach(t).is_some_and(|r| r <= target))
+            })
+            .reduce(f64::min)
+    }
+}
+
+/// The largest `x` in [`lo`, `hi`] with `holds(x)`, for a `holds` true at `lo` and, past some
+/// point, false: bisected to f64 precision.
+fn last_true(mut lo: f64, mut hi: f64, holds: impl Fn(f64) -> bool) -> f64 {
+    if holds(hi) {
+        return hi;
+    }
+    for _ in 0..64 {
+        let mid = 0.5 * (lo + hi);
+        if holds(mid) {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    lo
 }

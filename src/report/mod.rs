@@ -14,7 +14,7 @@ pub use comparison::{CompareEntry, CompareReport, Verdict, compare};
 
 pub use crate::bench::PathKind;
 use crate::bench::{Machine, Renderer, SceneSet, Setup};
-use crate::error::{Error, Result};
+use crate::error::Result;
 use crate::gpu::GpuContext;
 use crate::lens::LensCamera;
 use crate::plot;
@@ -120,10 +120,7 @@ pub fn file_stem(label: &str) -> String {
 }
 
 pub(crate) fn write_text(path: &Path, text: &str) -> Result<()> {
-    std::fs::write(path, text).map_err(|source| Error::Io {
-        path: path.to_path_buf(),
-        source,
-    })
+    crate::trace::write_file(path, text.as_bytes())
 }
 
 pub(crate) fn write_json(path: &Path, value: &impl Serialize) -> Result<()> {

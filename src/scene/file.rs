@@ -37,9 +37,12 @@ use std::path::{Path, PathBuf};
 use glam::{DAffine3, DMat3, DVec3, Vec3};
 use serde::Deserialize;
 
-use super::obj::{DEFAULT_AMBIENT, DEFAULT_SKY, Loaded, because, framing, load_into};
+use super::obj::{
+    DEFAULT_AMBIENT, DEFAULT_DISTANCE, DEFAULT_SKY, Loaded, because, framing, load_into,
+};
 use super::{Camera, Light, Material, MeshBuilder, ReadFile, Surface};
 use crate::error::{Error, Result};
+use crate::input::InputKind;
 
 type Triple = [f64; 3];
 
@@ -270,9 +273,9 @@ pub fn load_scene_file(path: &Path) -> Result<Loaded> {
 /// As [`load_scene_file`], reading the file and the files it names through `read`.
 pub fn load_scene_file_from(path: &Path, read: ReadFile) -> Result<Loaded> {
     let check = Check { path };
-    let bytes = read(path).map_err(|source| Error::Io {
+    let bytes = read(path, InputKind::SceneFile).map_err(|source| Error::Io {
         path: path.to_path_buf(),
-        source,
+        reason: source,
     })?;
     let text = match String::from_utf8(bytes) {
         Ok(text) => text,
@@ -375,6 +378,7 @@ pub fn load_scene_file_from(path: &Path, read: ReadFile) -> Result<Loaded> {
         Some(v) => check.colour("ambient", v)?,
         None => DEFAULT_AMBIENT,
     };
+    let mut framed = None;
     let (camera, path_keys) = match &file.camera {
         Some(c) => {
             let up = check.finite("camera.up", c.up)?;
@@ -390,12 +394,14 @@ pub fn load_scene_file_from(path: &Path, read: ReadFile) -> Result<Loaded> {
             (camera, keys)
         }
         None => {
-            let (lo, hi) = b.bounds().unwrap_or((DVec3::ZERO, DVec3::ZERO));
-            (framing(lo, hi).0, Vec::new())
+            let bounds = b.bounds().unwrap_or((DVec3::ZERO, DVec3::ZERO));
+            framed = Some(bounds);
+            (framing(bounds.0, bounds.1, DEFAULT_DISTANCE), Vec::new())
         }
     };
     let mut scene = b.finish(lights, sky, ambient, camera);
     scene.camera_path = path_keys;
+    scene.framed = framed;
     let emits = scene
         .materials
         .iter()

@@ -252,6 +252,7 @@ impl MeshBuilder {
             camera,
             camera_path: Vec::new(),
             headlight: None,
+            framed: None,
         }
     }
 }

@@ -11,15 +11,18 @@ pub mod obj;
 
 use glam::{DMat3, DVec3, Vec2, Vec3};
 
+use crate::input::InputKind;
+use crate::lens::LensCamera;
+
 pub use mesh::{MeshBuilder, checker};
 
 /// How loaders read the files a scene names: [`disk`], or bytes held in memory (tests and the
 /// fuzz targets).
-pub type ReadFile<'a> = &'a dyn Fn(&std::path::Path) -> std::io::Result<Vec<u8>>;
+pub type ReadFile<'a> = &'a dyn Fn(&std::path::Path, InputKind) -> std::io::Result<Vec<u8>>;
 
-/// Reads a file from the file system.
-pub fn disk(path: &std::path::Path) -> std::io::Result<Vec<u8>> {
-    std::fs::read(path)
+/// Reads a file from the file system, within its kind's budget (see [`crate::input`]).
+pub fn disk(path: &std::path::Path, kind: InputKind) -> std::io::Result<Vec<u8>> {
+    crate::input::read(path, kind)
 }
 
 /// How a surface scatters light in the Whitted model.
@@ -200,7 +203,21 @@ pub struct Scene {
     /// The point light (index into `lights`) that sits at the camera, as a bare OBJ's
     /// headlight does: [`Scene::set_camera`] moves it with the eye.
     pub headlight: Option<usize>,
+    /// The bounds the camera was placed to frame, where the scene did not give one (a bare
+    /// OBJ, a scene file without `[camera]`): [`Scene::frame_for`] re-frames them for a lens.
+    pub framed: Option<(DVec3, DVec3)>,
 }
+
+/// The share of the picture a scene's bounding sphere fills when [`Scene::frame_for`] places
+/// the camera (see [`LensCamera::fill_angle`]): 0.8, a margin of a fifth of the image
+/// circle's radius (or of the frame's half-height) around it.
+pub const FRAME_FILL: f64 = 0.8;
+
+/// The widest half-angle (degrees) under which [`Scene::frame_for`] sees the bounding
+/// sphere: 80°, the eye 1.015 radii from the centre, for lenses so wide (past 200°) that
+/// filling [`FRAME_FILL`] of their picture would put the eye inside the sphere; there the
+/// sphere fills less.
+pub const WIDEST_FRAMING: f64 = 80.0;
 
 impl Scene {
     /// Number of triangles.
@@ -221,6 +238,23 @@ impl Scene {
         {
             *position = pose.position;
         }
+    }
+
+    /// Moves a camera the scene did not give (see [`Scene::framed`]) so that the bounding
+    /// sphere fills [`FRAME_FILL`] of `lens`'s picture, looking at it from the same side;
+    /// the headlight, if any, goes with the eye, as bright at the scene's centre as before.
+    /// Returns the half-angle (radians) the sphere is seen under, or `None` (nothing moved) for
+    /// a scene with a camera of its own or a lens whose axis is outside its picture.
+    pub fn frame_for(&mut self, lens: &LensCamera) -> Option<f64> {
+        let (lo, hi) = self.framed?;
+        let angle = lens
+            .fill_angle(FRAME_FILL)?
+            .min(WIDEST_FRAMING.to_radians());
+        self.camera = obj::framing(lo, hi, 1.0 / angle.sin());
+        if let Some(light) = self.headlight.and_then(|i| self.lights.get_mut(i)) {
+            *light = obj::headlight(&self.camera);
+        }
+        Some(angle)
     }
 
     /// The axis-aligned bounds of all triangles (`None` when empty).

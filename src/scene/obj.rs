@@ -8,6 +8,7 @@ use glam::{DVec3, Vec2, Vec3};
 use super::lint::{self, LineError};
 use super::{Camera, Light, Material, MeshBuilder, ReadFile, Scene, Surface, Texture};
 use crate::error::{Error, Result};
+use crate::input::InputKind;
 
 /// A loaded scene and what was repaired or ignored on the way, for the user to read.
 pub struct Loaded {
@@ -29,7 +30,7 @@ fn material(
     dir: &Path,
     read: ReadFile,
     warnings: &mut Vec<String>,
-) -> Material {
+) -> Result<Material> {
     let surface = match m.illumination_model {
         Some(3 | 5) => Surface::Mirror,
         Some(4 | 6 | 7) => Surface::Glass,
@@ -44,11 +45,20 @@ fn material(
         Some([x]) => Vec3::splat(*x),
         _ => Vec3::ONE,
     };
-    let diffuse_texture = m.diffuse_texture.as_ref().and_then(|name| {
+    let mut diffuse_texture = None;
+    if let Some(name) = &m.diffuse_texture {
         let path = dir.join(name.replace('\\', "/"));
-        let image = read(&path)
-            .map_err(|e| e.to_string())
-            .and_then(|bytes| image::load_from_memory(&bytes).map_err(|e| e.to_string()));
+        let image = match read(&path, InputKind::Texture) {
+            Ok(bytes) => image::load_from_memory(&bytes).map_err(|e| e.to_string()),
+            // A missing texture is common and harmless; a special or oversized file is not.
+            Err(e) if e.kind() == std::io::ErrorKind::NotFound => Err(e.to_string()),
+            Err(e) => {
+                return Err(Error::Io {
+                    path,
+                    reason: std::io::Error::other(format!("texture of material {}: {e}", m.name)),
+                });
+            }
+        };
         match image {
             Ok(img) => {
                 let rgba = img.to_rgba8();
@@ -58,18 +68,15 @@ fn material(
                     height: rgba.height(),
                     rgba: rgba.into_raw(),
                 });
-                Some(textures.len() as u32 - 1)
+                diffuse_texture = Some(textures.len() as u32 - 1);
             }
-            Err(e) => {
-                warnings.push(format!(
-                    "material {}: texture {}: {e}; using Kd alone",
-                    m.name,
-                    path.display()
-                ));
-                None
-            }
+            Err(e) => warnings.push(format!(
+                "material {}: texture {}: {e}; using Kd alone",
+                m.name,
+                path.display()
+            )),
         }
-    });
+    }
     // `d` is opacity; some exporters write `Tr` (= 1 - d) instead.
     let opacity = m
         .dissolve
@@ -84,7 +91,7 @@ fn material(
                 1.0
             }
         });
-    Material {
+    Ok(Material {
         name: m.name.clone(),
         opacity,
         surface,
@@ -95,7 +102,7 @@ fn material(
         emission: m.emissive.map_or(Vec3::ZERO, vec3),
         ior: m.optical_density.map_or(1.5, |n| n as f32),
         transmission,
-    }
+    })
 }
 
 /// An error on a line of an OBJ or MTL file.
@@ -120,7 +127,8 @@ pub fn load_into(
         path: path.to_path_buf(),
         message,
     };
-    let bytes = read(path).map_err(|e| obj_error(format!("cannot open the file: {e}")))?;
+    let bytes =
+        read(path, InputKind::Obj).map_err(|e| obj_error(format!("cannot read the file: {e}")))?;
     let text = lint::clean(&String::from_utf8_lossy(&bytes));
     let facts = lint::check_obj(&text).map_err(|e| line_error(path, e))?;
     let shown = path.display();
@@ -129,7 +137,7 @@ pub fn load_into(
     let mut mtls = HashMap::new();
     for name in &facts.mtllibs {
         let mtl_path = dir.join(name);
-        match read(&mtl_path) {
+        match read(&mtl_path, InputKind::Mtl) {
             Ok(bytes) => {
                 let mtl = lint::clean(&String::from_utf8_lossy(&bytes));
                 let checked = lint::check_mtl(&mtl).map_err(|e| line_error(&mtl_path, e))?;
@@ -137,10 +145,17 @@ pub fn load_into(
                 warnings.extend(checked.warnings.iter().map(|w| format!("{shown}: {w}")));
                 mtls.insert(PathBuf::from(name), mtl);
             }
-            Err(e) => warnings.push(format!(
+            // A missing MTL is common and harmless; a special or oversized file is not.
+            Err(e) if e.kind() == std::io::ErrorKind::NotFound => warnings.push(format!(
                 "{shown}: its MTL {} could not be read ({e}); using grey",
                 mtl_path.display()
             )),
+            Err(e) => {
+                return Err(Error::Io {
+                    path: mtl_path,
+                    reason: std::io::Error::other(format!("the MTL of {shown}: {e}")),
+                });
+            }
         }
     }
     let options = tobj::LoadOptions {
@@ -172,7 +187,7 @@ pub fn load_into(
     let converted: Vec<Material> = materials
         .iter()
         .map(|m| material(m, &mut textures, &dir, read, warnings))
-        .collect();
+        .collect::<Result<_>>()?;
     let texture_base = b.texture_count();
     for t in textures {
         b.texture(t);
@@ -273,32 +288,50 @@ pub const DEFAULT_SKY: Vec3 = Vec3::new(0.35, 0.4, 0.5);
 /// The ambient light of scenes that do not set one.
 pub const DEFAULT_AMBIENT: Vec3 = Vec3::splat(0.08);
 
-/// A camera that frames the box `lo`..`hi` from the front (+z, slightly above) at 1.3 bounding
-/// radii, whatever its units or offset, with a headlight at the camera (the first light) and
-/// a sun.
-pub fn framing(lo: DVec3, hi: DVec3) -> (Camera, Vec<Light>) {
+/// How far, in bounding radii, the automatic camera stands from a scene's centre before it
+/// knows the lens ([`super::Scene::frame_for`] moves it for one): 1.33, as the bounding sphere
+/// is seen under a half-angle of 48.6°.
+pub const DEFAULT_DISTANCE: f64 = 1.334_166_4;
+
+/// A camera that frames the box `lo`..`hi` from the front (+z, 13° above) at `distance`
+/// bounding radii from its centre, whatever its units or offset.
+pub fn framing(lo: DVec3, hi: DVec3, distance: f64) -> Camera {
     let centre = (lo + hi) / 2.0;
-    // Scaled so that the length of a box beyond 1e154 does not overflow.
+    let direction = DVec3::new(0.0, 0.3, 1.3).normalize();
+    Camera {
+        position: centre + direction * (distance * bounding_radius(lo, hi)),
+        look_at: centre,
+        up: DVec3::Y,
+    }
+}
+
+/// The radius of the box `lo`..`hi`'s bounding sphere (at least 1e-6), scaled so that the
+/// length of a box beyond 1e154 does not overflow.
+pub fn bounding_radius(lo: DVec3, hi: DVec3) -> f64 {
     let half = (hi - lo) / 2.0;
     let scale = half.max_element().max(1e-6);
-    let radius = (scale * (half / scale).length()).max(1e-6);
-    let position = centre + DVec3::new(0.0, 0.3 * radius, 1.3 * radius);
-    let lights = vec![
-        Light::Point {
-            position,
-            intensity: Vec3::splat((0.6 * (1.3 * radius).powi(2)) as f32),
-        },
+    (scale * (half / scale).length()).max(1e-6)
+}
+
+/// A headlight at `camera`'s eye that gives 0.6 irradiance at the scene's centre (its look-at
+/// point), and a sun from above and behind the viewer's left: a bare OBJ's lights.
+pub fn headlight_and_sun(camera: &Camera) -> Vec<Light> {
+    vec![
+        headlight(camera),
         Light::Directional {
             direction: DVec3::new(-0.3, -1.0, -0.4).normalize(),
             irradiance: Vec3::splat(0.6),
         },
-    ];
-    let camera = Camera {
-        position,
-        look_at: centre,
-        up: DVec3::Y,
-    };
-    (camera, lights)
+    ]
+}
+
+/// A point light at `camera`'s eye giving 0.6 irradiance at its look-at point.
+pub(crate) fn headlight(camera: &Camera) -> Light {
+    let distance = camera.position.distance(camera.look_at);
+    Light::Point {
+        position: camera.position,
+        intensity: Vec3::splat((0.6 * distance * distance) as f32),
+    }
 }
 
 /// A bare OBJ as a scene, [`framing`] its bounds so that any OBJ shows something.
@@ -320,9 +353,15 @@ pub fn load_obj_from(path: &Path, read: ReadFile) -> Result<Loaded> {
         });
     }
     let (lo, hi) = b.bounds().unwrap_or((DVec3::ZERO, DVec3::ZERO));
-    let (camera, lights) = framing(lo, hi);
-    let mut scene = b.finish(lights, DEFAULT_SKY, DEFAULT_AMBIENT, camera);
+    let camera = framing(lo, hi, DEFAULT_DISTANCE);
+    let mut scene = b.finish(
+        headlight_and_sun(&camera),
+        DEFAULT_SKY,
+        DEFAULT_AMBIENT,
+        camera,
+    );
     scene.headlight = Some(0);
+    scene.framed = Some((lo, hi));
     Ok(Loaded { scene, warnings })
 }
 

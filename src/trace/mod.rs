@@ -3,6 +3,7 @@
 //! `cpu` holds the f64 reference the GPU output is tested against.
 
 pub mod cpu;
+mod display;
 mod output;
 mod ray_query;
 pub mod sampling;
@@ -10,7 +11,11 @@ pub mod sampling;
 use bytemuck::Pod;
 use glam::{DMat3, DVec3, Vec3};
 
-pub use output::{Channel, RenderOutput, colour_image, linear_to_srgb, save_png};
+pub use display::{
+    ColourFile, Display, MASKED_RGB, Tone, colour_image, colour_image_with, linear_to_srgb,
+    refuse_non_regular, save_png, write_atomically, write_colour, write_file,
+};
+pub use output::{Channel, RenderOutput};
 pub use ray_query::RayQueryScene;
 
 pub use crate::shared::{

@@ -8,6 +8,7 @@ use crate::error::{Error, Result};
 use crate::lens::ImageSize;
 
 use super::NO_HIT;
+use super::display::{colour_image, write_atomically};
 
 /// One rendered frame, row-major.
 #[derive(Clone, Debug)]
@@ -22,51 +23,6 @@ pub struct RenderOutput {
     pub geometry: Vec<[f32; 4]>,
     /// Scene triangle index of the primary hit, [`NO_HIT`] on a miss or a masked pixel.
     pub ids: Vec<u32>,
-}
-
-/// The sRGB transfer function (IEC 61966-2-1) of a linear value in [0, 1].
-pub fn linear_to_srgb(x: f32) -> f32 {
-    if x <= 0.0031308 {
-        12.92 * x
-    } else {
-        1.055 * x.powf(1.0 / 2.4) - 0.055
-    }
-}
-
-/// Masked pixels' colour in [`RenderOutput::to_image`] (sRGB).
-pub const MASKED_RGB: [u8; 3] = [0, 0, 0];
-
-/// The image of linear colours whose `w` is the lens's coverage (as [`RenderOutput::colour`]):
-/// sRGB-encoded and clamped, alpha the coverage (opaque where a pixel is covered, transparent
-/// where not, between at the edge of the image circle with several rays per pixel).
-pub fn colour_image(size: ImageSize, colour: &[[f32; 4]]) -> image::RgbaImage {
-    let mut out = Vec::with_capacity(colour.len() * 4);
-    for c in colour {
-        if c[3] > 0.0 {
-            for v in &c[..3] {
-                out.push((linear_to_srgb(v.clamp(0.0, 1.0)) * 255.0).round() as u8);
-            }
-            out.push((c[3].clamp(0.0, 1.0) * 255.0).round() as u8);
-        } else {
-            out.extend_from_slice(&MASKED_RGB);
-            out.push(0);
-        }
-    }
-    image::RgbaImage::from_raw(size.width, size.height, out).expect("width × height RGBA8 pixels")
-}
-
-/// Writes an image as PNG, creating the parent folder.
-pub fn save_png(image: &image::RgbaImage, path: &Path) -> Result<()> {
-    if let Some(parent) = path.parent().filter(|p| !p.as_os_str().is_empty()) {
-        std::fs::create_dir_all(parent).map_err(|source| Error::Io {
-            path: parent.to_path_buf(),
-            source,
-        })?;
-    }
-    image.save(path).map_err(|source| Error::Image {
-        path: path.to_path_buf(),
-        source,
-    })
 }
 
 impl RenderOutput {
@@ -134,20 +90,22 @@ fn write_array<T: npyz::Serialize + npyz::AutoSerialize>(
     shape: &[u64],
     data: impl IntoIterator<Item = T>,
 ) -> Result<()> {
-    let io = |source| Error::Io {
-        path: path.to_path_buf(),
-        source,
-    };
-    let file = std::fs::File::create(path).map_err(io)?;
-    use npyz::WriterBuilder;
-    let mut writer = npyz::WriteOptions::new()
-        .default_dtype()
-        .shape(shape)
-        .writer(std::io::BufWriter::new(file))
-        .begin_nd()
-        .map_err(io)?;
-    writer.extend(data).map_err(io)?;
-    writer.finish().map_err(io)
+    write_atomically(path, |temporary| {
+        let io = |reason| Error::Io {
+            path: path.to_path_buf(),
+            reason,
+        };
+        let file = std::fs::File::create(temporary).map_err(io)?;
+        use npyz::WriterBuilder;
+        let mut writer = npyz::WriteOptions::new()
+            .default_dtype()
+            .shape(shape)
+            .writer(std::io::BufWriter::new(file))
+            .begin_nd()
+            .map_err(io)?;
+        writer.extend(data).map_err(io)?;
+        writer.finish().map_err(io)
+    })
 }
 
 /// One array of a [`Channel`]: its per-pixel component count and the values, row-major.
@@ -243,12 +201,14 @@ impl RenderOutput {
             Encoding::SMALL_LOSSLESS,
             AnyChannels::sort(list),
         );
-        Image::from_layer(layer)
-            .write()
-            .to_file(path)
-            .map_err(|e| Error::Io {
-                path: path.to_path_buf(),
-                source: std::io::Error::other(e.to_string()),
-            })
+        write_atomically(path, |temporary| {
+            Image::from_layer(layer)
+                .write()
+                .to_file(temporary)
+                .map_err(|e| Error::Io {
+                    path: path.to_path_buf(),
+                    reason: std::io::Error::other(e.to_string()),
+                })
+        })
     }
 }

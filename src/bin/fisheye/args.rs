@@ -13,7 +13,7 @@ use fisheye_rt::lens::gpu::DirectionSource;
 use fisheye_rt::lens::{DirectionFormula, ImageSize, LensCamera, parse_spec};
 use fisheye_rt::raster::RasterMethod;
 use fisheye_rt::scene::Scene;
-use fisheye_rt::trace::Channel;
+use fisheye_rt::trace::{Channel, Tone};
 use glam::DVec3;
 
 /// How the scene is built and shaded, for `render`, `bench` and `compare`.
@@ -94,6 +94,22 @@ impl Method {
             Self::CubeForward => raster(RasterMethod::Forward),
             Self::CubeDeferred => raster(RasterMethod::Deferred),
             Self::CubeSingle => raster(RasterMethod::SinglePass),
+        }
+    }
+}
+
+/// The tone curve of `render --tone`.
+#[derive(Clone, Copy, ValueEnum)]
+pub(crate) enum ToneArg {
+    Aces,
+    Clamp,
+}
+
+impl From<ToneArg> for Tone {
+    fn from(t: ToneArg) -> Self {
+        match t {
+            ToneArg::Aces => Tone::Aces,
+            ToneArg::Clamp => Tone::Clamp,
         }
     }
 }

@@ -14,7 +14,7 @@ use fisheye_rt::lens::{
     CalibratedModel, ImageSize, LensCamera, LensModel, PRESET_FOV_DEGREES, PRESETS, parse_spec,
 };
 use fisheye_rt::report;
-use fisheye_rt::trace::save_png;
+use fisheye_rt::trace::{save_png, write_file};
 use glam::{DVec2, DVec3};
 
 use crate::args::{CameraArgs, Format};
@@ -212,7 +212,7 @@ pub(crate) fn convert(args: &CameraArgs, format: CalibFormat, out: &Path) -> Res
         },
         format,
     )?;
-    std::fs::write(out, text).with_context(|| format!("writing {}", out.display()))?;
+    write_file(out, text.as_bytes())?;
     println!("wrote {} ({})", out.display(), format.name());
     Ok(())
 }

@@ -9,16 +9,22 @@ use fisheye_rt::cube::{CubeMap, FACES, bordered};
 use fisheye_rt::gpu::GpuContext;
 use fisheye_rt::lens::ImageSize;
 use fisheye_rt::lens::gpu::DirectionSource;
-use fisheye_rt::trace::{Channel, RenderOptions, save_png, world_directions};
+use fisheye_rt::scene::FRAME_FILL;
+use fisheye_rt::trace::{
+    Channel, ColourFile, Display, RenderOptions, Tone, refuse_non_regular, world_directions,
+    write_colour,
+};
 
 use crate::args::{
-    ArrayFormat, CalibArgs, Directions, Method, Output, ShadingArgs, load_scene, parse_camera,
+    ArrayFormat, CalibArgs, Directions, Method, Output, ShadingArgs, ToneArg, load_scene,
+    parse_camera,
 };
 
 #[derive(clap::Args)]
 pub(crate) struct RenderArgs {
     /// The scene: `builtin:NAME` (see `fisheye scenes`), a scene file (`.toml`, see
-    /// `scenes/`), or an OBJ file, framed from the front with a headlight and a sun.
+    /// `scenes/`), or an OBJ file, framed from the front for the lens (its bounding sphere
+    /// fills 80% of the picture) with a headlight and a sun.
     #[arg(default_value = "builtin:default")]
     pub(crate) scene: String,
     /// Lens spec (see `fisheye lens list`).
@@ -57,9 +63,23 @@ pub(crate) struct RenderArgs {
     /// Primary ray directions: evaluated per pixel, or read from a table made once.
     #[arg(long, value_enum, default_value = "computed")]
     pub(crate) directions: Directions,
-    /// The colour image (PNG; alpha is the validity mask).
+    /// The colour image, by its extension: `.png` (sRGB through the exposure and tone curve)
+    /// or `.exr` (linear radiance times 2^EXPOSURE, no tone curve); alpha is the share of
+    /// the pixel the lens covers. Written to a temporary file and renamed into place.
     #[arg(long, short, default_value = "fisheye.png")]
     pub(crate) out: PathBuf,
+    /// Bits a channel of the colour image: 8 (PNG's default) or 16 for PNG; 16 (half float,
+    /// EXR's default) or 32 (float) for EXR.
+    #[arg(long)]
+    pub(crate) bits: Option<u32>,
+    /// Exposure in stops (EV): the radiance is scaled by 2^EXPOSURE before the tone curve.
+    #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
+    pub(crate) exposure: f32,
+    /// Tone curve from exposed radiance to the PNG's [0, 1]: `aces` (Narkowicz's 2015 fit of
+    /// the ACES filmic curve: highlights roll off instead of clipping) or `clamp` (linear,
+    /// clipped at 1: what `compare` and `validate` measure).
+    #[arg(long, value_enum, default_value = "aces")]
+    pub(crate) tone: ToneArg,
     /// Ground-truth arrays to write beside the image as OUT_STEM.NAME.npy (or .exr): range
     /// (distance to the primary hit), normal, id (triangle), direction (world-space ray), mask.
     #[arg(long, value_enum, value_delimiter = ',')]
@@ -71,6 +91,31 @@ pub(crate) struct RenderArgs {
 
 pub(crate) fn render(args: &RenderArgs) -> Result<()> {
     let started = Instant::now();
+    // Everything about the files first: a refused name costs no rendering.
+    let file = ColourFile::for_path(&args.out, args.bits)?;
+    if !args.exposure.is_finite() {
+        bail!(
+            "--exposure {}: give a finite number of stops",
+            args.exposure
+        );
+    }
+    let display = Display {
+        exposure: args.exposure,
+        tone: args.tone.into(),
+    };
+    let array_path = |channel: Channel| {
+        let extension = match args.format {
+            ArrayFormat::Npy => "npy",
+            ArrayFormat::Exr => "exr",
+        };
+        args.out
+            .with_extension(format!("{}.{extension}", channel.name()))
+    };
+    let channels: Vec<Channel> = args.outputs.iter().map(|&o| Channel::from(o)).collect();
+    refuse_non_regular(&args.out)?;
+    for &channel in &channels {
+        refuse_non_regular(&array_path(channel))?;
+    }
     let setup = Setup {
         method: args.method.method(),
         cube_size: args.cube_size,
@@ -93,6 +138,14 @@ pub(crate) fn render(args: &RenderArgs) -> Result<()> {
     let out = &args.out;
     let scene_spec = &args.scene;
     let mut scene = load_scene(scene_spec)?;
+    if let Some(angle) = scene.frame_for(&camera) {
+        println!(
+            "framed for the lens: the scene's bounding sphere seen under ±{:.1}°, {:.0}% of the \
+             picture",
+            angle.to_degrees(),
+            100.0 * FRAME_FILL
+        );
+    }
     if let Some(text) = &args.camera {
         let pose = parse_camera(text, &scene)?;
         scene.set_camera(pose);
@@ -150,31 +203,42 @@ pub(crate) fn render(args: &RenderArgs) -> Result<()> {
         ),
         None => println!("{what}; no GPU timestamps on this adapter"),
     }
-    save_png(&output.to_image(), out)?;
-    if !args.outputs.is_empty() {
+    write_colour(out, output.size, &output.colour, &display, file)?;
+    if !channels.is_empty() {
         let directions = world_directions(&camera, &scene.camera);
-        for channel in args.outputs.iter().map(|&o| Channel::from(o)) {
-            let path = match args.format {
-                ArrayFormat::Npy => {
-                    let path = out.with_extension(format!("{}.npy", channel.name()));
-                    output.write_npy(channel, &directions, &path)?;
-                    path
-                }
-                ArrayFormat::Exr => {
-                    let path = out.with_extension(format!("{}.exr", channel.name()));
-                    output.write_exr(channel, &directions, &path)?;
-                    path
-                }
-            };
+        for &channel in &channels {
+            let path = array_path(channel);
+            match args.format {
+                ArrayFormat::Npy => output.write_npy(channel, &directions, &path)?,
+                ArrayFormat::Exr => output.write_exr(channel, &directions, &path)?,
+            }
             println!("wrote {}", path.display());
         }
     }
     println!(
-        "wrote {} ({:.1} s in all)",
+        "wrote {} ({}; {:.1} s in all)",
         out.display(),
+        describe_file(file, &display),
         started.elapsed().as_secs_f64()
     );
     Ok(())
+}
+
+/// The colour file's format and how it shows radiance, in words.
+fn describe_file(file: ColourFile, display: &Display) -> String {
+    let exposure = format!("exposure {:+} EV", display.exposure);
+    match file {
+        ColourFile::Png8 | ColourFile::Png16 => {
+            let bits = if file == ColourFile::Png8 { 8 } else { 16 };
+            let tone = match display.tone {
+                Tone::Aces => "ACES tone curve",
+                Tone::Clamp => "clamped",
+            };
+            format!("{bits}-bit sRGB PNG, {exposure}, {tone}")
+        }
+        ColourFile::ExrHalf => format!("half-float linear OpenEXR, {exposure}"),
+        ColourFile::ExrFloat => format!("float linear OpenEXR, {exposure}"),
+    }
 }
 
 /// Which faces of the cube are rendered, how much of them, and the shadow maps.
