@@ -31,37 +31,62 @@ impl Method {
     }
 }
 
-/// One configuration measured: a method and, for cube maps, the face size.
+/// One configuration measured: a method and, for cube maps, the face size; for direct
+/// methods, the rays per pixel.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Setup {
     /// The method.
     pub method: Method,
     /// Face size in texels of a cube-map method; ignored by direct ray tracing.
     pub cube_size: u32,
+    /// Rays per pixel of a direct method (a square, see [`crate::trace::sampling`]); 1 for
+    /// cube maps, whose resampler takes one bilinear sample a pixel.
+    pub spp: u32,
 }
 
 impl Setup {
-    /// `rt`, `rq`, or the cube method and face size: `cube-forward@512`.
-    pub fn label(&self) -> String {
-        match self.method {
-            Method::Cube(_) => format!("{}@{}", self.method.name(), self.cube_size),
-            _ => self.method.name().to_string(),
+    /// A direct method at `spp` rays per pixel, or a cube method at face size `cube_size`.
+    pub fn direct(method: Method, spp: u32) -> Setup {
+        Setup {
+            method,
+            cube_size: 0,
+            spp,
         }
     }
 
-    /// Every setup of `methods`: direct methods once, cube methods once per face size.
-    pub fn all(methods: &[Method], cube_sizes: &[u32]) -> Vec<Setup> {
+    /// `rt@16spp`, `rq@1spp`, or the cube method and face size: `cube-forward@512`.
+    pub fn label(&self) -> String {
+        match self.method {
+            Method::Cube(_) => format!("{}@{}", self.method.name(), self.cube_size),
+            _ => format!("{}@{}spp", self.method.name(), self.spp),
+        }
+    }
+
+    /// The face size of a cube-map setup.
+    pub fn cube_size(&self) -> Option<u32> {
+        self.method.cube().map(|_| self.cube_size)
+    }
+
+    /// The rays per pixel of a direct setup.
+    pub fn spp(&self) -> Option<u32> {
+        self.method.cube().is_none().then_some(self.spp)
+    }
+
+    /// Every setup of `methods`: direct methods once per rays-per-pixel count of `spps`, cube
+    /// methods once per face size.
+    pub fn all(methods: &[Method], cube_sizes: &[u32], spps: &[u32]) -> Vec<Setup> {
         methods
             .iter()
             .flat_map(|&method| match method {
                 Method::Cube(_) => cube_sizes
                     .iter()
-                    .map(|&cube_size| Setup { method, cube_size })
-                    .collect(),
-                _ => vec![Setup {
-                    method,
-                    cube_size: 0,
-                }],
+                    .map(|&cube_size| Setup {
+                        method,
+                        cube_size,
+                        spp: 1,
+                    })
+                    .collect::<Vec<_>>(),
+                _ => spps.iter().map(|&spp| Setup::direct(method, spp)).collect(),
             })
             .collect()
     }
@@ -178,20 +203,26 @@ impl Renderer {
         setup: Setup,
         shadow_size: u32,
     ) -> Result<Self> {
-        let rays = (DirectionSource::Computed, 1);
-        Self::with_rays(ctx, camera, scenes, setup, shadow_size, rays)
+        Self::with_directions(
+            ctx,
+            camera,
+            scenes,
+            setup,
+            shadow_size,
+            DirectionSource::Computed,
+        )
     }
 
-    /// As [`Renderer::new`], with direct tracing's primary rays from `rays.0` and `rays.1` of
-    /// them per pixel (see [`crate::trace::sampling`]).
-    pub fn with_rays(
+    /// As [`Renderer::new`], with direct tracing's primary rays from `directions`.
+    pub fn with_directions(
         ctx: &GpuContext,
         camera: &LensCamera,
         scenes: &SceneSet,
         setup: Setup,
         shadow_size: u32,
-        rays: (DirectionSource, u32),
+        directions: DirectionSource,
     ) -> Result<Self> {
+        let rays = (directions, setup.spp);
         let scene = scenes.for_method(setup.method);
         let cube = match setup.method {
             Method::Cube(method) => Some(CubeSettings {
@@ -263,6 +294,39 @@ impl Renderer {
         match &self.path {
             Path::Cube(cube) => Some(cube),
             Path::Direct(_) => None,
+        }
+    }
+}
+
+/// Memory in use, for long runs: the process's resident set and the device memory wgpu's
+/// allocator holds.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct Memory {
+    /// Resident set size in MiB (`VmRSS` of `/proc/self/status`; `None` off Linux). On a CPU
+    /// driver it includes the "device" memory.
+    pub resident_mib: Option<f64>,
+    /// Device memory allocated through wgpu's allocator, in MiB (`None` where the backend
+    /// gives no allocator report).
+    pub gpu_mib: Option<f64>,
+}
+
+impl Memory {
+    /// The memory in use now.
+    pub fn now(ctx: &GpuContext) -> Memory {
+        let resident_mib = std::fs::read_to_string("/proc/self/status")
+            .ok()
+            .and_then(|status| {
+                let line = status.lines().find(|l| l.starts_with("VmRSS:"))?;
+                let kib: f64 = line.split_whitespace().nth(1)?.parse().ok()?;
+                Some(kib / 1024.0)
+            });
+        let gpu_mib = ctx
+            .device
+            .generate_allocator_report()
+            .map(|r| r.total_allocated_bytes as f64 / 1_048_576.0);
+        Memory {
+            resident_mib,
+            gpu_mib,
         }
     }
 }
@@ -450,9 +514,15 @@ mod tests {
         for m in Method::ALL {
             assert_eq!(Method::from_name(m.name()), Some(m));
         }
-        let setups = Setup::all(&[Method::Rt, Method::ALL[3]], &[512, 1024]);
+        let setups = Setup::all(&[Method::Rt, Method::ALL[3]], &[512, 1024], &[1, 16]);
         let labels: Vec<String> = setups.iter().map(Setup::label).collect();
-        assert_eq!(labels, ["rt", "cube-forward@512", "cube-forward@1024"]);
+        let wanted = [
+            "rt@1spp",
+            "rt@16spp",
+            "cube-forward@512",
+            "cube-forward@1024",
+        ];
+        assert_eq!(labels, wanted);
     }
 
     #[test]

@@ -1,7 +1,8 @@
 //! How wrong each method is: error against a reference image over the pixels both have
 //! ([`ImageError`]), an image of where the error is ([`error_map`]), the supersampled
-//! reference for anti-aliased comparisons ([`supersampled`]), and which setups no other beats
-//! in both time and error ([`pareto_front`]).
+//! reference of lens validation ([`supersampled`]), the perceptual ꟻLIP error
+//! ([`flip_error`]), which setups no other beats in both time and error ([`pareto_front`]),
+//! and the time a family of setups needs to reach an error ([`Envelope`]).
 //!
 //! Errors are measured on what a viewer sees: colours clamped to [0, 1] and sRGB-encoded, as
 //! the PNGs hold them, so an MSE of 0.001 (the thesis's "0.1 %") is a mean squared difference
@@ -37,8 +38,10 @@ fn shown(c: f32) -> f64 {
     f64::from(linear_to_srgb(c.clamp(0.0, 1.0)))
 }
 
+/// Whether the lens covers (some of) the pixel: one ray per pixel gives 0 or 1, several the
+/// covered share.
 fn valid(c: &[f32; 4]) -> bool {
-    c[3] == 1.0
+    c[3] > 0.0
 }
 
 /// The error of `image` against `reference` (linear colours with the mask in `w`, as
@@ -154,17 +157,111 @@ pub fn supersampled(
         .collect())
 }
 
+/// Errors within this fraction of each other are equal for the Pareto front: the reference
+/// is itself an estimate, and 256 stratified rays per pixel leave it an error of up to 1/16
+/// of a 16-ray setup's (independent samples; stratification does better), about 6% of the
+/// compared error.
+pub const EQUAL_ERROR: f64 = 0.05;
+
 /// For points `(time, error)`, whether each is on the Pareto front: no other point is at
-/// least as good in both and better in one.
+/// least as fast and at least as good, errors within [`EQUAL_ERROR`] counting as equal (a
+/// slower point whose error is lower by noise alone is not a new point).
 pub fn pareto_front(points: &[(f64, f64)]) -> Vec<bool> {
     points
         .iter()
         .map(|&(t, e)| {
             !points
                 .iter()
-                .any(|&(t2, e2)| t2 <= t && e2 <= e && (t2 < t || e2 < e))
+                .any(|&(t2, e2)| t2 <= t && e2 <= e * (1.0 + EQUAL_ERROR) && (t2 < t || e2 < e))
         })
         .collect()
+}
+
+/// The lower envelope of a family of setups (direct RT over rays per pixel, cube maps over
+/// face sizes): the time it needs to reach an error, interpolated between its Pareto points
+/// linearly in log time against log error (time and error follow power laws in rays per
+/// pixel and in face size, which are straight lines there).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Envelope {
+    /// `(time, error)` of the family's Pareto points, fastest first (errors falling).
+    pub points: Vec<(f64, f64)>,
+}
+
+impl Envelope {
+    /// The envelope of `(time, error)` points: those on their [`pareto_front`] (so a slower
+    /// setup within [`EQUAL_ERROR`] of a faster one is no level of its own).
+    pub fn of(points: &[(f64, f64)]) -> Envelope {
+        let mut front: Vec<(f64, f64)> = points
+            .iter()
+            .zip(pareto_front(points))
+            .filter_map(|(&p, on)| on.then_some(p))
+            .collect();
+        front.sort_by(|a, b| a.0.total_cmp(&b.0));
+        front.dedup();
+        Envelope { points: front }
+    }
+
+    /// The least error the family reaches, and the time it takes.
+    pub fn best(&self) -> Option<(f64, f64)> {
+        self.points.last().copied()
+    }
+
+    /// The time the family needs to reach `error` or less: its fastest setup's where that
+    /// one is good enough, interpolated between the two setups that bracket it, `None`
+    /// below the family's least error.
+    pub fn time_to_reach(&self, error: f64) -> Option<f64> {
+        let k = self.points.iter().position(|&(_, e)| e <= error)?;
+        if k == 0 {
+            return Some(self.points[0].0);
+        }
+        let ((t0, e0), (t1, e1)) = (self.points[k - 1], self.points[k]);
+        let s = (error.ln() - e0.ln()) / (e1.ln() - e0.ln());
+        Some((t0.ln() + s * (t1.ln() - t0.ln())).exp())
+    }
+}
+
+/// The mean ꟻLIP error (Andersson et al., "FLIP: A Difference Evaluator for Alternating
+/// Images", HPG 2020; NVIDIA's implementation, through the `nv-flip` crate) of `image`
+/// against `reference` over the pixels valid in both, on displayed values as [`image_error`]
+/// takes them (8-bit sRGB: LDR-ꟻLIP), at 67 pixels per degree (a 0.7 m wide 4K monitor seen
+/// from 0.7 m, ꟻLIP's default). 0 is identical; 1 the largest difference. Pixels valid in
+/// only one image are black in both, so the mask's edge is not counted as an error.
+pub fn flip_error(size: ImageSize, reference: &[[f32; 4]], image: &[[f32; 4]]) -> f64 {
+    assert_eq!(reference.len(), image.len(), "images of one size");
+    let both: Vec<bool> = reference
+        .iter()
+        .zip(image)
+        .map(|(r, m)| valid(r) && valid(m))
+        .collect();
+    let bytes = |colour: &[[f32; 4]]| -> Vec<u8> {
+        colour
+            .iter()
+            .zip(&both)
+            .flat_map(|(c, &on)| {
+                [0, 1, 2].map(|k| {
+                    if on {
+                        (shown(c[k]) * 255.0).round() as u8
+                    } else {
+                        0
+                    }
+                })
+            })
+            .collect()
+    };
+    let flip_image =
+        |colour: Vec<u8>| nv_flip::FlipImageRgb8::with_data(size.width, size.height, &colour);
+    let map = nv_flip::flip(
+        flip_image(bytes(reference)),
+        flip_image(bytes(image)),
+        nv_flip::DEFAULT_PIXELS_PER_DEGREE,
+    )
+    .to_vec();
+    let (sum, n) = map
+        .iter()
+        .zip(&both)
+        .filter(|&(_, &on)| on)
+        .fold((0.0, 0usize), |(s, n), (&e, _)| (s + f64::from(e), n + 1));
+    sum / n.max(1) as f64
 }
 
 #[cfg(test)]
@@ -228,5 +325,78 @@ mod tests {
             pareto_front(&points),
             [true, true, false, true, false, true]
         );
+        // Slower by a quarter for 3% less error: noise, not a new point; for 10% less, one.
+        assert_eq!(pareto_front(&[(2.0, 3.0), (2.5, 2.91)]), [true, false]);
+        assert_eq!(pareto_front(&[(2.0, 3.0), (2.5, 2.7)]), [true, true]);
+    }
+
+    /// Time to reach an error: the fastest setup's above its error, log-log interpolation
+    /// between setups, nothing below the best.
+    #[test]
+    fn envelopes_interpolate_in_log_time_and_log_error() {
+        // 1, 4 and 16 rays: error falls 4x per 4x time; a dominated point is left out, and so
+        // is one only 2% better than a faster one.
+        let family = Envelope::of(&[
+            (10.0, 4e-3),
+            (40.0, 1e-3),
+            (50.0, 2e-3),
+            (45.0, 0.98e-3),
+            (160.0, 2.5e-4),
+        ]);
+        assert_eq!(family.points, [(10.0, 4e-3), (40.0, 1e-3), (160.0, 2.5e-4)]);
+        assert_eq!(family.best(), Some((160.0, 2.5e-4)));
+        assert_eq!(family.time_to_reach(1e-2), Some(10.0));
+        assert_eq!(family.time_to_reach(4e-3), Some(10.0));
+        let at = |e: f64| family.time_to_reach(e).unwrap();
+        assert!((at(2e-3) - 20.0).abs() < 1e-9, "{}", at(2e-3));
+        assert!((at(1e-3) - 40.0).abs() < 1e-9);
+        assert!((at(5e-4) - 80.0).abs() < 1e-9);
+        assert_eq!(family.time_to_reach(2e-4), None);
+        assert_eq!(Envelope::of(&[]).time_to_reach(1.0), None);
+    }
+
+    /// ꟻLIP is NVIDIA's own implementation; these check how it is called: identical images
+    /// score 0, the score grows with the difference, stays in [0, 1], and pixels outside
+    /// either mask do not count.
+    #[test]
+    fn flip_grows_with_the_difference_and_ignores_masked_pixels() {
+        let size = ImageSize::new(32, 32).unwrap();
+        let pattern: Vec<[f32; 4]> = (0..1024)
+            .map(|p| {
+                let v = if (p % 32 / 4 + p / 128) % 2 == 0 {
+                    0.8
+                } else {
+                    0.1
+                };
+                [v, v * 0.5, 0.2, 1.0]
+            })
+            .collect();
+        assert_eq!(flip_error(size, &pattern, &pattern), 0.0);
+        let shifted = |by: f32| -> Vec<[f32; 4]> {
+            pattern
+                .iter()
+                .map(|c| [c[0] + by, c[1] + by, c[2], 1.0])
+                .collect()
+        };
+        let (small, large) = (
+            flip_error(size, &pattern, &shifted(0.02)),
+            flip_error(size, &pattern, &shifted(0.2)),
+        );
+        assert!(
+            0.0 < small && small < large && large <= 1.0,
+            "{small} {large}"
+        );
+        let black = vec![[0.0, 0.0, 0.0, 1.0]; 1024];
+        let white = vec![[1.0, 1.0, 1.0, 1.0]; 1024];
+        assert!(flip_error(size, &black, &white) > 0.9);
+        // Masking the whole left half of one image: only the right half is compared.
+        let mut masked = shifted(0.2);
+        for (p, pixel) in masked.iter_mut().enumerate() {
+            if p % 32 < 16 {
+                *pixel = [9.0, 0.0, 9.0, 0.0];
+            }
+        }
+        let half = flip_error(size, &pattern, &masked);
+        assert!((half - large).abs() < 0.2 * large, "{half} {large}");
     }
 }

@@ -99,7 +99,7 @@ pub struct Series {
     pub points: Vec<(f64, f64)>,
 }
 
-/// A point of the time-against-error plot.
+/// A point of the time-against-error plot (filled when on the Pareto front).
 pub struct TradeOff {
     /// Its label beside the point (the colour tells the method).
     pub label: String,
@@ -154,10 +154,18 @@ fn legend<'a, CT: plotters::coord::CoordTranslate>(
     Ok(())
 }
 
-/// A tick label with three significant figures at most.
+/// A tick label with three significant figures at most and no trailing zeros; below 0.01
+/// in scientific notation.
 fn tick(v: f64) -> String {
-    let decimals = (2 - v.abs().max(1e-12).log10().floor() as i32).clamp(0, 6) as usize;
-    format!("{v:.decimals$}")
+    if v.abs() < 0.01 && v != 0.0 {
+        return format!("{v:.0e}");
+    }
+    let decimals = (2 - v.abs().log10().floor() as i32).clamp(0, 6) as usize;
+    let text = format!("{v:.decimals$}");
+    match text.contains('.') {
+        true => text.trim_end_matches('0').trim_end_matches('.').to_string(),
+        false => text,
+    }
 }
 
 /// Frame rate (y) against frame number along the path (x), one line per series.
@@ -198,13 +206,81 @@ pub fn fps_along_path(path: &Path, title: &str, y_label: &str, series: &[Series]
     })
 }
 
+/// Tick values for a log axis over `lo..hi`: 1, 2 and 5 times powers of ten, or every
+/// integer multiple where that gives fewer than four, or only the powers where it gives more
+/// than twelve.
+fn log_ticks(lo: f64, hi: f64) -> Vec<f64> {
+    let within = |mantissas: &[f64]| -> Vec<f64> {
+        let (first, last) = (lo.log10().floor() as i32, hi.log10().ceil() as i32);
+        (first..=last)
+            // Divided for negative powers: 6 / 1e4 is the double nearest 0.0006.
+            .flat_map(|k| {
+                mantissas.iter().map(move |m| match k {
+                    0.. => m * 10f64.powi(k),
+                    _ => m / 10f64.powi(-k),
+                })
+            })
+            .filter(|v| (lo..=hi).contains(v))
+            .collect()
+    };
+    let nice = within(&[1.0, 2.0, 5.0]);
+    if nice.len() < 4 {
+        within(&[1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0, 8.0, 9.0])
+    } else if nice.len() > 12 {
+        within(&[1.0])
+    } else {
+        nice
+    }
+}
+
+/// Where each of `labels` (anchored at pixel points, `width` pixels wide) goes: the first of
+/// several offsets around its point whose box overlaps no label placed before it and no
+/// point, else the first offset.
+fn place_labels(anchors: &[(i32, i32)], widths: &[i32], height: i32) -> Vec<(i32, i32)> {
+    let offsets = |w: i32| {
+        [
+            (9, -height - 4),
+            (9, 4),
+            (-w - 9, -height - 4),
+            (-w - 9, 4),
+            (9, -height / 2),
+            (-w - 9, -height / 2),
+            (-w / 2, -height - 12),
+            (-w / 2, 12),
+        ]
+    };
+    let overlaps = |a: (i32, i32, i32, i32), b: (i32, i32, i32, i32)| {
+        a.0 < b.0 + b.2 && b.0 < a.0 + a.2 && a.1 < b.1 + b.3 && b.1 < a.1 + a.3
+    };
+    let dots: Vec<(i32, i32, i32, i32)> = anchors
+        .iter()
+        .map(|&(x, y)| (x - 7, y - 7, 14, 14))
+        .collect();
+    let mut placed: Vec<(i32, i32, i32, i32)> = Vec::new();
+    anchors
+        .iter()
+        .zip(widths)
+        .map(|(&(x, y), &w)| {
+            let boxes = offsets(w).map(|(dx, dy)| (x + dx, y + dy, w, height));
+            let free = boxes
+                .iter()
+                .find(|b| !placed.iter().chain(&dots).any(|o| overlaps(**b, *o)))
+                .unwrap_or(&boxes[0]);
+            placed.push(*free);
+            (free.0 - x, free.1 - y)
+        })
+        .collect()
+}
+
 /// Time per frame (x, log) against error (y, log), a labelled point per setup coloured by
-/// method, the Pareto front joined by a dashed black line.
+/// method (filled where it is on the Pareto front), and each family's lower envelope as a
+/// line (`envelopes`: direct RT first, then the cube maps).
 pub fn time_against_error(
     path: &Path,
     title: &str,
     error_label: &str,
     points: &[TradeOff],
+    envelopes: &[Series],
 ) -> Result<()> {
     write_png(path, |root| {
         let (x0, x1) = log_bounds(points.iter().map(|p| p.ms));
@@ -214,36 +290,46 @@ pub fn time_against_error(
             .margin(14)
             .x_label_area_size(45)
             .y_label_area_size(80)
-            .build_cartesian_2d((x0..x1).log_scale(), (y0..y1).log_scale())?;
+            .build_cartesian_2d(
+                (x0..x1).log_scale().with_key_points(log_ticks(x0, x1)),
+                (y0..y1).log_scale().with_key_points(log_ticks(y0, y1)),
+            )?;
         chart
             .configure_mesh()
             .x_desc("GPU ms per frame (log)")
             .y_desc(error_label)
             .label_style((FAMILY, 15))
             .light_line_style(WHITE)
-            .x_labels(8)
-            .y_labels(8)
+            .bold_line_style(RGBColor(225, 225, 225))
             .x_label_formatter(&|v| tick(*v))
-            .y_label_formatter(&|v| format!("{v:.0e}"))
+            .y_label_formatter(&|v| tick(*v))
             .draw()?;
-        let mut front: Vec<(f64, f64)> = points
+        let family_colours = [method_colour("rt"), RGBColor(90, 90, 90)];
+        for (series, &colour) in envelopes.iter().zip(&family_colours) {
+            let line: Vec<(f64, f64)> = series
+                .points
+                .iter()
+                .map(|&(t, e)| (t, e.max(1e-12)))
+                .collect();
+            chart
+                .draw_series(DashedLineSeries::new(line, 7, 4, colour.stroke_width(2)))?
+                .label(series.label.clone())
+                .legend(move |(x, y)| {
+                    PathElement::new(vec![(x, y), (x + 20, y)], colour.stroke_width(2))
+                });
+        }
+        let anchors: Vec<(i32, i32)> = points
             .iter()
-            .filter(|p| p.pareto)
-            .map(|p| (p.ms, p.error.max(1e-12)))
+            .map(|p| chart.backend_coord(&(p.ms, p.error.max(1e-12))))
             .collect();
-        front.sort_by(|a, b| a.0.total_cmp(&b.0));
-        // A staircase: each front point holds its error until the next, faster-to-better one.
-        let stairs: Vec<(f64, f64)> = front
-            .windows(2)
-            .flat_map(|w| [w[0], (w[1].0, w[0].1)])
-            .chain(front.last().copied())
+        // About 7 pixels a character at 13 px.
+        let widths: Vec<i32> = points
+            .iter()
+            .map(|p| 7 * p.label.chars().count() as i32)
             .collect();
-        chart
-            .draw_series(DashedLineSeries::new(stairs, 6, 4, BLACK.stroke_width(1)))?
-            .label("Pareto front")
-            .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], BLACK));
+        let offsets = place_labels(&anchors, &widths, 13);
         let mut methods: Vec<&str> = Vec::new();
-        for p in points {
+        for (p, &(dx, dy)) in points.iter().zip(&offsets) {
             let colour = method_colour(p.method);
             let style = if p.pareto {
                 colour.filled()
@@ -253,7 +339,7 @@ pub fn time_against_error(
             let series = chart.draw_series(std::iter::once(
                 EmptyElement::at((p.ms, p.error.max(1e-12)))
                     + Circle::new((0, 0), 6, style)
-                    + Text::new(p.label.clone(), (8, -16), (FAMILY, 13)),
+                    + Text::new(p.label.clone(), (dx, dy), (FAMILY, 13)),
             ))?;
             if !methods.contains(&p.method) {
                 methods.push(p.method);
@@ -311,4 +397,45 @@ pub fn error_against_angle(path: &Path, title: &str, series: &[Series], bound: f
         }
         legend(&mut chart)
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Log axes get 4 to 12 readable ticks over any span, short labels.
+    #[test]
+    fn log_axes_get_readable_ticks() {
+        assert_eq!(log_ticks(6.0, 400.0), [10.0, 20.0, 50.0, 100.0, 200.0]);
+        // Less than a decade: every multiple.
+        let narrow = log_ticks(3.1e-4, 1.3e-3);
+        assert_eq!(narrow, [4e-4, 5e-4, 6e-4, 7e-4, 8e-4, 9e-4, 1e-3]);
+        // Many decades: the powers alone.
+        assert_eq!(log_ticks(1e-9, 1.0).len(), 10);
+        let labels: Vec<String> = [10.0, 2.5, 0.02, 0.125, 5e-3, 1500.0].map(tick).to_vec();
+        assert_eq!(labels, ["10", "2.5", "0.02", "0.125", "5e-3", "1500"]);
+    }
+
+    /// Labels of crowded points are moved until no two overlap each other or a point.
+    #[test]
+    fn crowded_labels_do_not_overlap() {
+        let anchors = [(100, 100), (104, 101), (108, 99), (300, 300)];
+        let widths = [21, 21, 35, 14];
+        let offsets = place_labels(&anchors, &widths, 13);
+        let boxes: Vec<(i32, i32, i32, i32)> = anchors
+            .iter()
+            .zip(&offsets)
+            .zip(&widths)
+            .map(|((&(x, y), &(dx, dy)), &w)| (x + dx, y + dy, w, 13))
+            .collect();
+        for (i, a) in boxes.iter().enumerate() {
+            for b in &boxes[i + 1..] {
+                let apart =
+                    a.0 >= b.0 + b.2 || b.0 >= a.0 + a.2 || a.1 >= b.1 + b.3 || b.1 >= a.1 + a.3;
+                assert!(apart, "{a:?} overlaps {b:?}");
+            }
+        }
+        // A lone point keeps the first place: above and to the right.
+        assert_eq!(offsets[3], (9, -17));
+    }
 }

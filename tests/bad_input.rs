@@ -644,3 +644,159 @@ fn special_and_oversized_inputs_are_refused_within_bounds() {
     );
     std::fs::remove_dir_all(dir).unwrap();
 }
+
+/// The clauses of an error message (split at ": " and "; "), each of which must appear once:
+/// a cause repeated in its own context ("X: reason: reason") reads as two failures.
+fn repeated_clause(message: &str) -> Option<String> {
+    let clauses: Vec<String> = message
+        .split(": ")
+        .flat_map(|c| c.split("; "))
+        .map(|c| c.trim().to_lowercase())
+        .filter(|c| c.len() > 3)
+        .collect();
+    clauses
+        .iter()
+        .enumerate()
+        .find(|(i, c)| clauses[i + 1..].contains(c))
+        .map(|(_, c)| c.clone())
+}
+
+/// One of each kind of error in the README's bad-input table, from the command line: exit
+/// status 1, the problem named, no panic, no image, and no clause said twice (the OS's reason,
+/// the file, the parameter).
+#[test]
+fn every_error_says_each_clause_once() {
+    assert_eq!(
+        repeated_clause("a.obj: cannot read: No such file: No such file"),
+        Some("no such file".into())
+    );
+    assert_eq!(
+        repeated_clause("a.obj: line 4: broken; line 5: broken"),
+        Some("broken".into())
+    );
+    assert_eq!(repeated_clause("a.obj: line 4: face vertex \"x\""), None);
+
+    let dir = temp_dir("once");
+    let at = |name: &str| dir.join(name).to_str().unwrap().to_string();
+    std::fs::create_dir_all(dir.join("folder.obj")).unwrap();
+    std::fs::create_dir_all(dir.join("folder.png")).unwrap();
+    let status = std::process::Command::new("mkfifo")
+        .arg(at("pipe.obj"))
+        .status()
+        .unwrap();
+    assert!(status.success());
+    let files: [(&str, String); 11] = [
+        ("bad-face.obj", format!("{TRIANGLE}f 1 2 x\n")),
+        ("bad-index.obj", format!("{TRIANGLE}f 1 2 9\n")),
+        (
+            "bad-mtl.obj",
+            format!("mtllib bad.mtl\n{TRIANGLE}f 1 2 3\n"),
+        ),
+        ("bad.mtl", "newmtl m\nKd 1\n".into()),
+        ("empty.obj", TRIANGLE.into()),
+        ("text.txt", "hello\n".into()),
+        (
+            "key.toml",
+            "[[mesh]]\npath = \"tri.obj\"\ncolour = 1\n".into(),
+        ),
+        (
+            "scale.toml",
+            "[[mesh]]\npath = \"tri.obj\"\nscale = 0.0\n".into(),
+        ),
+        ("zero.toml", "[[mesh]]\npath = \"/dev/zero\"\n".into()),
+        ("tri.obj", format!("{TRIANGLE}f 1 2 3\n")),
+        ("calib.yaml", "cam0:\n  camera_model: pinhole\n".into()),
+    ];
+    for (name, text) in &files {
+        write(&dir, name, text.as_bytes());
+    }
+    let out = at("out.png");
+    let small = ["--size", "32x24", "--spp", "1"];
+    type Case<'a> = (Vec<String>, Vec<(&'a str, &'a str)>, &'a str);
+    let cases: Vec<Case> = [
+        (
+            vec!["render", "/nonexistent/scene.obj"],
+            vec![],
+            "scene.obj",
+        ),
+        (vec!["render", &at("folder.obj")], vec![], "a folder"),
+        (vec!["render", &at("pipe.obj")], vec![], "a named pipe"),
+        (vec!["render", &at("text.txt")], vec![], ".toml"),
+        (vec!["render", "builtin:nope"], vec![], "nope"),
+        (vec!["render", &at("bad-face.obj")], vec![], "line 4"),
+        (vec!["render", &at("bad-index.obj")], vec![], "line 4"),
+        (vec!["render", &at("bad-mtl.obj")], vec![], "bad.mtl"),
+        (vec!["render", &at("empty.obj")], vec![], "empty.obj"),
+        (vec!["render", &at("key.toml")], vec![], "colour"),
+        (vec!["render", &at("scale.toml")], vec![], "scale"),
+        (vec!["render", &at("zero.toml")], vec![], "a device"),
+        (
+            vec!["render", &at("tri.obj")],
+            vec![("FISHEYE_MAX_INPUT_MIB", "0")],
+            "budget",
+        ),
+        (vec!["render", "--lens", "nope:f=1"], vec![], "nope"),
+        (vec!["render", "--lens", "equidistant:f=0"], vec![], "f"),
+        (
+            vec!["render", "--lens", "rectilinear:f=1,fov=180"],
+            vec![],
+            "180",
+        ),
+        (
+            vec!["render", "--calib", &at("calib.yaml")],
+            vec![],
+            "calib.yaml",
+        ),
+        (vec!["render", "--size", "0x10"], vec![], "0x10"),
+        (vec!["render", "--camera", "1,2:3"], vec![], "X,Y,Z"),
+        (vec!["render", "--max-depth", "9"], vec![], "max-depth"),
+        (vec!["render", "--exposure", "nan"], vec![], "exposure"),
+        (vec!["render", "-o", &at("out.jpg")], vec![], "out.jpg"),
+        (vec!["render", "-o", "/dev/full"], vec![], "/dev/full"),
+        (vec!["render", "-o", &at("folder.png")], vec![], "a folder"),
+        (
+            vec!["render", "-o", "/proc/nope/x.png"],
+            vec![],
+            "/proc/nope",
+        ),
+        (
+            vec!["render"],
+            vec![("FISHEYE_INJECT_FAULT", "device-lost")],
+            "device was lost",
+        ),
+    ]
+    .into_iter()
+    .map(|(args, env, needle)| {
+        let mut args: Vec<String> = args.into_iter().map(String::from).collect();
+        if !args.iter().any(|a| a == "-o") {
+            args.extend(["-o".to_string(), out.clone()]);
+        }
+        // Small and quick, unless the case sets the size (a calibration brings its own).
+        let sized = args.iter().any(|a| a == "--calib" || a == "--size");
+        let keep = if sized { 2 } else { 0 };
+        args.extend(small[keep..].iter().map(|s| s.to_string()));
+        (args, env, needle)
+    })
+    .collect();
+    for (args, env, needle) in cases {
+        let output = std::process::Command::new(env!("CARGO_BIN_EXE_fisheye"))
+            .args(&args)
+            .envs(env.iter().copied())
+            .output()
+            .unwrap();
+        let stderr = String::from_utf8_lossy(&output.stderr);
+        // 2 is clap's status for a value its parser refuses.
+        let code = output.status.code();
+        assert!(matches!(code, Some(1 | 2)), "{args:?}: {code:?} {stderr}");
+        assert!(
+            stderr.contains(needle),
+            "{args:?}: {stderr:?} lacks {needle:?}"
+        );
+        assert!(!stderr.contains("panicked"), "{args:?}: {stderr}");
+        assert!(!Path::new(&out).exists(), "{args:?} wrote an image");
+        for line in stderr.lines().filter(|l| l.starts_with("error")) {
+            assert_eq!(repeated_clause(line), None, "{args:?}: {line}");
+        }
+    }
+    std::fs::remove_dir_all(dir).unwrap();
+}

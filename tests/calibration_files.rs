@@ -204,6 +204,39 @@ fn expresses(format: CalibFormat, model: CalibratedModel) -> bool {
     }
 }
 
+/// Whether YAML 1.1 (PyYAML's resolver, the regular expression of the YAML 1.1 float type,
+/// yaml.org/type/float.html, less the forms the writer never makes: a leading point,
+/// sexagesimal, infinities, NaN) reads `text` as a float: digits, a point, digits, and an
+/// exponent only with its sign.
+fn yaml_1_1_float(text: &str) -> bool {
+    let unsigned = text.strip_prefix(['-', '+']).unwrap_or(text);
+    let (body, exponent) = match unsigned.split_once(['e', 'E']) {
+        Some((body, exponent)) => (body, Some(exponent)),
+        None => (unsigned, None),
+    };
+    let digits = |s: &str| s.bytes().all(|c| c.is_ascii_digit() || c == b'_');
+    let exponent_ok = exponent.is_none_or(|e| {
+        e.len() > 1 && (e.starts_with('-') || e.starts_with('+')) && digits(&e[1..])
+    });
+    match body.split_once('.') {
+        Some((whole, fraction)) => {
+            exponent_ok && !whole.is_empty() && digits(whole) && digits(fraction)
+        }
+        None => false,
+    }
+}
+
+#[test]
+fn the_yaml_1_1_float_form_is_what_pyyaml_takes() {
+    for float in ["230.0", "2.3e+2", "-1.5e-5", "0.0", "1.", "+3.25"] {
+        assert!(yaml_1_1_float(float), "{float}");
+    }
+    // PyYAML reads these as strings (or integers).
+    for not in ["2.3e2", "1e-5", "230", "1.0e5", "abc"] {
+        assert!(!yaml_1_1_float(not), "{not}");
+    }
+}
+
 /// Every model a format can express (and only those) is written, and survives reading back
 /// exactly (the unified model through Kalibr's ξ form to rounding): the same model, every
 /// parameter by name, the intrinsics, the size and the field of view. The rest is a clear
@@ -239,6 +272,19 @@ fn written_files_read_back() {
                             Some(lens.intrinsics().fx)
                         );
                         assert_eq!(doc["value0"]["resolution"][0][0].as_u64(), Some(512));
+                    }
+                    if format == CalibFormat::Kalibr {
+                        // Kalibr reads with PyYAML, a YAML 1.1 reader: every number of the
+                        // intrinsics and coefficients must be a float to it, not a string.
+                        for line in text.lines().filter(|l| l.contains("s: [")) {
+                            let list = line.split_once('[').unwrap().1.trim_end_matches(']');
+                            for number in list.split(", ").filter(|n| !n.is_empty()) {
+                                assert!(
+                                    yaml_1_1_float(number),
+                                    "{spec}: {number:?} is a string to YAML 1.1\n{text}"
+                                );
+                            }
+                        }
                     }
                     let back = calib::parse(&text, format)
                         .unwrap_or_else(|e| panic!("{spec} as {name}: {e}\n{text}"));

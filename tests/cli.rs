@@ -94,6 +94,24 @@ fn unproject_writes_directions_or_none() {
     assert_eq!(gpu_lines[2], "none");
     let got = DVec3::from_slice(&numbers(gpu_lines[1]));
     assert!(got.distance(reference) < 1e-6, "{got} vs {reference}");
+
+    // A pinhole maps every pixel, in the image or not; outside it there is no ray, on either
+    // path, as `project` answers `none` there. The image's far corner is still in it.
+    let pinhole = [
+        "lens",
+        "unproject",
+        "--lens",
+        "rectilinear:f=1",
+        "--size",
+        "64x48",
+    ];
+    for args in [pinhole.to_vec(), [&pinhole[..], &["--gpu"]].concat()] {
+        let text = stdout(&fisheye(&args, "-5 -5\n64 48\n64.5 10\n10 -0.1\n"));
+        let lines: Vec<&str> = text.lines().collect();
+        assert_eq!(lines.len(), 4, "{text}");
+        assert_eq!([lines[0], lines[2], lines[3]], ["none"; 3], "{args:?}");
+        assert_eq!(numbers(lines[1]).len(), 3, "{args:?}");
+    }
 }
 
 #[test]
@@ -884,13 +902,15 @@ fn bench_and_compare_write_their_reports_into_a_new_folder() {
         "rt,cube-forward",
         "--cube-size",
         "16",
+        "--spp",
+        "1,4",
     ];
     // No --out: a new numbered folder each time.
     let mut args = vec!["bench", "builtin:few-detailed", "--frames", "2"];
     args.extend(common);
     let (ok, text, errors) = run(&args);
     assert!(ok, "{errors}");
-    assert!(text.contains("| rectilinear:f=1 | rt |"), "{text}");
+    assert!(text.contains("| rectilinear:f=1 | rt@4spp |"), "{text}");
     assert!(text.contains("Fisheye overhead"), "{text}");
     for file in ["bench.json", "bench.md", "fps.canon-8-15mm@8mm.png"] {
         assert!(dir.join("fisheye-bench-1").join(file).is_file(), "{file}");
@@ -902,19 +922,21 @@ fn bench_and_compare_write_their_reports_into_a_new_folder() {
         "compare",
         "--frames",
         "1",
-        "--supersample",
-        "2",
+        "--reference-spp",
+        "16",
         "-o",
         "cmp",
     ];
     args.extend(common);
     let (ok, text, errors) = run(&args);
     assert!(ok, "{errors}");
-    assert!(text.contains("MSE vs supersampled"), "{text}");
+    assert!(text.contains("| ꟻLIP |"), "{text}");
+    assert!(text.contains("- canon-8-15mm@8mm, MSE (least: "), "{text}");
     for file in [
         "compare.json",
         "compare.md",
         "tradeoff.canon-8-15mm@8mm.png",
+        "tradeoff-flip.canon-8-15mm@8mm.png",
         "canon-8-15mm@8mm.cube-forward@16.error.png",
         "rectilinear_f_1.reference.png",
     ] {
@@ -926,8 +948,13 @@ fn bench_and_compare_write_their_reports_into_a_new_folder() {
     assert!(!ok && errors.contains("no camera path"), "{errors}");
     let (ok, _, errors) = run(&["compare", "--cube-size", "0"]);
     assert!(!ok && errors.contains("--cube-size 0"), "{errors}");
-    let (ok, _, errors) = run(&["compare", "--supersample", "9"]);
-    assert!(!ok && errors.contains("--supersample 9"), "{errors}");
+    let (ok, _, errors) = run(&["compare", "--reference-spp", "300"]);
+    assert!(
+        !ok && errors.contains("--reference-spp 300: 300 samples"),
+        "{errors}"
+    );
+    let (ok, _, errors) = run(&["bench", "--spp", "1,3"]);
+    assert!(!ok && errors.contains("--spp 3: 3 samples"), "{errors}");
     std::fs::remove_dir_all(dir).unwrap();
 }
 
@@ -1044,15 +1071,17 @@ fn calibration_files_drive_lens_and_render() {
             "rt",
             "--frames",
             "1",
-            "--supersample",
-            "2",
+            "--spp",
+            "1",
+            "--reference-spp",
+            "4",
             "-o",
             cmp.to_str().unwrap(),
         ],
         "",
     ));
-    assert!(text.contains(&format!("| {path} | rt |")), "{text}");
-    assert!(text.contains("| rectilinear:f=1 | rt |"), "{text}");
+    assert!(text.contains(&format!("| {path} | rt@1spp |")), "{text}");
+    assert!(text.contains("| rectilinear:f=1 | rt@1spp |"), "{text}");
     let report = std::fs::read_to_string(cmp.join("compare.md")).unwrap();
     assert!(report.contains("96x72"), "{report}");
 

@@ -92,6 +92,20 @@ struct Traced {
     triangle: u32,
 }
 
+// A primary ray's closest hit and its surface, unshaded (colour zero): the ground truth at a
+// pixel's centre when its colour comes from several samples.
+fn first_hit(primary: Ray) -> Traced {
+    var out = Traced(vec3<f32>(0.0), Hit(0.0, 0.0, 0.0, NO_HIT), vec3<f32>(0.0), NO_HIT);
+    let hit = bvh_trace(primary, false);
+    if hit.slot != NO_HIT {
+        let s = surface_at(primary, hit);
+        out.hit = hit;
+        out.normal = s.normal;
+        out.triangle = s.triangle;
+    }
+    return out;
+}
+
 // Whitted's recursion as a loop over a stack of pending rays (depth-first; a binary tree of
 // depth MAX_DEPTH_LIMIT needs one more entry than its depth).
 fn shade(primary: Ray) -> Traced {

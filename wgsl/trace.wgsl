@@ -48,10 +48,15 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
         ids_out[index] = NO_HIT;
         return;
     }
-    let traced = shade(Ray(frame.eye.xyz, world(ray.xyz), 0.0, 3.0e38));
-    colour_out[index] = vec4<f32>(traced.colour, 1.0);
+    let centre = Ray(frame.eye.xyz, world(ray.xyz), 0.0, 3.0e38);
+    var traced: Traced;
     if SAMPLES_PER_SIDE > 1u {
+        // The samples make the colour; the centre gives the ground truth, its hit alone.
+        traced = first_hit(centre);
         colour_out[index] = supersampled(pixel, index);
+    } else {
+        traced = shade(centre);
+        colour_out[index] = vec4<f32>(traced.colour, 1.0);
     }
     if traced.triangle == NO_HIT {
         geometry_out[index] = vec4<f32>(0.0);

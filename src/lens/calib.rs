@@ -175,6 +175,18 @@ enum Node {
     List(Vec<Option<f64>>),
 }
 
+/// A finite number as calibration files write it: the shortest digits that read back to the
+/// same f64 (Rust's `{:e}`), with a decimal point and a signed exponent (`2.3e+2`,
+/// `1.0e-5`), the form every reader takes as a float: YAML 1.1 (PyYAML, so Kalibr) reads
+/// `2.3e2` as a string, as it needs both; JSON and OpenCV take either.
+fn float_text(x: f64) -> String {
+    let text = format!("{x:e}");
+    let (mantissa, exponent) = text.split_once('e').expect("{:e} has an exponent");
+    let point = if mantissa.contains('.') { "" } else { ".0" };
+    let sign = if exponent.starts_with('-') { "" } else { "+" };
+    format!("{mantissa}{point}e{sign}{exponent}")
+}
+
 fn numbers(text: &str) -> Vec<Option<f64>> {
     text.split_whitespace().map(|t| t.parse().ok()).collect()
 }
@@ -471,7 +483,7 @@ pub fn write(calibration: &Calibration, format: CalibFormat) -> Result<String, L
     let i = lens.intrinsics();
     let (fx, fy, cx, cy) = (i.fx, i.fy, i.cx - 0.5, i.cy - 0.5);
     let (w, h) = (calibration.size.width, calibration.size.height);
-    let join = |v: &[f64]| v.iter().map(|x| format!("{x:e}")).collect::<Vec<_>>();
+    let join = |v: &[f64]| v.iter().map(|&x| float_text(x)).collect::<Vec<_>>();
     match format {
         CalibFormat::OpenCvYaml | CalibFormat::OpenCvXml => {
             let (fisheye, d) = match model {
@@ -563,11 +575,10 @@ pub fn write(calibration: &Calibration, format: CalibFormat) -> Result<String, L
                 }
                 _ => return Err(unsupported()),
             };
-            // Rust's `{:e}` is the shortest form that reads back to the same f64.
             let values: Vec<String> = [("fx", fx), ("fy", fy), ("cx", cx), ("cy", cy)]
                 .into_iter()
                 .chain(extra)
-                .map(|(key, value)| format!("          \"{key}\": {value:e}"))
+                .map(|(key, value)| format!("          \"{key}\": {}", float_text(value)))
                 .collect();
             Ok(format!(
                 "{{\n  \"value0\": {{\n    \"intrinsics\": [\n      {{\n        \"camera_type\": \

@@ -7,23 +7,24 @@ use std::path::Path;
 use serde::Serialize;
 
 use super::{Progress, Run, Study, file_stem, is_pinhole, machine_lines, sig, write_report};
-use crate::bench::{FrameStats, FrameTime, Pass, PathKind, camera_path};
+use crate::bench::{FrameStats, FrameTime, Memory, Pass, PathKind, camera_path};
 use crate::error::{Error, Result};
 use crate::gpu::median;
 use crate::plot;
-use crate::renderer::Method;
 
 /// One setup's frames along the path.
 #[derive(Serialize)]
 pub struct BenchEntry {
     /// Lens name.
     pub lens: String,
-    /// Setup label (`rt`, `cube-forward@512`).
+    /// Setup label (`rt@1spp`, `cube-forward@512`).
     pub setup: String,
     /// Method name.
     pub method: &'static str,
     /// Cube face size, `None` for direct methods.
     pub cube_size: Option<u32>,
+    /// Rays per pixel of a direct method, `None` for cube maps.
+    pub spp: Option<u32>,
     /// The timed passes, in the order of each frame's `passes_ms`.
     pub passes: &'static [Pass],
     /// Statistics of the GPU time per frame (the sum of the passes), if timestamps exist.
@@ -34,6 +35,10 @@ pub struct BenchEntry {
     pub pass_median_ms: Option<Vec<f64>>,
     /// Every timed frame.
     pub frames: Vec<FrameTime>,
+    /// Memory in use before the first timed frame (after the warm-up).
+    pub memory_start: Memory,
+    /// Memory in use after the last frame: equal to the start's in a run that leaks nothing.
+    pub memory_end: Memory,
 }
 
 impl BenchEntry {
@@ -93,7 +98,12 @@ pub fn bench(
             });
             let renderer = study.renderer(lens, setup)?;
             let mut timed = Vec::with_capacity(frames);
+            let mut memory_start = None;
+            // The warm-up frames at the path's first pose, then the path.
             for k in 0..warmup + frames {
+                if k == warmup {
+                    memory_start = Some(Memory::now(study.ctx));
+                }
                 let pose = &poses[k.saturating_sub(warmup)];
                 let time = renderer.frame(study.ctx, study.scenes, pose)?;
                 if k >= warmup {
@@ -106,6 +116,7 @@ pub fn bench(
                     what: &what,
                 });
             }
+            let memory_start = memory_start.expect("at least one timed frame");
             let wall: Vec<f64> = timed.iter().map(|t| t.wall_ms).collect();
             let gpu: Option<Vec<f64>> = timed.iter().map(FrameTime::gpu_ms).collect();
             let passes = setup.method.passes();
@@ -122,12 +133,15 @@ pub fn bench(
                 lens: lens.name.clone(),
                 setup: setup.label(),
                 method: setup.method.name(),
-                cube_size: matches!(setup.method, Method::Cube(_)).then_some(setup.cube_size),
+                cube_size: setup.cube_size(),
+                spp: setup.spp(),
                 passes,
                 gpu: gpu.as_deref().and_then(FrameStats::of),
                 wall: FrameStats::of(&wall).expect("at least one frame"),
                 pass_median_ms,
                 frames: timed,
+                memory_start,
+                memory_end: Memory::now(study.ctx),
             });
         }
     }
@@ -189,6 +203,20 @@ impl BenchReport {
                 sig(e.wall.mean_fps),
             );
         }
+        md.push_str("\nMemory before the first timed frame and after the last (resident set; device memory wgpu's allocator holds):\n\n");
+        let mib = |v: Option<f64>| v.map_or("n/a".to_string(), |v| format!("{v:.1}"));
+        for e in &self.entries {
+            let _ = writeln!(
+                md,
+                "- {} {}: resident {} → {} MiB, GPU {} → {} MiB",
+                e.lens,
+                e.setup,
+                mib(e.memory_start.resident_mib),
+                mib(e.memory_end.resident_mib),
+                mib(e.memory_start.gpu_mib),
+                mib(e.memory_end.gpu_mib)
+            );
+        }
         let overheads = self.fisheye_overheads();
         if !overheads.is_empty() {
             md.push_str(
@@ -205,12 +233,21 @@ impl BenchReport {
     }
 
     /// Per non-pinhole lens, direct RT's median frame time over the pinhole lens's (the
-    /// lens named `pinhole` or starting `rectilinear`).
+    /// lens named `pinhole` or starting `rectilinear`), at the fewest rays per pixel measured.
     pub fn fisheye_overheads(&self) -> Vec<(String, f64)> {
+        let Some(label) = self
+            .entries
+            .iter()
+            .filter(|e| e.method == "rt")
+            .min_by_key(|e| e.spp)
+            .map(|e| e.setup.clone())
+        else {
+            return Vec::new();
+        };
         let rt = |lens: &str| {
             self.entries
                 .iter()
-                .find(|e| e.lens == lens && e.setup == "rt")
+                .find(|e| e.lens == lens && e.setup == label)
                 .map(|e| e.stats().p50_ms)
         };
         let Some(pinhole) = self

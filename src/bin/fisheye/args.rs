@@ -22,8 +22,9 @@ pub(crate) struct ShadingArgs {
     /// Shadow-map size in texels per side and layer (rasterized `cube-*` methods).
     #[arg(long, default_value_t = 2048)]
     pub(crate) shadow_size: u32,
-    /// Deepest reflection/refraction bounce.
-    #[arg(long, default_value_t = 5)]
+    /// Deepest reflection/refraction bounce (0 to 8).
+    #[arg(long, default_value_t = 5,
+          value_parser = clap::value_parser!(u32).range(0..=i64::from(fisheye_rt::shared::MAX_DEPTH_LIMIT)))]
     pub(crate) max_depth: u32,
     /// BVH build preset.
     #[arg(long, value_enum, default_value = "fast")]
@@ -60,6 +61,10 @@ pub(crate) struct StudyArgs {
     /// Cube face sizes to measure the cube-map methods at (comma-separated).
     #[arg(long, value_delimiter = ',', default_value = "512,1024,1920")]
     pub(crate) cube_size: Vec<u32>,
+    /// Rays per pixel to measure direct tracing at (comma-separated squares): RT is a family
+    /// over rays per pixel as the cube maps are over face sizes.
+    #[arg(long, value_delimiter = ',', default_value = "1,4,16")]
+    pub(crate) spp: Vec<u32>,
     #[command(flatten)]
     pub(crate) shading: ShadingArgs,
     /// Folder for the results; by default a new folder `fisheye-COMMAND-N` here.
@@ -174,8 +179,8 @@ impl From<Formula> for DirectionFormula {
 /// A calibration file in place of `--lens` and `--size`.
 #[derive(clap::Args)]
 pub(crate) struct CalibArgs {
-    /// Calibration file (OpenCV YAML/XML, Kalibr camchain YAML or Basalt JSON): render
-    /// through that camera at its resolution, instead of --lens and --size.
+    /// Calibration file (OpenCV YAML/XML, Kalibr camchain YAML or Basalt JSON): its camera,
+    /// at its resolution, instead of --lens and --size.
     #[arg(long, conflicts_with_all = ["lens", "size"])]
     pub(crate) calib: Option<PathBuf>,
     /// Which camera of a multi-camera calibration file (0 is the first).
@@ -244,18 +249,30 @@ pub(crate) struct CameraArgs {
     pub(crate) size: ImageSize,
     #[command(flatten)]
     pub(crate) calib: CalibArgs,
-    /// How directions are built from θ: the stable default, or the thesis's formula.
-    #[arg(long, value_enum, default_value = "stable")]
-    pub(crate) formula: Formula,
-    /// Run the WGSL (f32) lens code on the GPU instead of the f64 reference.
-    #[arg(long)]
-    pub(crate) gpu: bool,
 }
 
 impl CameraArgs {
     pub(crate) fn camera(&self) -> Result<LensCamera> {
-        let camera = self.calib.camera(self.lens.as_deref(), self.size)?;
-        Ok(camera.with_formula(self.formula.into()))
+        self.calib.camera(self.lens.as_deref(), self.size)
+    }
+}
+
+/// The camera, and how `lens project|unproject` evaluate it.
+#[derive(clap::Args)]
+pub(crate) struct PointArgs {
+    #[command(flatten)]
+    pub(crate) camera: CameraArgs,
+    /// How directions are built from θ: the stable default, or the thesis's formula.
+    #[arg(long, value_enum, default_value = "stable")]
+    pub(crate) formula: Formula,
+    /// Evaluate the lens with its WGSL (f32) code on the GPU instead of the f64 reference.
+    #[arg(long)]
+    pub(crate) gpu: bool,
+}
+
+impl PointArgs {
+    pub(crate) fn camera(&self) -> Result<LensCamera> {
+        Ok(self.camera.camera()?.with_formula(self.formula.into()))
     }
 }
 

@@ -17,7 +17,7 @@ use fisheye_rt::report;
 use fisheye_rt::trace::{save_png, write_file};
 use glam::{DVec2, DVec3};
 
-use crate::args::{CameraArgs, Format};
+use crate::args::{CameraArgs, Format, PointArgs};
 
 #[derive(Subcommand)]
 pub(crate) enum LensCommand {
@@ -25,10 +25,13 @@ pub(crate) enum LensCommand {
     List,
     /// Read `px py` lines on stdin (continuous pixel coordinates, origin at the top-left
     /// corner of the image) and write the unit direction `dx dy dz` (x right, y down, z
-    /// forward) or `none` for each.
-    Unproject(CameraArgs),
-    /// Read `dx dy dz` lines on stdin and write the pixel `px py` each lands on, or `none`.
-    Project(CameraArgs),
+    /// forward) or `none` for each (outside the image or the lens's field). A line that is
+    /// not two numbers fails the whole batch, naming its line, before anything is written.
+    Unproject(PointArgs),
+    /// Read `dx dy dz` lines on stdin and write the pixel `px py` each lands on, or `none`
+    /// (outside the lens's field or the image). A line that is not three numbers fails the
+    /// whole batch, naming its line, before anything is written.
+    Project(PointArgs),
     /// Fit the thesis's classic mappings (equidistant, equisolid, orthographic,
     /// stereographic) to a calibrated lens over the angles its image shows, and print each
     /// one's focal length and radial residual in pixels, best first.
@@ -125,7 +128,7 @@ pub(crate) fn write_lines(lines: impl Iterator<Item = String>) -> Result<()> {
     Ok(out.flush()?)
 }
 
-pub(crate) fn unproject(args: &CameraArgs) -> Result<()> {
+pub(crate) fn unproject(args: &PointArgs) -> Result<()> {
     let camera = args.camera()?;
     let pixels: Vec<DVec2> = read_points::<2>()?.into_iter().map(DVec2::from).collect();
     let dirs: Vec<Option<DVec3>> = if args.gpu {
@@ -138,13 +141,17 @@ pub(crate) fn unproject(args: &CameraArgs) -> Result<()> {
     } else {
         pixels.iter().map(|&p| camera.unproject(p)).collect()
     };
-    write_lines(dirs.into_iter().map(|d| match d {
-        Some(d) => format!("{:.9} {:.9} {:.9}", d.x, d.y, d.z),
-        None => "none".into(),
+    // A pixel outside the image has no ray, as `project` answers `none` for a direction
+    // landing outside it.
+    let (w, h) = (f64::from(camera.size.width), f64::from(camera.size.height));
+    let inside = |p: &DVec2| (0.0..=w).contains(&p.x) && (0.0..=h).contains(&p.y);
+    write_lines(pixels.iter().zip(dirs).map(|(p, d)| match d {
+        Some(d) if inside(p) => format!("{:.9} {:.9} {:.9}", d.x, d.y, d.z),
+        _ => "none".into(),
     }))
 }
 
-pub(crate) fn project(args: &CameraArgs) -> Result<()> {
+pub(crate) fn project(args: &PointArgs) -> Result<()> {
     let camera = args.camera()?;
     let dirs: Vec<DVec3> = read_points::<3>()?.into_iter().map(DVec3::from).collect();
     let pixels: Vec<Option<DVec2>> = if args.gpu {

@@ -36,9 +36,10 @@ pub(crate) enum Command {
     /// camera path, fisheye and pinhole: fps statistics and per-pass GPU times, as JSON, a
     /// Markdown table and a PNG of fps along the path, in the --out folder.
     Bench(BenchArgs),
-    /// Measure every method's error against direct ray tracing and a supersampled reference,
-    /// with its time per frame: JSON, a Markdown table, error maps and a time-against-error
-    /// PNG with the Pareto front, in the --out folder.
+    /// Measure every setup's time and error (MSE and ꟻLIP) against a many-ray reference, and
+    /// direct RT's family (over rays per pixel) against the cube maps' (over face sizes) at
+    /// equal error: JSON, a Markdown table, error maps and time-against-error PNGs with the
+    /// Pareto front and each family's envelope, in the --out folder.
     Compare(CompareArgs),
     /// Check lens models against rendered images: render the built-in `grid` checkerboard
     /// through each lens, find its corners in the image to a fraction of a pixel without the

@@ -116,9 +116,15 @@ pub(crate) fn render(args: &RenderArgs) -> Result<()> {
     for &channel in &channels {
         refuse_non_regular(&array_path(channel))?;
     }
-    let setup = Setup {
-        method: args.method.method(),
-        cube_size: args.cube_size,
+    let method = args.method.method();
+    // A cube map's resampler takes one bilinear sample a pixel; --spp is direct tracing's.
+    let setup = match method.cube() {
+        Some(_) => Setup {
+            method,
+            cube_size: args.cube_size,
+            spp: 1,
+        },
+        None => Setup::direct(method, args.spp),
     };
     let directions = DirectionSource::from(args.directions);
     if setup.method.cube().is_some() && directions == DirectionSource::Table {
@@ -172,13 +178,13 @@ pub(crate) fn render(args: &RenderArgs) -> Result<()> {
         "lens: {} at {}; compiling the kernels...",
         camera.lens, camera.size
     );
-    let renderer = Renderer::with_rays(
+    let renderer = Renderer::with_directions(
         &ctx,
         &camera,
         &scenes,
         setup,
         args.shading.shadow_size,
-        (options.directions, options.spp),
+        options.directions,
     )?;
     if let Some(cube) = renderer.cube() {
         describe_cube(cube, setup, scene.lights.len());
@@ -187,10 +193,7 @@ pub(crate) fn render(args: &RenderArgs) -> Result<()> {
     let output = renderer.output(&ctx)?;
     let (rays, hits) = output.counts();
     // Pixels with a ray at their centre, and rays traced from the camera.
-    let (primary, spp) = match renderer.cube() {
-        Some(_) => (rays, 1),
-        None => (rays * args.spp as usize, args.spp),
-    };
+    let (primary, spp) = (rays * setup.spp as usize, setup.spp);
     let what = match renderer.cube() {
         Some(_) => format!("{} (faces and resampling)", setup.label()),
         None => format!("trace: {rays} pixels ({hits} hit at their centre) × {spp} rays"),

@@ -9,6 +9,7 @@ use fisheye_rt::lens::{LensCamera, parse_spec};
 use fisheye_rt::report::{self, LensRun, Progress, Study};
 use fisheye_rt::scene::Scene;
 use fisheye_rt::trace::RenderOptions;
+use fisheye_rt::trace::sampling::samples_per_side;
 
 use crate::args::{PathArg, StudyArgs, load_scene, parse_camera};
 
@@ -36,10 +37,11 @@ pub(crate) struct CompareArgs {
     /// Timed frames per setup at the pose (the median is reported), after one untimed.
     #[arg(long, default_value_t = 5)]
     pub(crate) frames: usize,
-    /// Rays per pixel side of the supersampled reference (1 to 8); by default the most, up to
-    /// 4, whose image fits one storage binding.
-    #[arg(long)]
-    pub(crate) supersample: Option<u32>,
+    /// Rays per pixel of the reference (direct tracing, the same box filter as the RT
+    /// setups; a square up to 256): 16 times the most the setups use leaves it about a
+    /// sixteenth of their error.
+    #[arg(long, default_value_t = 256)]
+    pub(crate) reference_spp: u32,
 }
 
 /// What `bench` and `compare` set up from their shared arguments.
@@ -100,7 +102,10 @@ pub(crate) fn prepare(args: &StudyArgs, command: &str) -> Result<Prepared> {
     } else {
         args.method.iter().map(|m| m.method()).collect()
     };
-    let setups = Setup::all(&methods, &args.cube_size);
+    for &spp in &args.spp {
+        samples_per_side(spp).with_context(|| format!("--spp {spp}"))?;
+    }
+    let setups = Setup::all(&methods, &args.cube_size, &args.spp);
     let mut scene = load_scene(&args.scene)?;
     if let Some(text) = &args.camera {
         let pose = parse_camera(text, &scene)?;
@@ -201,23 +206,12 @@ pub(crate) fn run_bench(args: &BenchArgs) -> Result<()> {
 }
 
 pub(crate) fn run_compare(args: &CompareArgs) -> Result<()> {
-    if let Some(s) = args.supersample.filter(|s| !(1..=8).contains(s)) {
-        bail!("--supersample {s}: must be 1 to 8");
-    }
+    let spp = args.reference_spp;
+    samples_per_side(spp).with_context(|| format!("--reference-spp {spp}"))?;
     let p = prepare(&args.study, "compare")?;
-    let supersample = args.supersample.unwrap_or_else(|| {
-        fisheye_rt::compare::supersample_factor(&p.ctx, p.lenses[0].camera.size)
-    });
     let study = p.study(&args.study);
     let pose = p.scene.camera;
-    let report = report::compare(
-        &study,
-        &pose,
-        args.frames,
-        supersample,
-        &p.out,
-        &mut progress_bar(),
-    )?;
+    let report = report::compare(&study, &pose, args.frames, spp, &p.out, &mut progress_bar())?;
     let warning = report.write(&p.out)?;
     finish(&report.markdown(), &p.out, warning);
     Ok(())
