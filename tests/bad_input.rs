@@ -500,7 +500,7 @@ fn the_readme_table_names_tests_that_exist() {
 /// fails the test instead of hanging it): the exit status and stderr.
 fn fisheye_bounded(args: &[&str], env: &[(&str, &str)]) -> (Option<i32>, String) {
     use std::os::unix::process::CommandExt;
-    const MIB: u64 = 256;
+    const MIB: u64 = 100;
     let mut command = std::process::Command::new(env!("CARGO_BIN_EXE_fisheye"));
     command
         .args(args)
@@ -535,7 +535,7 @@ fn fisheye_bounded(args: &[&str], env: &[(&str, &str)]) -> (Option<i32>, String)
 }
 
 /// Endless, special and oversized inputs: each is refused before it is read, with an error
-/// naming the file and what it is (once), by a process held to 256 MiB of address space that
+/// naming the file and what it is (once), by a process held to 100 MiB of address space that
 /// never gets to the GPU; budgets come from `FISHEYE_MAX_INPUT_MIB`.
 #[test]
 fn special_and_oversized_inputs_are_refused_within_bounds() {
@@ -758,6 +758,22 @@ fn every_error_says_each_clause_once() {
             vec!["render", "-o", "/proc/nope/x.png"],
             vec![],
             "/proc/nope",
+        ),
+        // A folder no one may write into: sysfs refuses new files, even to root.
+        (
+            vec!["render", "-o", "/sys/fisheye.png"],
+            vec![],
+            "/sys/fisheye.png",
+        ),
+        (
+            vec!["render", "-o", "/sys/fisheye.png", "--outputs", "range"],
+            vec![],
+            "/sys/fisheye",
+        ),
+        (
+            vec!["compare", "-o", "/sys/fisheye-compare"],
+            vec![],
+            "/sys/fisheye-compare",
         ),
         (
             vec!["render"],
