@@ -278,6 +278,31 @@ impl Renderer {
         Ok(FrameTime { wall_ms, passes_ms })
     }
 
+    /// Compiles the frame's kernels before anything is timed (lavapipe, like many drivers,
+    /// compiles a pipeline at its first dispatch) with the least work that runs each: one
+    /// workgroup of a traced frame, or a whole cube-map frame (whose passes each need their
+    /// first draw or dispatch). Returns the wall milliseconds it took: compilation, mostly.
+    pub fn warm_up(&self, ctx: &GpuContext, scenes: &SceneSet, pose: &Camera) -> Result<f64> {
+        let started = std::time::Instant::now();
+        match &self.path {
+            Path::Direct(pass) => {
+                let scene = scenes.for_method(self.setup.method);
+                let one = crate::lens::ImageSize::new(1, 1).expect("1x1 is a size");
+                ctx.checked("compiling the kernels", || {
+                    let mut encoder = ctx.device.create_command_encoder(&Default::default());
+                    pass.encode_pose(&ctx.device, &mut encoder, scene, pose);
+                    pass.encode_region(&mut encoder, scene, 0, one, None);
+                    ctx.queue.submit([encoder.finish()]);
+                })?;
+                ctx.wait()?;
+            }
+            Path::Cube(_) => {
+                self.frame(ctx, scenes, pose)?;
+            }
+        }
+        Ok(started.elapsed().as_secs_f64() * 1e3)
+    }
+
     /// The lens image's linear colours of the last frame (as [`RenderOutput::colour`]).
     pub fn colour(&self, ctx: &GpuContext) -> Result<Vec<[f32; 4]>> {
         Ok(self.output(ctx)?.colour)

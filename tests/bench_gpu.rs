@@ -24,6 +24,8 @@ fn every_method_times_each_of_its_passes_and_renders_what_render_does() {
     let scenes = SceneSet::new(ctx(), &scene, &RenderOptions::default(), &all).unwrap();
     for setup in all {
         let renderer = Renderer::new(ctx(), &cam, &scenes, setup, 256).unwrap();
+        // The warm-up compiles the kernels; the frame after it is the one compared below.
+        assert!(renderer.warm_up(ctx(), &scenes, &scene.camera).unwrap() > 0.0);
         let time = renderer.frame(ctx(), &scenes, &scene.camera).unwrap();
         let passes = time.passes_ms.expect("lavapipe has timestamp queries");
         assert_eq!(

@@ -328,7 +328,16 @@ fn render_writes_a_masked_png_and_reports() {
     let out = path.to_str().unwrap();
     let args = ["render", "builtin:default", "--size", "96x64", "--out", out];
     let text = stdout(&fisheye(&args, ""));
-    for needle in ["adapter:", "triangles", "primary rays", "wrote"] {
+    // Compilation is reported apart from the timed trace.
+    let needles = [
+        "adapter:",
+        "triangles",
+        "kernels compiled and first dispatch: ",
+        "ms on the GPU (after compilation)",
+        "primary rays",
+        "wrote",
+    ];
+    for needle in needles {
         assert!(text.contains(needle), "{needle} missing from:\n{text}");
     }
     let image = image::open(&path).unwrap().to_rgba8();
