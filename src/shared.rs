@@ -362,7 +362,9 @@ pub struct Frame {
     pub forward: [f32; 4],
     /// Eye position relative to the scene's origin (`GpuScene::origin`), xyz.
     pub eye: [f32; 4],
-    /// The pixel of the first invocation (x, y), for dispatches over a part of the image.
+    /// The pixel of the first invocation (x, y), for dispatches over a part of the image;
+    /// w: the first image row the outputs hold (a band of rows, when the whole image's
+    /// outputs exceed one storage binding; 0 otherwise).
     pub offset: [u32; 4],
 }
 

@@ -286,18 +286,28 @@ fn sizes_beyond_the_adapter_are_errors_with_the_limit() {
         "{message}"
     );
     // Within the texture limit, but its outputs (16 bytes a pixel) are beyond one storage
-    // binding: on an adapter whose bindings stop at 1 MiB, 256² fits and 257² does not.
+    // binding: on an adapter whose bindings stop at 1 MiB, 256² fits in one dispatch and 257²
+    // is traced in two bands of rows (tested bit for bit in `trace_gpu`), while a traced cube
+    // map, whose six faces share one pass, is refused with the numbers.
     let small = fisheye_rt::gpu::GpuContext::with_binding_limit(1 << 20).unwrap();
     let grid = fisheye_rt::scene::builtin::scene("grid").unwrap();
     let small_scene = GpuScene::new(&small, &grid, &options).unwrap();
     let on_small = |side: u32| {
         let camera = common::camera("equidistant:f=0.5", side, side);
-        TracePass::new(&small, &camera, &small_scene, DirectionSource::Computed).map(|_| ())
+        TracePass::new(&small, &camera, &small_scene, DirectionSource::Computed).unwrap()
     };
-    on_small(256).unwrap();
-    let message = error_of(on_small(257));
+    assert_eq!(on_small(256).bands(), 1);
+    assert_eq!(on_small(257).bands(), 2);
+    let traced = fisheye_rt::cube::CubeSettings::new(300, fisheye_rt::cube::CubeMethod::Traced);
+    let lens = common::camera("equidistant:f=0.5", 64, 64);
+    let message = error_of(fisheye_rt::cube::CubeMap::new(
+        &small,
+        &lens,
+        &small_scene,
+        &traced,
+    ));
     assert!(
-        message.contains("needs a storage buffer of 1.01 MiB")
+        message.contains("needs a storage buffer of")
             && message.contains("limit of 1.00 MiB per binding"),
         "{message}"
     );

@@ -256,3 +256,29 @@ fn bench_times_every_frame_of_the_walk_and_writes_its_report() {
         assert_eq!((plot.width(), plot.height()), (1100, 700));
     }
 }
+
+/// A frame traced in bands of rows (an image beyond one storage binding; bindings forced down
+/// to 1 MiB) from a moved pose: its timestamps span every band, and it is the frame traced
+/// in one dispatch, bit for bit.
+#[test]
+fn banded_frames_are_timed_whole() {
+    let small = fisheye_rt::gpu::GpuContext::with_binding_limit(1 << 20).unwrap();
+    let scene = builtin::scene("grid").unwrap();
+    let cam = camera("equidistant:f=0.5", 512, 300);
+    let setup = Setup::direct(Method::Rt, 1);
+    let options = RenderOptions::default();
+    let pose = fisheye_rt::scene::Camera {
+        position: scene.camera.position + glam::DVec3::new(0.1, 0.0, 0.05),
+        ..scene.camera
+    };
+    let frames = |ctx: &fisheye_rt::gpu::GpuContext| {
+        let scenes = SceneSet::new(ctx, &scene, &options, &[setup]).unwrap();
+        let renderer = Renderer::new(ctx, &cam, &scenes, setup, 256).unwrap();
+        let time = renderer.frame(ctx, &scenes, &pose).unwrap();
+        assert!(time.gpu_ms().unwrap() > 0.0);
+        renderer.output(ctx).unwrap()
+    };
+    let (banded, whole) = (frames(&small), frames(ctx()));
+    assert!(banded.colour == whole.colour && banded.ids == whole.ids);
+    assert!(banded.counts().1 > 1000, "the grid is in view");
+}

@@ -19,7 +19,8 @@ struct Frame {
     down: vec4<f32>,
     forward: vec4<f32>,
     eye: vec4<f32>,
-    // The pixel of the first invocation (xy), for dispatches over a part of the image.
+    // The pixel of the first invocation (xy), for dispatches over a part of the image; w:
+    // the first image row the outputs hold (a band of rows; 0 for a whole image).
     offset: vec4<u32>,
 }
 
@@ -37,15 +38,17 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     if pixel.x >= lens.width || pixel.y >= lens.height {
         return;
     }
+    // The pixel's index in the image (its samples' hash), and in the outputs.
     let index = pixel.y * lens.width + pixel.x;
+    let stored = index - frame.offset.w * lens.width;
     let ray = primary_ray(pixel);
     if ray.w == 0.0 {
-        colour_out[index] = vec4<f32>(0.0);
+        colour_out[stored] = vec4<f32>(0.0);
         if SAMPLES_PER_SIDE > 1u {
-            colour_out[index] = supersampled(pixel, index);
+            colour_out[stored] = supersampled(pixel, index);
         }
-        geometry_out[index] = vec4<f32>(0.0);
-        ids_out[index] = NO_HIT;
+        geometry_out[stored] = vec4<f32>(0.0);
+        ids_out[stored] = NO_HIT;
         return;
     }
     let centre = Ray(frame.eye.xyz, world(ray.xyz), 0.0, 3.0e38);
@@ -53,17 +56,17 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     if SAMPLES_PER_SIDE > 1u {
         // The samples make the colour; the centre gives the ground truth, its hit alone.
         traced = first_hit(centre);
-        colour_out[index] = supersampled(pixel, index);
+        colour_out[stored] = supersampled(pixel, index);
     } else {
         traced = shade(centre);
-        colour_out[index] = vec4<f32>(traced.colour, 1.0);
+        colour_out[stored] = vec4<f32>(traced.colour, 1.0);
     }
     if traced.triangle == NO_HIT {
-        geometry_out[index] = vec4<f32>(0.0);
+        geometry_out[stored] = vec4<f32>(0.0);
     } else {
-        geometry_out[index] = vec4<f32>(traced.normal, traced.hit.t);
+        geometry_out[stored] = vec4<f32>(traced.normal, traced.hit.t);
     }
-    ids_out[index] = traced.triangle;
+    ids_out[stored] = traced.triangle;
 }
 
 // A camera-space direction in the world.

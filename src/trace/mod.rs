@@ -198,6 +198,15 @@ fn frame_for(origin: DVec3, pose: &Camera) -> Frame {
     view_frame(origin, pose.position, pose.rotation(), [0, 0])
 }
 
+/// `frame` for the band of output rows starting at `first_row`: its dispatch starts there,
+/// and its outputs hold rows from there on.
+fn band_frame(frame: Frame, first_row: u32) -> Frame {
+    Frame {
+        offset: [0, first_row, 0, first_row],
+        ..frame
+    }
+}
+
 /// The frame of an eye and a camera-to-world rotation for a scene uploaded relative to
 /// `origin`.
 fn view_frame(origin: DVec3, eye: DVec3, rotation: DMat3, offset: [u32; 2]) -> Frame {
@@ -394,11 +403,17 @@ pub struct TracePass {
     pipeline: wgpu::ComputePipeline,
     /// One bind group per view, each with its slot of `frame`.
     bind_groups: Vec<wgpu::BindGroup>,
+    /// The outputs the kernel writes: the whole image's, or one band's.
     colour: wgpu::Buffer,
     geometry: wgpu::Buffer,
     ids: wgpu::Buffer,
     frame: wgpu::Buffer,
     camera: LensCamera,
+    /// The bands of rows traced one after another, `(first row, rows)`: one for an image
+    /// whose outputs fit one storage binding.
+    bands: Vec<(u32, u32)>,
+    /// With several bands, the whole image's outputs, each band copied in after its dispatch.
+    whole: Option<[wgpu::Buffer; 3]>,
 }
 
 impl TracePass {
@@ -440,12 +455,9 @@ impl TracePass {
     ) -> Result<Self> {
         ctx.check_image(camera.size)?;
         let pixels = camera.size.pixels() as u64;
-        for (what, bytes) in [
-            ("the colour output", 16 * pixels),
-            ("the geometry output", 16 * pixels),
-        ] {
-            ctx.check_binding(what, bytes)?;
-        }
+        let bands = output_bands(ctx, camera.size, views)?;
+        // Rows in the largest band: what the kernel's outputs hold.
+        let band_pixels = u64::from(camera.size.width) * u64::from(bands[0].1);
         let table = LensRays::for_source(ctx, camera, source)?;
         ctx.checked("creating the trace pass", || {
             let device = &ctx.device;
@@ -480,38 +492,49 @@ impl TracePass {
                 None => "trace",
             };
             let pipeline = shader::compute_pipeline(device, file, "main", &constants, &layouts);
-            let output = |label: &str, bytes: u64| {
+            let output = |label: &str, bytes: u64, usage: wgpu::BufferUsages| {
                 device.create_buffer(&wgpu::BufferDescriptor {
                     label: Some(label),
                     size: bytes,
-                    usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
+                    usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC | usage,
                     mapped_at_creation: false,
                 })
             };
-            let colour = output("fisheye.trace.colour", 16 * pixels);
-            let geometry = output("fisheye.trace.geometry", 16 * pixels);
-            let ids = output("fisheye.trace.ids", 4 * pixels);
-            let slots: Vec<u8> = (0..views)
-                .flat_map(|_| {
-                    let mut slot = bytemuck::bytes_of(&scene.frame).to_vec();
-                    slot.resize(FRAME_SLOT as usize, 0);
-                    slot
-                })
-                .collect();
+            let none = wgpu::BufferUsages::empty();
+            let colour = output("fisheye.trace.colour", 16 * band_pixels, none);
+            let geometry = output("fisheye.trace.geometry", 16 * band_pixels, none);
+            let ids = output("fisheye.trace.ids", 4 * band_pixels, none);
+            let whole = (bands.len() > 1).then(|| {
+                let into = wgpu::BufferUsages::COPY_DST;
+                [
+                    output("fisheye.trace.colour.whole", 16 * pixels, into),
+                    output("fisheye.trace.geometry.whole", 16 * pixels, into),
+                    output("fisheye.trace.ids.whole", 4 * pixels, into),
+                ]
+            });
+            // A slot per view, or per band (each band's frame starts at its first row).
+            let frames: Vec<Frame> = match bands.len() {
+                1 => vec![scene.frame; views as usize],
+                _ => bands
+                    .iter()
+                    .map(|&(first, _)| band_frame(scene.frame, first))
+                    .collect(),
+            };
+            let slots = frame_slots(&frames);
             let frame = crate::gpu::buffer_init(
                 device,
                 "fisheye.trace.frame",
                 &slots,
                 wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
             );
-            let placeholder = output("fisheye.trace.no_table", 16);
+            let placeholder = output("fisheye.trace.no_table", 16, none);
             let table = table.as_ref().map_or(&placeholder, |t| &t.directions);
             let lens = params_buffer(device, camera);
-            let bind_groups = (0..views)
+            let bind_groups = (0..frames.len() as u64)
                 .map(|view| {
                     let slot = wgpu::BufferBinding {
                         buffer: &frame,
-                        offset: u64::from(view) * FRAME_SLOT,
+                        offset: view * FRAME_SLOT,
                         size: wgpu::BufferSize::new(size_of::<Frame>() as u64),
                     };
                     bind_group(
@@ -537,6 +560,8 @@ impl TracePass {
                 ids,
                 frame,
                 camera: *camera,
+                bands,
+                whole,
             }
         })
     }
@@ -545,7 +570,21 @@ impl TracePass {
     /// stays where it was uploaded, relative to its own camera, so poses far from it lose the
     /// precision that relative upload buys; paths through a scene are fine.
     pub fn set_pose(&self, ctx: &GpuContext, scene: &GpuScene, pose: &Camera) {
-        self.set_view(ctx, scene, 0, pose.position, pose.rotation(), [0, 0]);
+        let frames = self.band_frames(frame_for(scene.origin, pose));
+        ctx.queue
+            .write_buffer(&self.frame, 0, &frame_slots(&frames));
+    }
+
+    /// `frame` for each band (itself for a whole image).
+    fn band_frames(&self, frame: Frame) -> Vec<Frame> {
+        match self.bands.len() {
+            1 => vec![frame],
+            _ => self
+                .bands
+                .iter()
+                .map(|&(first, _)| band_frame(frame, first))
+                .collect(),
+        }
     }
 
     /// As [`TracePass::set_pose`] for view number `view` (see [`TracePass::with_views`]), with
@@ -578,35 +617,74 @@ impl TracePass {
         scene: &GpuScene,
         pose: &Camera,
     ) {
-        let frame = frame_for(scene.origin, pose);
+        let slots = frame_slots(&self.band_frames(frame_for(scene.origin, pose)));
         let staging = crate::gpu::buffer_init(
             device,
             "fisheye.trace.pose",
-            bytemuck::bytes_of(&frame),
+            &slots,
             wgpu::BufferUsages::COPY_SRC,
         );
-        encoder.copy_buffer_to_buffer(&staging, 0, &self.frame, 0, size_of::<Frame>() as u64);
+        encoder.copy_buffer_to_buffer(&staging, 0, &self.frame, 0, slots.len() as u64);
     }
 
     /// The colour output of the last frame (as [`RenderOutput::colour`]), for passes that
     /// read it on the GPU.
     pub fn colour_buffer(&self) -> &wgpu::Buffer {
-        &self.colour
+        self.buffers()[0]
     }
 
     /// The colour, geometry and id outputs of the last frame (as [`RenderOutput`] reads them).
+    /// For an image traced in bands these are larger than one storage binding: bind a range.
     pub fn buffers(&self) -> [&wgpu::Buffer; 3] {
-        [&self.colour, &self.geometry, &self.ids]
+        match &self.whole {
+            Some([colour, geometry, ids]) => [colour, geometry, ids],
+            None => [&self.colour, &self.geometry, &self.ids],
+        }
     }
 
-    /// Records one frame, optionally timed.
+    /// How many bands of rows a frame is traced in: 1 unless the image's outputs exceed one
+    /// storage binding.
+    pub fn bands(&self) -> usize {
+        self.bands.len()
+    }
+
+    /// Records one frame, optionally timed: one dispatch, or one per band, each band's
+    /// outputs copied into the whole image's after it (the timestamps span them all).
     pub fn encode(
         &self,
         encoder: &mut wgpu::CommandEncoder,
         scene: &GpuScene,
         timestamp_writes: Option<wgpu::ComputePassTimestampWrites<'_>>,
     ) {
-        self.encode_region(encoder, scene, 0, self.camera.size, timestamp_writes);
+        let Some(whole) = &self.whole else {
+            self.encode_region(encoder, scene, 0, self.camera.size, timestamp_writes);
+            return;
+        };
+        let width = self.camera.size.width;
+        let last = self.bands.len() - 1;
+        for (band, &(first, rows)) in self.bands.iter().enumerate() {
+            let writes = timestamp_writes
+                .as_ref()
+                .filter(|_| band == 0 || band == last)
+                .map(|w| wgpu::ComputePassTimestampWrites {
+                    query_set: w.query_set,
+                    beginning_of_pass_write_index: w
+                        .beginning_of_pass_write_index
+                        .filter(|_| band == 0),
+                    end_of_pass_write_index: w.end_of_pass_write_index.filter(|_| band == last),
+                });
+            let extent = crate::lens::ImageSize::new(width, rows).expect("a band has rows");
+            self.encode_region(encoder, scene, band as u32, extent, writes);
+            let pixels = u64::from(width) * u64::from(rows);
+            let from = u64::from(width) * u64::from(first);
+            for (out, into, bytes) in [
+                (&self.colour, &whole[0], 16),
+                (&self.geometry, &whole[1], 16),
+                (&self.ids, &whole[2], 4),
+            ] {
+                encoder.copy_buffer_to_buffer(out, 0, into, from * bytes, pixels * bytes);
+            }
+        }
     }
 
     /// Records a frame of view `view` of only the `extent` pixels from the offset given to
@@ -646,13 +724,60 @@ impl TracePass {
 
     /// Reads the last frame's outputs back.
     pub fn read(&self, ctx: &GpuContext) -> Result<RenderOutput> {
+        let [colour, geometry, ids] = self.buffers();
         Ok(RenderOutput {
             size: self.camera.size,
-            colour: ctx.read_buffer(&self.colour)?,
-            geometry: ctx.read_buffer(&self.geometry)?,
-            ids: ctx.read_buffer(&self.ids)?,
+            colour: ctx.read_buffer(colour)?,
+            geometry: ctx.read_buffer(geometry)?,
+            ids: ctx.read_buffer(ids)?,
         })
     }
+}
+
+/// The frames' bytes, each in its `FRAME_SLOT`.
+fn frame_slots(frames: &[Frame]) -> Vec<u8> {
+    frames
+        .iter()
+        .flat_map(|frame| {
+            let mut slot = bytemuck::bytes_of(frame).to_vec();
+            slot.resize(FRAME_SLOT as usize, 0);
+            slot
+        })
+        .collect()
+}
+
+/// The bands of rows `(first row, rows)` a trace of `size` is dispatched in: one where the
+/// colour and geometry outputs (16 bytes a pixel) fit one storage binding, else as many rows
+/// a band as fit (only for a single view; a cube map's faces fit or are refused). The whole
+/// image's outputs must still fit one buffer.
+fn output_bands(
+    ctx: &GpuContext,
+    size: crate::lens::ImageSize,
+    views: u32,
+) -> Result<Vec<(u32, u32)>> {
+    let limits = ctx.device.limits();
+    let (width, height) = (size.width, size.height);
+    let pixels = size.pixels() as u64;
+    let row = 16 * u64::from(width);
+    let rows = (limits.max_storage_buffer_binding_size / row).min(u64::from(height)) as u32;
+    if rows == height {
+        return Ok(vec![(0, height)]);
+    }
+    if views > 1 || rows == 0 {
+        ctx.check_binding("the colour output", 16 * pixels)?;
+    }
+    if 16 * pixels > limits.max_buffer_size {
+        return Err(Error::Limit(format!(
+            "a {size} image's colour output needs a buffer of {:.1} MiB, above this adapter's \
+             limit of {:.1} MiB per buffer; use a smaller image",
+            (16 * pixels) as f64 / f64::from(1 << 20),
+            limits.max_buffer_size as f64 / f64::from(1 << 20)
+        )));
+    }
+    Ok((0..height)
+        .step_by(rows as usize)
+        .map(|first| (first, rows.min(height - first)))
+        .collect())
 }
 
 /// The world-space direction of every pixel's ray (f64 lens model, rotated by the pose),
