@@ -372,3 +372,112 @@ fn bad_files_are_clear_errors() {
     }
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// A classic lens converts to the calibrated model that contains its mapping (equidistant to
+/// Kannala–Brandt with k = 0, stereographic and orthographic to the unified model with α = ½
+/// and 1, equisolid to the double sphere with ξ = α = 1, rectilinear to radial-tangential
+/// with no distortion): every pixel of the image unprojects to the same direction (to 1e-9)
+/// or to none on both, and the field of view is kept. Other general-model rates get a fitted
+/// Kannala–Brandt polynomial whose stated residual is what the pixels show. Either way the
+/// result is written to a file and reads back.
+#[test]
+fn classic_lenses_convert_to_their_calibrated_equivalents() {
+    use fisheye_rt::lens::fit::calibrated_equivalent;
+    use fisheye_rt::lens::{ImageSize, Lens, LensCamera, PRESETS};
+    use glam::DVec2;
+    let size = ImageSize::new(320, 240).unwrap();
+    let exact = [
+        ("equidistant:f=0.3", "kb"),
+        ("equidistant:f=0.5,fov=150", "kb"),
+        ("stereographic:f=0.35", "ucm"),
+        ("orthographic:f=0.66", "ucm"),
+        ("equisolid:f=0.45,fov=260", "ds"),
+        ("rectilinear:f=0.5", "radtan"),
+        ("general:f=0.4,k1=0.5,k2=0.5", "ucm"),
+        ("general:f=0.4,k1=0.8,k2=-1", "ucm"),
+    ];
+    let presets = PRESETS.iter().map(|p| (p.name, ""));
+    for (spec, model) in exact.into_iter().chain(presets) {
+        let classic = LensCamera::new(parse_spec(spec).unwrap(), size);
+        let equivalent = calibrated_equivalent(&classic).unwrap();
+        assert!(equivalent.exact, "{spec}");
+        assert!(
+            equivalent.residual_px < 1e-9,
+            "{spec}: {}",
+            equivalent.residual_px
+        );
+        if !model.is_empty() {
+            assert_eq!(equivalent.lens.model().name(), model, "{spec}");
+        }
+        let calibrated = LensCamera::new(Lens::Calibrated(equivalent.lens), size);
+        let mut rays = 0;
+        for j in 0..=48 {
+            for i in 0..=64 {
+                let p = DVec2::new(f64::from(i) * 5.0, f64::from(j) * 5.0);
+                match (classic.unproject(p), calibrated.unproject(p)) {
+                    (Some(a), Some(b)) => {
+                        assert!(a.distance(b) < 1e-9, "{spec} at {p}: {a} vs {b}");
+                        rays += 1;
+                    }
+                    (None, None) => {}
+                    // The mask's edge may fall either side by rounding.
+                    (a, b) => {
+                        let d = a.or(b).unwrap();
+                        let edge = classic.lens.theta_max();
+                        assert!(
+                            (d.z.acos() - edge).abs() < 1e-6,
+                            "{spec} at {p}: {a:?} vs {b:?}"
+                        );
+                    }
+                }
+            }
+        }
+        assert!(rays > 500, "{spec}: {rays} rays");
+        let file = calib::write(
+            &Calibration {
+                lens: equivalent.lens,
+                size,
+            },
+            CalibFormat::Basalt,
+        );
+        if let Ok(text) = file {
+            let back = calib::parse(&text, CalibFormat::Basalt).unwrap()[0];
+            assert_eq!(back.lens.model(), equivalent.lens.model(), "{spec}");
+        }
+    }
+    // Past the double sphere's 135° an equisolid lens is fitted instead (its whole 180°
+    // here); so is a general tan at another rate: its residual is the largest radial
+    // difference, measured here along the image's diagonal in pixels.
+    let wide = LensCamera::new(parse_spec("equisolid:f=0.45").unwrap(), size);
+    let wide = calibrated_equivalent(&wide).unwrap();
+    assert!(!wide.exact && wide.residual_px < 0.5, "{wide:?}");
+    let spec = "general:f=0.4,k1=0.7,k2=0.7";
+    let classic = LensCamera::new(parse_spec(spec).unwrap(), size);
+    let fitted = calibrated_equivalent(&classic).unwrap();
+    assert!(!fitted.exact);
+    assert_eq!(fitted.lens.model().name(), "kb");
+    assert!(
+        (1e-3..1.0).contains(&fitted.residual_px),
+        "{}",
+        fitted.residual_px
+    );
+    let calibrated = LensCamera::new(Lens::Calibrated(fitted.lens), size);
+    let centre = DVec2::new(160.0, 120.0);
+    let worst = (1..=100)
+        .filter_map(|k| {
+            let p = centre + DVec2::new(160.0, 120.0) * f64::from(k) / 100.0;
+            let d = classic.unproject(p)?;
+            Some(calibrated.project(d)?.distance(p))
+        })
+        .fold(0.0, f64::max);
+    assert!(
+        worst <= fitted.residual_px * 1.01 + 1e-9,
+        "{worst} vs {}",
+        fitted.residual_px
+    );
+    assert!(
+        worst > fitted.residual_px * 0.2,
+        "{worst} vs {}",
+        fitted.residual_px
+    );
+}

@@ -1051,6 +1051,27 @@ fn calibration_files_drive_lens_and_render() {
     assert!(text.contains("basalt"), "{text}");
     assert_eq!(fisheye_rt::lens::calib::read(&json).unwrap()[0], library[0]);
 
+    // A classic lens converts to its exact calibrated equivalent: the 180° canon preset is
+    // Kannala–Brandt with k = 0 and f W/2 pixels of focal length.
+    let kalibr = dir.join("canon.yaml");
+    let args = [
+        "lens",
+        "convert",
+        "--lens",
+        "canon-8-15mm@8mm",
+        "--size",
+        "512x384",
+    ];
+    let out = ["--format", "kalibr", "-o", kalibr.to_str().unwrap()];
+    let text = stdout(&fisheye(&[&args[..], &out].concat(), ""));
+    assert!(text.contains("is exactly kb:fx=107.52"), "{text}");
+    let back = fisheye_rt::lens::calib::read(&kalibr).unwrap()[0];
+    assert_eq!(
+        back.lens.model(),
+        CalibratedModel::KannalaBrandt { k: [0.0; 4] }
+    );
+    assert_eq!(back.lens.intrinsics().fx, 0.42 * 256.0);
+
     let png = dir.join("ds.png");
     let text = stdout(&fisheye(
         &[
@@ -1109,13 +1130,13 @@ fn calibration_files_drive_lens_and_render() {
                 "lens",
                 "convert",
                 "--lens",
-                "equidistant:f=1",
+                "orthographic:f=0.66",
                 "--format",
                 "kalibr",
                 "-o",
                 "x",
             ],
-            "classic lens",
+            "kalibr calibration format cannot express ucm",
         ),
         (
             vec![

@@ -9,9 +9,11 @@ use clap::Subcommand;
 use fisheye_rt::demo::LensDemo;
 use fisheye_rt::gpu::{GpuContext, Queries};
 use fisheye_rt::lens::calib::{self, CalibFormat, Calibration};
+use fisheye_rt::lens::fit::calibrated_equivalent;
 use fisheye_rt::lens::gpu::{DirectionSource, LensPoints};
 use fisheye_rt::lens::{
-    CalibratedModel, ImageSize, LensCamera, LensModel, PRESET_FOV_DEGREES, PRESETS, parse_spec,
+    CalibratedLens, CalibratedModel, ImageSize, LensCamera, LensModel, PRESET_FOV_DEGREES, PRESETS,
+    parse_spec,
 };
 use fisheye_rt::report;
 use fisheye_rt::trace::{save_png, write_file};
@@ -37,7 +39,8 @@ pub(crate) enum LensCommand {
     /// one's focal length and radial residual in pixels, best first.
     Fit(CameraArgs),
     /// Write a lens (--lens SPEC at --size, or --calib FILE) as a calibration file: OpenCV
-    /// YAML or XML, a Kalibr camchain or Basalt JSON.
+    /// YAML or XML, a Kalibr camchain or Basalt JSON. A classic lens is written as its exact
+    /// calibrated equivalent, or a fitted Kannala–Brandt model with its residual printed.
     Convert {
         #[command(flatten)]
         camera: CameraArgs,
@@ -205,16 +208,38 @@ pub(crate) fn fit(args: &CameraArgs) -> Result<()> {
 
 pub(crate) fn convert(args: &CameraArgs, format: CalibFormat, out: &Path) -> Result<()> {
     let camera = args.camera()?;
-    let Some(lens) = camera.lens.calibrated() else {
-        bail!(
-            "{} is a classic lens; calibration files hold calibrated models (see `fisheye lens \
-             list`)",
-            camera.lens
-        );
+    let lens = match camera.lens.calibrated() {
+        Some(lens) => *lens,
+        None => {
+            // A classic lens goes as its calibrated equivalent: exact, or fitted.
+            let equivalent = calibrated_equivalent(&camera)?;
+            let model = fisheye_rt::lens::Lens::Calibrated(equivalent.lens);
+            if equivalent.exact {
+                println!(
+                    "{} is exactly {model}; largest difference {:.1e} px (rounding)",
+                    camera.lens, equivalent.residual_px
+                );
+            } else {
+                println!(
+                    "{} has no exact calibrated equivalent: fitted {model}, largest radial \
+                     residual {:.2e} px over the angles the image shows",
+                    camera.lens, equivalent.residual_px
+                );
+            }
+            // The formats have no field of view: the file holds the mapping alone.
+            if let Some(fov) = equivalent.lens.max_fov() {
+                println!(
+                    "the {:.0}° field of view is not written (the formats hold none): readers \
+                     take the model's whole domain",
+                    fov.to_degrees()
+                );
+            }
+            CalibratedLens::new(equivalent.lens.model(), equivalent.lens.intrinsics())?
+        }
     };
     let text = calib::write(
         &Calibration {
-            lens: *lens,
+            lens,
             size: camera.size,
         },
         format,
