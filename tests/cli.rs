@@ -1158,6 +1158,23 @@ fn calibration_files_drive_lens_and_render() {
         "",
     );
     assert!(String::from_utf8_lossy(&clipped.stderr).contains("warning: kb: the mapping stops"));
+    // The same lens on an image that ends before the clip (its corners at θd 0.3, the turn at
+    // 0.70): nothing to warn about.
+    let unseen = fisheye(
+        &[
+            "lens",
+            "unproject",
+            "--lens",
+            "kb:fx=300,cx=1,cy=1,k1=-0.3",
+            "--size",
+            "64x64",
+        ],
+        "",
+    );
+    assert!(
+        unseen.status.success() && unseen.stderr.is_empty(),
+        "{unseen:?}"
+    );
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
@@ -1260,4 +1277,33 @@ fn validate_reports_and_fails_loudly() {
         "{errors}"
     );
     std::fs::remove_dir_all(dir).unwrap();
+}
+
+/// `--pixel-origin opencv` puts pixel centres at whole numbers, as OpenCV does: the same
+/// rays as the project's convention half a pixel on, both ways, on both paths; and the
+/// image's edge moves with it (-0.4 is inside, -0.6 is not).
+#[test]
+fn pixel_origin_opencv_shifts_by_half_a_pixel() {
+    let lens = ["--lens", "samyang-7.5mm", "--size", "64x48"];
+    for gpu in [&[][..], &["--gpu"]] {
+        let run = |command: &str, origin: &str, input: &str| {
+            let args = [
+                &["lens", command][..],
+                &lens,
+                gpu,
+                &["--pixel-origin", origin],
+            ]
+            .concat();
+            stdout(&fisheye(&args, input))
+        };
+        assert_eq!(
+            run("unproject", "opencv", "0 0\n10 20\n"),
+            run("unproject", "corner", "0.5 0.5\n10.5 20.5\n")
+        );
+        let centre = numbers(run("project", "opencv", "0 0 1\n").trim());
+        assert_eq!(centre, [31.5, 23.5]);
+        let edge = run("unproject", "opencv", "-0.4 10\n-0.6 10\n");
+        let lines: Vec<&str> = edge.lines().collect();
+        assert!(lines[0] != "none" && lines[1] == "none", "{edge}");
+    }
 }

@@ -202,7 +202,7 @@ impl CalibArgs {
     }
 
     /// The camera of `--calib`, or else `--lens` (required then) at `size`; warns when the
-    /// lens's field of view is clipped where its mapping turns.
+    /// lens's field of view is clipped where its mapping turns and the image reaches past it.
     pub(crate) fn camera(&self, lens: Option<&str>, size: ImageSize) -> Result<LensCamera> {
         let camera = match &self.calib {
             Some(path) => {
@@ -224,7 +224,17 @@ impl CalibArgs {
                 LensCamera::new(parse_spec(spec)?, size)
             }
         };
-        if let Some(turn) = camera.lens.calibrated().and_then(|l| l.turns_at()) {
+        // Warned about only where the image reaches past the clip: a corner beyond it.
+        let visible_turn = camera.lens.calibrated().and_then(|l| {
+            let i = l.intrinsics();
+            let (w, h) = (f64::from(camera.size.width), f64::from(camera.size.height));
+            let reach = [(0.0, 0.0), (w, 0.0), (0.0, h), (w, h)]
+                .map(|(x, y)| ((x - i.cx) / i.fx).hypot((y - i.cy) / i.fy))
+                .into_iter()
+                .fold(0.0, f64::max);
+            l.turns_at().filter(|_| reach > l.r_max())
+        });
+        if let Some(turn) = visible_turn {
             eprintln!(
                 "warning: {}: the mapping stops increasing at θ = {:.2}°, so the field of view \
                  is clipped to {:.2}° (pixels beyond have no ray)",
@@ -268,6 +278,29 @@ pub(crate) struct PointArgs {
     /// Evaluate the lens with its WGSL (f32) code on the GPU instead of the f64 reference.
     #[arg(long)]
     pub(crate) gpu: bool,
+    /// Pixel coordinates in and out: `corner` (the project's: the top-left pixel's corner is
+    /// (0, 0), its centre (0.5, 0.5)) or `opencv` (OpenCV's and most calibration tools':
+    /// pixel centres at whole numbers, the top-left pixel's centre at (0, 0)).
+    #[arg(long, value_enum, default_value = "corner")]
+    pub(crate) pixel_origin: PixelOrigin,
+}
+
+/// Where pixel coordinates start.
+#[derive(Clone, Copy, ValueEnum)]
+pub(crate) enum PixelOrigin {
+    Corner,
+    #[value(name = "opencv")]
+    OpenCv,
+}
+
+impl PixelOrigin {
+    /// What to add to a coordinate in this convention to get the project's.
+    pub(crate) fn to_corner(self) -> f64 {
+        match self {
+            PixelOrigin::Corner => 0.0,
+            PixelOrigin::OpenCv => 0.5,
+        }
+    }
 }
 
 impl PointArgs {

@@ -133,7 +133,11 @@ pub(crate) fn write_lines(lines: impl Iterator<Item = String>) -> Result<()> {
 
 pub(crate) fn unproject(args: &PointArgs) -> Result<()> {
     let camera = args.camera()?;
-    let pixels: Vec<DVec2> = read_points::<2>()?.into_iter().map(DVec2::from).collect();
+    let shift = DVec2::splat(args.pixel_origin.to_corner());
+    let pixels: Vec<DVec2> = read_points::<2>()?
+        .into_iter()
+        .map(|p| DVec2::from(p) + shift)
+        .collect();
     let dirs: Vec<Option<DVec3>> = if args.gpu {
         let ctx = GpuContext::new()?;
         LensPoints::new(&ctx, &camera)?
@@ -167,8 +171,9 @@ pub(crate) fn project(args: &PointArgs) -> Result<()> {
     } else {
         dirs.iter().map(|&d| camera.project(d)).collect()
     };
+    let shift = args.pixel_origin.to_corner();
     write_lines(pixels.into_iter().map(|p| match p {
-        Some(p) => format!("{:.6} {:.6}", p.x, p.y),
+        Some(p) => format!("{:.6} {:.6}", p.x - shift, p.y - shift),
         None => "none".into(),
     }))
 }
