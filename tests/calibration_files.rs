@@ -481,3 +481,93 @@ fn classic_lenses_convert_to_their_calibrated_equivalents() {
         fitted.residual_px
     );
 }
+
+/// Kalibr reads camchains with PyYAML (YAML 1.1): every number of every camchain we write is
+/// a float to PyYAML itself (not a string), with the value written. Basalt's JSON, read by
+/// Python's `json`, holds the values written. (`.ci/install-lavapipe` installs python3-yaml.)
+#[test]
+fn written_files_read_back_in_the_tools_own_readers() {
+    let dir = std::env::temp_dir().join(format!("fisheye-calib-py-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let size = fisheye_rt::lens::ImageSize::new(640, 480).unwrap();
+    let python = |script: &str, file: &std::path::Path| -> Vec<String> {
+        let output = std::process::Command::new("python3")
+            .args(["-c", script])
+            .arg(file)
+            .output()
+            .expect("python3 runs (install python3-yaml: .ci/install-lavapipe)");
+        assert!(
+            output.status.success(),
+            "{}",
+            String::from_utf8_lossy(&output.stderr)
+        );
+        String::from_utf8(output.stdout)
+            .unwrap()
+            .lines()
+            .map(String::from)
+            .collect()
+    };
+    // Each number of the lists, as `type value` (repr round-trips a float exactly).
+    let kalibr_script = "import sys, yaml\n\
+        c = yaml.safe_load(open(sys.argv[1]))['cam0']\n\
+        for key in ('intrinsics', 'distortion_coeffs'):\n\
+        \x20   for x in c[key]:\n\
+        \x20       print(type(x).__name__, repr(x))\n";
+    let basalt_script = "import sys, json\n\
+        c = json.load(open(sys.argv[1]))['value0']['intrinsics'][0]['intrinsics']\n\
+        for x in c.values():\n\
+        \x20   print(type(x).__name__, repr(x))\n";
+    let mut checked = 0;
+    for spec in CalibratedModel::EXAMPLES {
+        let lens = *parse_spec(spec).unwrap().calibrated().unwrap();
+        let calibration = Calibration { lens, size };
+        for (format, script) in [
+            (CalibFormat::Kalibr, kalibr_script),
+            (CalibFormat::Basalt, basalt_script),
+        ] {
+            let Ok(text) = calib::write(&calibration, format) else {
+                continue;
+            };
+            let file = dir.join(format!("cam.{}", format.name()));
+            std::fs::write(&file, &text).unwrap();
+            // The numbers as written, in order.
+            let written: Vec<f64> = match format {
+                CalibFormat::Kalibr => text
+                    .lines()
+                    .filter(|l| l.contains("intrinsics: [") || l.contains("coeffs: ["))
+                    .flat_map(|l| {
+                        let list = l.split_once('[').unwrap().1.trim_end_matches(']');
+                        list.split(", ")
+                            .filter(|n| !n.is_empty())
+                            .map(|n| n.parse::<f64>().unwrap())
+                            .collect::<Vec<_>>()
+                    })
+                    .collect(),
+                _ => text
+                    .lines()
+                    .filter(|l| {
+                        l.trim_start().starts_with('"')
+                            && l.contains("\": ")
+                            && !l.contains("camera_type")
+                    })
+                    .filter_map(|l| l.rsplit(": ").next()?.trim_end_matches(',').parse().ok())
+                    .collect(),
+            };
+            let read = python(script, &file);
+            assert_eq!(
+                read.len(),
+                written.len(),
+                "{spec} as {}: {read:?}",
+                format.name()
+            );
+            for (line, value) in read.iter().zip(&written) {
+                let (kind, number) = line.split_once(' ').unwrap();
+                assert_eq!(kind, "float", "{spec} as {}: {line}", format.name());
+                assert_eq!(number.parse::<f64>().unwrap(), *value, "{spec}: {line}");
+            }
+            checked += 1;
+        }
+    }
+    assert!(checked >= 8, "{checked} files checked");
+    std::fs::remove_dir_all(dir).unwrap();
+}
