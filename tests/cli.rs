@@ -333,6 +333,7 @@ fn render_writes_a_masked_png_and_reports() {
         "adapter:",
         "triangles",
         "kernels compiled and first dispatch: ",
+        "bytes a triangle (geometry 48, BVH ",
         "ms on the GPU (after compilation)",
         "primary rays",
         "wrote",

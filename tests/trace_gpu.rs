@@ -788,3 +788,22 @@ fn images_beyond_one_binding_are_traced_in_bands_bit_identically() {
         assert!(banded.counts().1 > 1000, "the grid is in view");
     }
 }
+
+/// The device bytes a scene reports are what its buffers hold: 48 bytes a triangle (three
+/// `vec4<f32>`), 80 a BVH node (obvhs's `CwBvhNode`), and shading data and textures where the
+/// default room has them (normals, UVs and its checker texture).
+#[test]
+fn scene_bytes_count_what_the_buffers_hold() {
+    use fisheye_rt::trace::GpuScene;
+    let scene = builtin::scene("default").unwrap();
+    let gpu = GpuScene::new(ctx(), &scene, &RenderOptions::default()).unwrap();
+    assert_eq!(gpu.bytes.geometry, 48 * u64::from(gpu.triangles));
+    assert_eq!(gpu.bytes.bvh, 80 * gpu.bvh_nodes as u64);
+    assert!(gpu.bytes.shading >= 48 * u64::from(gpu.triangles));
+    assert!(gpu.bytes.textures > 0);
+    let all = gpu.bytes.geometry + gpu.bytes.bvh + gpu.bytes.shading;
+    assert_eq!(
+        gpu.bytes.per_triangle(gpu.triangles),
+        all as f64 / f64::from(gpu.triangles)
+    );
+}

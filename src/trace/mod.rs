@@ -275,8 +275,30 @@ pub struct GpuScene {
     pub bvh_build_time: std::time::Duration,
     /// The acceleration structure, with [`Traversal::RayQuery`].
     pub ray_query: Option<RayQueryScene>,
+    /// What the scene's buffers hold on the device.
+    pub bytes: SceneBytes,
     /// The camera-to-world rotation.
     frame: Frame,
+}
+
+/// The bytes a scene's buffers take on the device, by what they hold.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct SceneBytes {
+    /// The triangles the traversal tests (48 bytes each).
+    pub geometry: u64,
+    /// The BVH's nodes (80 bytes each, obvhs's CWBVH).
+    pub bvh: u64,
+    /// Shading data: per-vertex normals and UVs, materials, lights.
+    pub shading: u64,
+    /// Texels and their table.
+    pub textures: u64,
+}
+
+impl SceneBytes {
+    /// Everything but the textures, per triangle.
+    pub fn per_triangle(&self, triangles: u32) -> f64 {
+        (self.geometry + self.bvh + self.shading) as f64 / f64::from(triangles.max(1))
+    }
 }
 
 impl GpuScene {
@@ -374,6 +396,13 @@ impl GpuScene {
             let bind_group = bind_buffers(device, "fisheye.scene", &layout, &resources);
             let ray_query = (options.traversal == Traversal::RayQuery)
                 .then(|| RayQueryScene::new(ctx, &buffers[1], scene.len() as u32));
+            let size = |k: usize| buffers[k].size();
+            let bytes = SceneBytes {
+                bvh: size(0),
+                geometry: size(1),
+                shading: size(2) + size(3) + size(4),
+                textures: size(5) + size(6),
+            };
             Self {
                 layout,
                 bind_group,
@@ -388,6 +417,7 @@ impl GpuScene {
                 bvh_nodes: bvh.nodes.len(),
                 bvh_depth: bvh.depth,
                 bvh_build_time: bvh.build_time,
+                bytes,
                 frame,
             }
         })?;

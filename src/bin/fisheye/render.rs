@@ -168,6 +168,17 @@ pub(crate) fn render(args: &RenderArgs) -> Result<()> {
         gpu_scene.bvh_depth,
         gpu_scene.bvh_build_time.as_secs_f64() * 1e3
     );
+    let bytes = gpu_scene.bytes;
+    let per = |b: u64| b as f64 / f64::from(gpu_scene.triangles.max(1));
+    println!(
+        "on the device: {:.0} bytes a triangle (geometry {:.0}, BVH {:.1}, shading {:.1}), \
+         textures {:.1} MiB",
+        bytes.per_triangle(gpu_scene.triangles),
+        per(bytes.geometry),
+        per(bytes.bvh),
+        per(bytes.shading),
+        bytes.textures as f64 / f64::from(1 << 20)
+    );
     if let Some(rq) = &gpu_scene.ray_query {
         println!(
             "ray queries: acceleration structure built by the driver in {:.1} ms",
