@@ -10,7 +10,7 @@ use glam::DVec2;
 
 use super::calibrated::{CalibratedLens, CalibratedModel, Intrinsics};
 use super::camera::{ImageSize, LensCamera};
-use super::model::{ClassicLens, Family, LensModel};
+use super::model::{Family, LensModel};
 use crate::error::LensError;
 
 /// A classic mapping fitted to a calibrated lens.
@@ -40,17 +40,24 @@ const CLASSIC: [(LensModel, Mapping); 4] = [
 /// The angles a fit covers: from the axis to the widest angle the image shows (its farthest
 /// corner, or the lens's domain edge), sampled evenly.
 pub fn fitted_angles(lens: &CalibratedLens, size: ImageSize) -> Vec<f64> {
+    shown_angles(|p| lens.unproject(p), size, lens.theta_max())
+}
+
+/// 512 angles from the axis to the widest the image shows: its farthest corner's, or
+/// `theta_max` (the domain's edge) where a corner has no ray.
+fn shown_angles(
+    unproject: impl Fn(DVec2) -> Option<glam::DVec3>,
+    size: ImageSize,
+    theta_max: f64,
+) -> Vec<f64> {
     let (w, h) = (f64::from(size.width), f64::from(size.height));
-    let widest = [(0.0, 0.0), (w, 0.0), (0.0, h), (w, h)]
+    let corners: Option<Vec<f64>> = [(0.0, 0.0), (w, 0.0), (0.0, h), (w, h)]
         .into_iter()
-        .filter_map(|(x, y)| lens.unproject(DVec2::new(x, y)))
-        .map(|d| d.z.clamp(-1.0, 1.0).acos())
-        .fold(0.0f64, f64::max);
-    let end = if widest > 0.0 {
-        widest.min(lens.theta_max())
-    } else {
-        lens.theta_max()
-    };
+        .map(|(x, y)| unproject(DVec2::new(x, y)).map(|d| d.z.clamp(-1.0, 1.0).acos()))
+        .collect();
+    let end = corners.map_or(theta_max, |c| {
+        c.into_iter().fold(0.0, f64::max).min(theta_max)
+    });
     (1..=512).map(|k| end * f64::from(k) / 512.0).collect()
 }
 
@@ -150,7 +157,7 @@ pub fn calibrated_equivalent(camera: &LensCamera) -> Result<Equivalent, LensErro
         )),
         _ => None,
     };
-    let angles = shown_angles(camera, &classic);
+    let angles = shown_angles(|p| camera.unproject(p), camera.size, classic.theta_max());
     let radius = |t: f64| classic.radius(t).map(|r| r * w / 2.0);
     // The slope at the axis, d/dθ of scale·g(rate θ), is the fit's focal length.
     let fitted = || {
@@ -220,21 +227,6 @@ fn residual(
         worst = worst.max((want - got * f).abs());
     }
     Ok(worst)
-}
-
-/// The angles a classic lens's image shows, from the axis to its farthest corner (or its
-/// domain's edge), 512 of them.
-fn shown_angles(camera: &LensCamera, classic: &ClassicLens) -> Vec<f64> {
-    let (w, h) = (f64::from(camera.size.width), f64::from(camera.size.height));
-    let corner = [(0.0, 0.0), (w, 0.0), (0.0, h), (w, h)]
-        .into_iter()
-        .map(|(x, y)| camera.normalized(DVec2::new(x, y)).length())
-        .fold(0.0, f64::max);
-    let end = classic
-        .theta(corner.min(classic.r_max()))
-        .unwrap_or(classic.theta_max())
-        .min(classic.theta_max());
-    (1..=512).map(|k| end * f64::from(k) / 512.0).collect()
 }
 
 /// Kannala–Brandt's k1..k4 for `θd(θ)` (the radius over the focal length) by least squares:

@@ -198,13 +198,17 @@ fn frame_for(origin: DVec3, pose: &Camera) -> Frame {
     view_frame(origin, pose.position, pose.rotation(), [0, 0])
 }
 
-/// `frame` for the band of output rows starting at `first_row`: its dispatch starts there,
-/// and its outputs hold rows from there on.
-fn band_frame(frame: Frame, first_row: u32) -> Frame {
-    Frame {
-        offset: [0, first_row, 0, first_row],
-        ..frame
-    }
+/// `frame` for each band of output rows `(first row, rows)`: its dispatch starts at the
+/// band's first row, and its outputs hold rows from there on (one band from row 0: the frame
+/// itself).
+fn band_frames(bands: &[(u32, u32)], frame: Frame) -> Vec<Frame> {
+    bands
+        .iter()
+        .map(|&(first, _)| Frame {
+            offset: [0, first, 0, first],
+            ..frame
+        })
+        .collect()
 }
 
 /// The frame of an eye and a camera-to-world rotation for a scene uploaded relative to
@@ -543,12 +547,9 @@ impl TracePass {
                 ]
             });
             // A slot per view, or per band (each band's frame starts at its first row).
-            let frames: Vec<Frame> = match bands.len() {
+            let frames = match bands.len() {
                 1 => vec![scene.frame; views as usize],
-                _ => bands
-                    .iter()
-                    .map(|&(first, _)| band_frame(scene.frame, first))
-                    .collect(),
+                _ => band_frames(&bands, scene.frame),
             };
             let slots = frame_slots(&frames);
             let frame = crate::gpu::buffer_init(
@@ -600,21 +601,9 @@ impl TracePass {
     /// stays where it was uploaded, relative to its own camera, so poses far from it lose the
     /// precision that relative upload buys; paths through a scene are fine.
     pub fn set_pose(&self, ctx: &GpuContext, scene: &GpuScene, pose: &Camera) {
-        let frames = self.band_frames(frame_for(scene.origin, pose));
+        let frames = band_frames(&self.bands, frame_for(scene.origin, pose));
         ctx.queue
             .write_buffer(&self.frame, 0, &frame_slots(&frames));
-    }
-
-    /// `frame` for each band (itself for a whole image).
-    fn band_frames(&self, frame: Frame) -> Vec<Frame> {
-        match self.bands.len() {
-            1 => vec![frame],
-            _ => self
-                .bands
-                .iter()
-                .map(|&(first, _)| band_frame(frame, first))
-                .collect(),
-        }
     }
 
     /// As [`TracePass::set_pose`] for view number `view` (see [`TracePass::with_views`]), with
@@ -647,7 +636,7 @@ impl TracePass {
         scene: &GpuScene,
         pose: &Camera,
     ) {
-        let slots = frame_slots(&self.band_frames(frame_for(scene.origin, pose)));
+        let slots = frame_slots(&band_frames(&self.bands, frame_for(scene.origin, pose)));
         let staging = crate::gpu::buffer_init(
             device,
             "fisheye.trace.pose",

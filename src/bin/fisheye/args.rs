@@ -224,16 +224,17 @@ impl CalibArgs {
                 LensCamera::new(parse_spec(spec)?, size)
             }
         };
-        // Warned about only where the image reaches past the clip: a corner beyond it.
-        let visible_turn = camera.lens.calibrated().and_then(|l| {
-            let i = l.intrinsics();
-            let (w, h) = (f64::from(camera.size.width), f64::from(camera.size.height));
-            let reach = [(0.0, 0.0), (w, 0.0), (0.0, h), (w, h)]
-                .map(|(x, y)| ((x - i.cx) / i.fx).hypot((y - i.cy) / i.fy))
-                .into_iter()
-                .fold(0.0, f64::max);
-            l.turns_at().filter(|_| reach > l.r_max())
-        });
+        // Warned about only where the image reaches past the clip: where the turn ends the
+        // domain, a corner without a ray lies beyond it.
+        let (w, h) = (f64::from(camera.size.width), f64::from(camera.size.height));
+        let corner_lost = [(0.0, 0.0), (w, 0.0), (0.0, h), (w, h)]
+            .into_iter()
+            .any(|(x, y)| camera.unproject(glam::DVec2::new(x, y)).is_none());
+        let visible_turn = camera
+            .lens
+            .calibrated()
+            .and_then(|l| l.turns_at())
+            .filter(|_| corner_lost);
         if let Some(turn) = visible_turn {
             eprintln!(
                 "warning: {}: the mapping stops increasing at θ = {:.2}°, so the field of view \
