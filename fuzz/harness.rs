@@ -10,6 +10,7 @@ use std::io::{Error, ErrorKind, Result};
 use std::path::Path;
 
 use fisheye_rt::bvh::{BvhQuality, SceneBvh};
+use fisheye_rt::dataset::trajectory::{self, TrajectoryFormat};
 use fisheye_rt::input::InputKind;
 use fisheye_rt::lens::calib::{self, CalibFormat};
 use fisheye_rt::lens::{ImageSize, Lens, LensCamera, parse_spec};
@@ -81,6 +82,10 @@ pub fn lens_spec(data: &[u8]) {
 pub fn calibration(data: &[u8]) {
     let text = String::from_utf8_lossy(data);
     for (_, format) in CalibFormat::ALL {
+        // A rig's cameras sit where rigid transforms put them.
+        for camera in calib::parse_rig(&text, format).into_iter().flatten() {
+            check_rigid(&camera.body_from_camera);
+        }
         let Ok(cameras) = calib::parse(&text, format) else {
             continue;
         };
@@ -96,6 +101,36 @@ pub fn calibration(data: &[u8]) {
             }
         }
     }
+}
+
+/// A trajectory in every format: an error, or poses with finite, rigid transforms and time
+/// stamps fit for file names.
+pub fn trajectory(data: &[u8]) {
+    let text = String::from_utf8_lossy(data);
+    for (_, format) in TrajectoryFormat::ALL {
+        for pose in trajectory::parse(&text, format, 10.0).into_iter().flatten() {
+            check_rigid(&pose.world_from_body);
+            assert!(pose.seconds.is_finite(), "{pose:?}");
+            let name_safe = pose.stamp.chars().all(|c| c.is_ascii_digit() || c == '.');
+            assert!(name_safe && !pose.stamp.is_empty(), "{pose:?}");
+        }
+    }
+}
+
+/// A transform that is a rotation (orthonormal, right-handed, to rounding) and a finite
+/// translation.
+fn check_rigid(t: &glam::DAffine3) {
+    let m = t.matrix3;
+    let off = (m.transpose() * m - glam::DMat3::IDENTITY)
+        .to_cols_array()
+        .into_iter()
+        .fold(0.0f64, |a, e| a.max(e.abs()));
+    assert!(off < 1e-12, "not orthonormal ({off:e}): {t:?}");
+    assert!(
+        (m.determinant() - 1.0).abs() < 1e-12,
+        "not a rotation: {t:?}"
+    );
+    assert!(t.translation.is_finite(), "{t:?}");
 }
 
 /// A loaded scene is what the renderer may take: triangles with finite corners, finite

@@ -46,6 +46,11 @@ impl BvhQuality {
         Self::Slow,
     ];
 
+    /// The preset called `name` (as [`BvhQuality::name`] gives it).
+    pub fn from_name(name: &str) -> Option<Self> {
+        Self::ALL.into_iter().find(|q| q.name() == name)
+    }
+
     /// The name on the command line.
     pub fn name(&self) -> &'static str {
         match self {

@@ -150,6 +150,14 @@ pub enum Error {
         /// What went wrong, with the line and key where the parser knows them.
         message: String,
     },
+    /// A trajectory, rig or dataset folder that cannot be used.
+    #[error("{path}: {message}")]
+    Dataset {
+        /// The file or folder.
+        path: std::path::PathBuf,
+        /// What is wrong, with the line where it is in a file.
+        message: String,
+    },
     /// A render option out of its range (with the choices).
     #[error("{0}")]
     Option(String),

@@ -27,6 +27,8 @@ pub enum InputKind {
     SceneFile,
     /// A camera calibration file (YAML, XML, JSON, text): 16 MiB.
     Calibration,
+    /// A trajectory of poses (TUM, KITTI, EuRoC text): 256 MiB (a day of poses at 200 Hz).
+    Trajectory,
 }
 
 impl InputKind {
@@ -38,6 +40,7 @@ impl InputKind {
             InputKind::Texture => "textures",
             InputKind::SceneFile => "scene files",
             InputKind::Calibration => "calibration files",
+            InputKind::Trajectory => "trajectories",
         }
     }
 
@@ -46,7 +49,7 @@ impl InputKind {
         const MIB: u64 = 1 << 20;
         match self {
             InputKind::Obj => 1024 * MIB,
-            InputKind::Texture => 256 * MIB,
+            InputKind::Texture | InputKind::Trajectory => 256 * MIB,
             InputKind::Mtl | InputKind::SceneFile | InputKind::Calibration => 16 * MIB,
         }
     }

@@ -13,6 +13,8 @@
 //! - [`scene`], [`bvh`], [`trace`]: scenes (built-in and OBJ), the CWBVH, and the GPU tracer
 //!   with its f64 reference.
 //! - [`renderer`]: rendering on the caller's device into the caller's texture and encoder.
+//! - [`pose`], [`dataset`]: rigid transforms, trajectories (TUM, KITTI, EuRoC) and synthetic
+//!   datasets of a camera rig along them, in shards.
 //! - [`cube`], [`raster`]: the cube-map path (faces ray traced or rasterized, then resampled),
 //!   to compare with direct ray tracing.
 //!
@@ -40,10 +42,12 @@
 
 pub mod bvh;
 pub mod cube;
+pub mod dataset;
 mod error;
 pub mod gpu;
 pub mod input;
 pub mod lens;
+pub mod pose;
 pub mod precision;
 pub mod raster;
 pub mod renderer;

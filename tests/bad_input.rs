@@ -475,7 +475,7 @@ fn the_readme_table_names_tests_that_exist() {
         .expect("the README has a \"Bad input, limits and faults\" section");
     let section = section.split("\n## ").next().unwrap();
     let mut sources = String::new();
-    for dir in ["tests", "src", "src/scene", "src/lens", "src/trace"] {
+    for dir in ["tests", "src", "src/scene", "src/lens", "src/trace", "src/dataset"] {
         for entry in std::fs::read_dir(root.join(dir)).unwrap() {
             let path = entry.unwrap().path();
             if path.extension().is_some_and(|e| e == "rs") {
@@ -674,6 +674,28 @@ fn repeated_clause(message: &str) -> Option<String> {
 /// One of each kind of error in the README's bad-input table, from the command line: exit
 /// status 1, the problem named, no panic, no image, and no clause said twice (the OS's reason,
 /// the file, the parameter).
+/// `fisheye dataset render` of `trajectory` through `cameras` (`--lens SPEC` or `--rig FILE`)
+/// into `out`, with `extra` arguments.
+fn dataset<'a>(
+    trajectory: &'a str,
+    cameras: &'a str,
+    which: &'a str,
+    out: &'a str,
+    extra: &[&'a str],
+) -> Vec<&'a str> {
+    let mut args = vec![
+        "dataset",
+        "render",
+        "--trajectory",
+        trajectory,
+        cameras,
+        which,
+    ];
+    args.extend(["-o", out]);
+    args.extend(extra);
+    args
+}
+
 #[test]
 fn every_error_says_each_clause_once() {
     assert_eq!(
@@ -695,7 +717,7 @@ fn every_error_says_each_clause_once() {
         .status()
         .unwrap();
     assert!(status.success());
-    let files: [(&str, String); 11] = [
+    let files: [(&str, String); 14] = [
         ("bad-face.obj", format!("{TRIANGLE}f 1 2 x\n")),
         ("bad-index.obj", format!("{TRIANGLE}f 1 2 9\n")),
         (
@@ -716,12 +738,25 @@ fn every_error_says_each_clause_once() {
         ("zero.toml", "[[mesh]]\npath = \"/dev/zero\"\n".into()),
         ("tri.obj", format!("{TRIANGLE}f 1 2 3\n")),
         ("calib.yaml", "cam0:\n  camera_model: pinhole\n".into()),
+        ("bad.tum", "0 0 0 0 0 0 0 1\n0.1 0 0 0 0 0 0 1 9\n".into()),
+        (
+            "two.yaml",
+            "cam0:\n  camera_model: pinhole\n  intrinsics: [10, 10, 8, 6]\n  resolution: [16, \
+             12]\ncam1:\n  camera_model: pinhole\n  intrinsics: [10, 10, 8, 6]\n  \
+             resolution: [16, 12]\n"
+                .into(),
+        ),
+        ("other/plan.json", "{}\n".into()),
     ];
+    std::fs::create_dir_all(dir.join("other")).unwrap();
     for (name, text) in &files {
         write(&dir, name, text.as_bytes());
     }
     let out = at("out.png");
     let small = ["--size", "32x24", "--spp", "1"];
+    const TUM: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/scenes/dataset/room-loop.tum");
+    const LENS: &str = "equidistant:f=1";
+    let (set, other) = (at("set"), at("other"));
     type Case<'a> = (Vec<String>, Vec<(&'a str, &'a str)>, &'a str);
     let cases: Vec<Case> = [
         (
@@ -790,17 +825,67 @@ fn every_error_says_each_clause_once() {
             vec![("FISHEYE_INJECT_FAULT", "device-lost")],
             "device was lost",
         ),
+        (
+            dataset(&at("bad.tum"), "--lens", LENS, &set, &[]),
+            vec![],
+            "line 2: 9 fields",
+        ),
+        (
+            dataset("/dev/zero", "--lens", LENS, &set, &[]),
+            vec![],
+            "a device",
+        ),
+        (
+            dataset(&at("tri.obj"), "--lens", LENS, &set, &[]),
+            vec![],
+            "tri.obj: not a trajectory",
+        ),
+        (
+            dataset(TUM, "--rig", &at("two.yaml"), &set, &[]),
+            vec![],
+            "cam1: no T_cn_cnm1",
+        ),
+        (
+            dataset(TUM, "--lens", LENS, &set, &["--shard", "4/4"]),
+            vec![],
+            "shard 4 of 4 does not exist",
+        ),
+        (
+            dataset(TUM, "--lens", LENS, &set, &["--t-body-rig", "1,2"]),
+            vec![],
+            "--t-body-rig \"1,2\" has 2 numbers",
+        ),
+        (
+            dataset(TUM, "--lens", LENS, &set, &["--resume"]),
+            vec![],
+            "holds no dataset",
+        ),
+        (
+            dataset(TUM, "--lens", LENS, &other, &[]),
+            vec![],
+            "plan of another dataset",
+        ),
+        (
+            vec!["dataset", "merge", &at("folder.obj")],
+            vec![],
+            "holds no dataset",
+        ),
     ]
     .into_iter()
     .map(|(args, env, needle)| {
         let mut args: Vec<String> = args.into_iter().map(String::from).collect();
-        if !args.iter().any(|a| a == "-o") {
+        let merge = args.get(1).is_some_and(|a| a == "merge");
+        if !args.iter().any(|a| a == "-o") && !merge {
             args.extend(["-o".to_string(), out.clone()]);
         }
         // Small and quick, unless the case sets the size (a calibration brings its own).
-        let sized = args.iter().any(|a| a == "--calib" || a == "--size");
+        let sized = args
+            .iter()
+            .any(|a| a == "--calib" || a == "--size" || a == "--rig");
         let keep = if sized { 2 } else { 0 };
-        args.extend(small[keep..].iter().map(|s| s.to_string()));
+        if !merge {
+            args.extend(small[keep..].iter().map(|s| s.to_string()));
+        }
         (args, env, needle)
     })
     .collect();

@@ -49,3 +49,8 @@ fn lens_spec_corpus() {
 fn calibration_corpus() {
     replay("calibration", harness::calibration);
 }
+
+#[test]
+fn trajectory_corpus() {
+    replay("trajectory", harness::trajectory);
+}

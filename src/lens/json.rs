@@ -249,6 +249,12 @@ impl Parser<'_> {
                     let escape = self
                         .peek()
                         .ok_or_else(|| self.error("the string is not closed"))?;
+                    // A non-ASCII escaped character spans several bytes: refused before
+                    // stepping one byte into it (an error's position must fall between
+                    // characters).
+                    if !escape.is_ascii() {
+                        return Err(self.error("unknown escape"));
+                    }
                     self.at += 1;
                     out.push(match escape {
                         b'"' => '"',
@@ -357,6 +363,8 @@ mod tests {
             ("1e999", "beyond the f64 range"),
             ("\"abc", "not closed"),
             ("\"\\x\"", "unknown escape"),
+            // A multi-byte character after a backslash (found by fuzzing: it panicked).
+            ("\"n\\Ú\"", "line 1, column 4: unknown escape"),
             ("\"\\ud800\"", "lone surrogate"),
             ("{} x", "unexpected text"),
             ("nul", "expected a value"),

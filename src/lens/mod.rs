@@ -11,6 +11,7 @@ pub mod fit;
 pub mod gpu;
 mod json;
 mod model;
+pub mod points;
 mod spec;
 
 pub use calibrated::{CalibratedLens, CalibratedModel, Intrinsics, newton_bound, solve};

@@ -15,7 +15,7 @@ pub use display::{
     ColourFile, Display, MASKED_RGB, Tone, colour_image, colour_image_with, linear_to_srgb,
     refuse_non_regular, save_png, write_atomically, write_colour, write_file,
 };
-pub use output::{Channel, RenderOutput};
+pub use output::{Channel, RenderOutput, Values};
 pub use ray_query::RayQueryScene;
 
 pub use crate::shared::{

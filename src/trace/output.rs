@@ -108,15 +108,21 @@ fn write_array<T: npyz::Serialize + npyz::AutoSerialize>(
     })
 }
 
-/// One array of a [`Channel`]: its per-pixel component count and the values, row-major.
-enum Values {
+/// One array of a [`Channel`], row-major, image rows first.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Values {
+    /// Floats: the components a pixel (1: H×W, else H×W×n) and the values.
     F32(usize, Vec<f32>),
+    /// One `u32` a pixel.
     U32(Vec<u32>),
+    /// One `u8` a pixel.
     U8(Vec<u8>),
 }
 
 impl RenderOutput {
-    fn values(&self, channel: Channel, directions: &[Option<DVec3>]) -> Values {
+    /// The values of `channel` as the files hold them; `directions` as for
+    /// [`RenderOutput::write_npy`].
+    pub fn values(&self, channel: Channel, directions: &[Option<DVec3>]) -> Values {
         match channel {
             Channel::Range => Values::F32(1, self.geometry.iter().map(|g| g[3]).collect()),
             Channel::Normal => Values::F32(

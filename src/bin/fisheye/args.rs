@@ -294,12 +294,11 @@ pub(crate) enum PixelOrigin {
     OpenCv,
 }
 
-impl PixelOrigin {
-    /// What to add to a coordinate in this convention to get the project's.
-    pub(crate) fn to_corner(self) -> f64 {
-        match self {
-            PixelOrigin::Corner => 0.0,
-            PixelOrigin::OpenCv => 0.5,
+impl From<PixelOrigin> for fisheye_rt::lens::points::PixelOrigin {
+    fn from(origin: PixelOrigin) -> Self {
+        match origin {
+            PixelOrigin::Corner => Self::Corner,
+            PixelOrigin::OpenCv => Self::OpenCv,
         }
     }
 }

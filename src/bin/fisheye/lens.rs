@@ -10,7 +10,8 @@ use fisheye_rt::demo::LensDemo;
 use fisheye_rt::gpu::{GpuContext, Queries};
 use fisheye_rt::lens::calib::{self, CalibFormat, Calibration};
 use fisheye_rt::lens::fit::calibrated_equivalent;
-use fisheye_rt::lens::gpu::{DirectionSource, LensPoints};
+use fisheye_rt::lens::gpu::DirectionSource;
+use fisheye_rt::lens::points;
 use fisheye_rt::lens::{
     CalibratedLens, CalibratedModel, ImageSize, LensCamera, LensModel, PRESET_FOV_DEGREES, PRESETS,
     parse_spec,
@@ -133,47 +134,22 @@ pub(crate) fn write_lines(lines: impl Iterator<Item = String>) -> Result<()> {
 
 pub(crate) fn unproject(args: &PointArgs) -> Result<()> {
     let camera = args.camera()?;
-    let shift = DVec2::splat(args.pixel_origin.to_corner());
-    let pixels: Vec<DVec2> = read_points::<2>()?
-        .into_iter()
-        .map(|p| DVec2::from(p) + shift)
-        .collect();
-    let dirs: Vec<Option<DVec3>> = if args.gpu {
-        let ctx = GpuContext::new()?;
-        LensPoints::new(&ctx, &camera)?
-            .unproject(&ctx, &pixels)?
-            .into_iter()
-            .map(|d| d.map(|d| d.as_dvec3()))
-            .collect()
-    } else {
-        pixels.iter().map(|&p| camera.unproject(p)).collect()
-    };
-    // A pixel outside the image has no ray, as `project` answers `none` for a direction
-    // landing outside it.
-    let (w, h) = (f64::from(camera.size.width), f64::from(camera.size.height));
-    let inside = |p: &DVec2| (0.0..=w).contains(&p.x) && (0.0..=h).contains(&p.y);
-    write_lines(pixels.iter().zip(dirs).map(|(p, d)| match d {
-        Some(d) if inside(p) => format!("{:.9} {:.9} {:.9}", d.x, d.y, d.z),
-        _ => "none".into(),
+    let pixels: Vec<DVec2> = read_points::<2>()?.into_iter().map(DVec2::from).collect();
+    let ctx = args.gpu.then(GpuContext::new).transpose()?;
+    let dirs = points::unproject(&camera, &pixels, args.pixel_origin.into(), ctx.as_ref())?;
+    write_lines(dirs.into_iter().map(|d| match d {
+        Some(d) => format!("{:.9} {:.9} {:.9}", d.x, d.y, d.z),
+        None => "none".into(),
     }))
 }
 
 pub(crate) fn project(args: &PointArgs) -> Result<()> {
     let camera = args.camera()?;
     let dirs: Vec<DVec3> = read_points::<3>()?.into_iter().map(DVec3::from).collect();
-    let pixels: Vec<Option<DVec2>> = if args.gpu {
-        let ctx = GpuContext::new()?;
-        LensPoints::new(&ctx, &camera)?
-            .project(&ctx, &dirs)?
-            .into_iter()
-            .map(|p| p.map(|p| p.as_dvec2()))
-            .collect()
-    } else {
-        dirs.iter().map(|&d| camera.project(d)).collect()
-    };
-    let shift = args.pixel_origin.to_corner();
+    let ctx = args.gpu.then(GpuContext::new).transpose()?;
+    let pixels = points::project(&camera, &dirs, args.pixel_origin.into(), ctx.as_ref())?;
     write_lines(pixels.into_iter().map(|p| match p {
-        Some(p) => format!("{:.6} {:.6}", p.x - shift, p.y - shift),
+        Some(p) => format!("{:.6} {:.6}", p.x, p.y),
         None => "none".into(),
     }))
 }

@@ -2,8 +2,10 @@
 //! the command line and hands each command to its module.
 
 mod args;
+mod dataset;
 mod info;
 mod lens;
+mod progress;
 mod render;
 mod study;
 mod validate;
@@ -47,6 +49,13 @@ pub(crate) enum Command {
     /// table, JSON, an overlay per lens and an error plot into the --out folder; exits
     /// non-zero if a lens misses the bound.
     Validate(ValidateArgs),
+    /// Synthetic datasets: a rig of calibrated cameras along a trajectory (TUM, KITTI,
+    /// EuRoC), every camera rendered at every pose with its ground truth, in shards for
+    /// several machines that resume after a kill; then the manifest.
+    Dataset {
+        #[command(subcommand)]
+        command: dataset::DatasetCommand,
+    },
     /// List the built-in scenes.
     Scenes,
     /// Show the GPU adapter, its optional features and limits, and measure the precision of
@@ -72,6 +81,7 @@ pub(crate) fn run(cli: Cli) -> Result<()> {
         Command::Bench(args) => run_bench(&args),
         Command::Compare(args) => run_compare(&args),
         Command::Validate(args) => validate::run_validate(&args),
+        Command::Dataset { command } => dataset::run(&command),
         Command::Scenes => {
             for (name, what) in builtin::SCENES {
                 println!("builtin:{name:<14} {what}");

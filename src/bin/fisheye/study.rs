@@ -6,7 +6,7 @@ use anyhow::{Context, Result, bail};
 use fisheye_rt::bench::{self, PathKind, SceneSet, Setup};
 use fisheye_rt::gpu::GpuContext;
 use fisheye_rt::lens::{LensCamera, parse_spec};
-use fisheye_rt::report::{self, LensRun, Progress, Study};
+use fisheye_rt::report::{self, LensRun, Study};
 use fisheye_rt::scene::Scene;
 use fisheye_rt::trace::RenderOptions;
 use fisheye_rt::trace::sampling::samples_per_side;
@@ -151,33 +151,6 @@ pub(crate) fn out_folder(out: Option<&std::path::Path>, command: &str) -> Result
     Ok(out)
 }
 
-/// A progress bar on stderr when it is a terminal, else a line per new setup.
-pub(crate) fn progress_bar() -> impl FnMut(Progress<'_>) {
-    use std::io::IsTerminal;
-    let terminal = std::io::stderr().is_terminal();
-    let mut last = String::new();
-    move |p: Progress<'_>| {
-        if terminal {
-            let width = 30;
-            let filled = (width * p.done / p.total.max(1)).min(width);
-            eprint!(
-                "\r[{}{}] {:>5}/{} frames  {:<40}",
-                "#".repeat(filled),
-                ".".repeat(width - filled),
-                p.done,
-                p.total,
-                p.what
-            );
-            if p.done == p.total {
-                eprintln!();
-            }
-        } else if p.what != last {
-            eprintln!("[{}/{} frames] {}", p.done, p.total, p.what);
-        }
-        last = p.what.to_string();
-    }
-}
-
 /// Prints the table lines of a report's Markdown and where the files went.
 pub(crate) fn finish(markdown: &str, out: &std::path::Path, plot_warning: Option<String>) {
     println!();
@@ -199,7 +172,13 @@ pub(crate) fn run_bench(args: &BenchArgs) -> Result<()> {
         None => PathKind::Walk,
     };
     let study = p.study(&args.study);
-    let report = report::bench(&study, path, args.frames, args.warmup, &mut progress_bar())?;
+    let report = report::bench(
+        &study,
+        path,
+        args.frames,
+        args.warmup,
+        &mut crate::progress::frames(),
+    )?;
     let warning = report.write(&p.out)?;
     finish(&report.markdown(), &p.out, warning);
     Ok(())
@@ -211,7 +190,14 @@ pub(crate) fn run_compare(args: &CompareArgs) -> Result<()> {
     let p = prepare(&args.study, "compare")?;
     let study = p.study(&args.study);
     let pose = p.scene.camera;
-    let report = report::compare(&study, &pose, args.frames, spp, &p.out, &mut progress_bar())?;
+    let report = report::compare(
+        &study,
+        &pose,
+        args.frames,
+        spp,
+        &p.out,
+        &mut crate::progress::frames(),
+    )?;
     let warning = report.write(&p.out)?;
     finish(&report.markdown(), &p.out, warning);
     Ok(())

@@ -56,9 +56,11 @@ pub(crate) fn run_validate(args: &ValidateArgs) -> Result<()> {
     let ctx = GpuContext::new()?;
     println!("adapter: {}", ctx.adapter_name());
     let count = lenses.len();
+    let mut progress = crate::progress::Progress::new(count, "lenses");
     let report = fisheye_rt::validate::run(&ctx, &lenses, args.supersample, &mut |k, name| {
-        eprintln!("[{}/{count}] {name}", k + 1);
+        progress.update(k, name);
     })?;
+    progress.update(count, "done");
     let warning = report.write(&out)?;
     finish(&report.markdown(), &out, warning);
     let failed: Vec<&str> = report

@@ -1,0 +1,521 @@
+//! The `fisheye_rt` Python module: lens models that map numpy arrays of pixels and directions
+//! (the f64 reference, or the WGSL code on the GPU), scenes, and a renderer that uploads a
+//! scene once and renders it through any lens from any pose into numpy arrays. The GIL is
+//! released while the GPU (or a long CPU loop) works. Errors are Python exceptions carrying
+//! the library's message: `ValueError` for bad input, `OSError` for files, `RuntimeError` for
+//! the GPU.
+
+use std::collections::HashMap;
+use std::path::PathBuf;
+use std::sync::{Arc, Mutex, OnceLock};
+
+use fisheye_rt::dataset::camera_from_transform;
+use fisheye_rt::gpu::GpuContext;
+use fisheye_rt::lens::points::{self, PixelOrigin};
+use fisheye_rt::lens::{ImageSize, LensCamera, calib, parse_spec};
+use fisheye_rt::scene::Camera;
+use fisheye_rt::trace::{
+    Channel, Display, GpuScene, RenderOptions, RenderOutput, Tone, TracePass, Values,
+    colour_image_with, world_directions,
+};
+use fisheye_rt::{Error, LensError};
+use glam::{DVec2, DVec3};
+use numpy::ndarray::IxDyn;
+use numpy::{AllowTypeChange, PyArray1, PyArrayDyn, PyArrayLikeDyn, PyArrayMethods};
+use pyo3::exceptions::{PyOSError, PyRuntimeError, PyValueError};
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+
+/// The library's error as the Python exception of its kind, with its message.
+fn raise(error: Error) -> PyErr {
+    let message = error.to_string();
+    match error {
+        Error::Io { .. } | Error::Image { .. } => PyOSError::new_err(message),
+        Error::NoAdapter { .. }
+        | Error::AdapterNotFound { .. }
+        | Error::RequestDevice { .. }
+        | Error::MissingFeature { .. }
+        | Error::Gpu { .. }
+        | Error::DeviceLost(_)
+        | Error::Limits(_)
+        | Error::Limit(_) => PyRuntimeError::new_err(message),
+        _ => PyValueError::new_err(message),
+    }
+}
+
+fn lens_error(error: LensError) -> PyErr {
+    raise(Error::Lens(error))
+}
+
+/// The one GPU context of the process, made at first use.
+fn context() -> PyResult<&'static GpuContext> {
+    static CONTEXT: OnceLock<GpuContext> = OnceLock::new();
+    if let Some(ctx) = CONTEXT.get() {
+        return Ok(ctx);
+    }
+    let ctx = GpuContext::new().map_err(raise)?;
+    Ok(CONTEXT.get_or_init(|| ctx))
+}
+
+fn pixel_origin(name: &str) -> PyResult<PixelOrigin> {
+    match name {
+        "corner" => Ok(PixelOrigin::Corner),
+        "opencv" => Ok(PixelOrigin::OpenCv),
+        other => Err(PyValueError::new_err(format!(
+            "pixel_origin={other:?}: use \"corner\" (the top-left pixel's corner at (0, 0)) or \
+             \"opencv\" (its centre at (0, 0))"
+        ))),
+    }
+}
+
+/// An array of points, `(..., n)`: its leading shape and its points, row-major.
+fn points_of<const N: usize>(
+    array: &PyArrayLikeDyn<'_, f64, AllowTypeChange>,
+    what: &str,
+) -> PyResult<(Vec<usize>, Vec<[f64; N]>)> {
+    let view = array.as_array();
+    let shape = view.shape().to_vec();
+    if shape.last() != Some(&N) {
+        return Err(PyValueError::new_err(format!(
+            "{what} has shape {shape:?}; give an array of shape (..., {N})"
+        )));
+    }
+    let values: Vec<f64> = view.iter().copied().collect();
+    let points = values
+        .chunks_exact(N)
+        .map(|c| <[f64; N]>::try_from(c).expect("chunks of N"))
+        .collect();
+    Ok((shape[..shape.len() - 1].to_vec(), points))
+}
+
+/// `values` as an array of shape `leading + (n,)`.
+fn array_of<'py>(
+    py: Python<'py>,
+    leading: &[usize],
+    n: usize,
+    values: Vec<f64>,
+) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+    let mut shape = leading.to_vec();
+    shape.push(n);
+    PyArray1::from_vec(py, values).reshape(IxDyn(&shape))
+}
+
+/// A lens at an image size: a classic model or a calibrated camera.
+#[pyclass(frozen, module = "fisheye_rt")]
+struct Lens {
+    camera: LensCamera,
+}
+
+#[pymethods]
+impl Lens {
+    /// A lens from its spec (see `fisheye lens list`: `"samyang-7.5mm"`,
+    /// `"equisolid:f=0.6,fov=180"`, `"kb:fx=...,k1=..."`) at `size = (width, height)`.
+    #[staticmethod]
+    fn from_spec(spec: &str, size: (u32, u32)) -> PyResult<Self> {
+        let size = ImageSize::new(size.0, size.1).map_err(lens_error)?;
+        let lens = parse_spec(spec).map_err(lens_error)?;
+        Ok(Self {
+            camera: LensCamera::new(lens, size),
+        })
+    }
+
+    /// Camera `camera` (0 is the first) of a calibration file (OpenCV YAML/XML, a Kalibr
+    /// camchain or Basalt JSON), at its calibrated size.
+    #[staticmethod]
+    #[pyo3(signature = (path, camera = 0))]
+    fn from_calibration(path: PathBuf, camera: usize) -> PyResult<Self> {
+        let cameras = calib::read(&path).map_err(lens_error)?;
+        let Some(c) = cameras.get(camera) else {
+            return Err(PyValueError::new_err(format!(
+                "{} holds {} camera(s); camera={camera} is not one",
+                path.display(),
+                cameras.len()
+            )));
+        };
+        Ok(Self {
+            camera: LensCamera::new(c.lens, c.size),
+        })
+    }
+
+    /// `(width, height)` in pixels.
+    #[getter]
+    fn size(&self) -> (u32, u32) {
+        (self.camera.size.width, self.camera.size.height)
+    }
+
+    /// The lens as a spec `from_spec` reads back.
+    #[getter]
+    fn spec(&self) -> String {
+        self.camera.lens.to_string()
+    }
+
+    fn __repr__(&self) -> String {
+        format!(
+            "Lens.from_spec({:?}, size=({}, {}))",
+            self.spec(),
+            self.camera.size.width,
+            self.camera.size.height
+        )
+    }
+
+    /// Unit directions (camera frame: x right, y down, z forward) of pixels, an array of shape
+    /// (..., 2); rows are NaN where a pixel has no ray (outside the image or the lens's
+    /// field). `pixel_origin` is "corner" (this project's: the top-left pixel's corner at
+    /// (0, 0)) or "opencv" (its centre at (0, 0)). `gpu=True` runs the lens's WGSL code (f32)
+    /// instead of the f64 reference.
+    #[pyo3(signature = (pixels, pixel_origin = "corner", gpu = false))]
+    fn unproject<'py>(
+        &self,
+        py: Python<'py>,
+        pixels: PyArrayLikeDyn<'py, f64, AllowTypeChange>,
+        pixel_origin: &str,
+        gpu: bool,
+    ) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+        let origin = self::pixel_origin(pixel_origin)?;
+        let (leading, points) = points_of::<2>(&pixels, "pixels")?;
+        let ctx = if gpu { Some(context()?) } else { None };
+        let camera = self.camera;
+        let dirs = py.detach(move || {
+            let pixels: Vec<DVec2> = points.into_iter().map(DVec2::from).collect();
+            points::unproject(&camera, &pixels, origin, ctx)
+        });
+        let values = dirs
+            .map_err(raise)?
+            .into_iter()
+            .flat_map(|d| d.map_or([f64::NAN; 3], |d| d.to_array()))
+            .collect();
+        array_of(py, &leading, 3, values)
+    }
+
+    /// Pixels where directions (camera frame, an array of shape (..., 3), any length) land;
+    /// rows are NaN where one lands outside the lens's field or the image. `pixel_origin` and
+    /// `gpu` as for `unproject`.
+    #[pyo3(signature = (directions, pixel_origin = "corner", gpu = false))]
+    fn project<'py>(
+        &self,
+        py: Python<'py>,
+        directions: PyArrayLikeDyn<'py, f64, AllowTypeChange>,
+        pixel_origin: &str,
+        gpu: bool,
+    ) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+        let origin = self::pixel_origin(pixel_origin)?;
+        let (leading, points) = points_of::<3>(&directions, "directions")?;
+        let ctx = if gpu { Some(context()?) } else { None };
+        let camera = self.camera;
+        let pixels = py.detach(move || {
+            let dirs: Vec<DVec3> = points.into_iter().map(DVec3::from).collect();
+            points::project(&camera, &dirs, origin, ctx)
+        });
+        let values = pixels
+            .map_err(raise)?
+            .into_iter()
+            .flat_map(|p| p.map_or([f64::NAN; 2], |p| p.to_array()))
+            .collect();
+        array_of(py, &leading, 2, values)
+    }
+}
+
+/// The 4×4 `T_scene_camera` (OpenCV camera frame) of a look-at camera.
+fn transform_of(camera: &Camera) -> [[f64; 4]; 4] {
+    let r = camera.rotation();
+    let p = camera.position;
+    let row = |i: usize| [r.x_axis[i], r.y_axis[i], r.z_axis[i], p[i]];
+    [row(0), row(1), row(2), [0.0, 0.0, 0.0, 1.0]]
+}
+
+fn matrix<'py>(py: Python<'py>, m: [[f64; 4]; 4]) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+    PyArray1::from_vec(py, m.concat()).reshape(IxDyn(&[4, 4]))
+}
+
+/// A scene: built-in, a scene file or an OBJ.
+#[pyclass(frozen, module = "fisheye_rt")]
+struct Scene {
+    scene: Arc<fisheye_rt::scene::Scene>,
+    name: String,
+    warnings: Vec<String>,
+}
+
+#[pymethods]
+impl Scene {
+    /// Loads `"builtin:NAME"`, a scene file (`.toml`) or an OBJ file; what was repaired on the
+    /// way is in `warnings`.
+    #[staticmethod]
+    fn load(spec: PathBuf) -> PyResult<Self> {
+        let name = spec.to_string_lossy().into_owned();
+        let loaded = fisheye_rt::scene::load(&name).map_err(raise)?;
+        Ok(Self {
+            scene: Arc::new(loaded.scene),
+            name,
+            warnings: loaded.warnings,
+        })
+    }
+
+    /// How many triangles it has.
+    #[getter]
+    fn triangles(&self) -> usize {
+        self.scene.len()
+    }
+
+    /// Its own camera as `T_scene_camera`, a 4×4 array (OpenCV camera frame).
+    #[getter]
+    fn camera<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+        matrix(py, transform_of(&self.scene.camera))
+    }
+
+    /// What loading repaired, one line each.
+    #[getter]
+    fn warnings(&self) -> Vec<String> {
+        self.warnings.clone()
+    }
+
+    fn __repr__(&self) -> String {
+        format!(
+            "Scene.load({:?})  # {} triangles",
+            self.name,
+            self.scene.len()
+        )
+    }
+}
+
+/// `T_scene_camera` (4×4, OpenCV camera frame) of a camera at `eye` looking at `target`, level
+/// with `up`.
+#[pyfunction]
+#[pyo3(signature = (eye, target, up = (0.0, 1.0, 0.0)))]
+fn look_at<'py>(
+    py: Python<'py>,
+    eye: (f64, f64, f64),
+    target: (f64, f64, f64),
+    up: (f64, f64, f64),
+) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+    let camera = Camera {
+        position: eye.into(),
+        look_at: target.into(),
+        up: up.into(),
+    };
+    if (camera.look_at - camera.position).length_squared() == 0.0 {
+        return Err(PyValueError::new_err("eye and target are the same point"));
+    }
+    matrix(py, transform_of(&camera))
+}
+
+/// The outputs `render` can return.
+const OUTPUTS: [&str; 7] = [
+    "colour",
+    "srgb",
+    "range",
+    "normal",
+    "id",
+    "direction",
+    "mask",
+];
+
+/// What a renderer keeps between calls: the scene on the GPU and a trace pass per lens and
+/// rays per pixel.
+struct State {
+    scene: GpuScene,
+    passes: HashMap<(String, u32, u32, u32), TracePass>,
+}
+
+/// A scene on the GPU, rendered through any lens from any pose into numpy arrays; the scene is
+/// uploaded (and its BVH built) once.
+#[pyclass(frozen, module = "fisheye_rt")]
+struct Renderer {
+    scene: Arc<fisheye_rt::scene::Scene>,
+    options: RenderOptions,
+    state: Mutex<State>,
+}
+
+#[pymethods]
+impl Renderer {
+    /// Builds the scene's BVH and uploads it. `max_depth` bounds reflection and refraction
+    /// (0 to 8); `bvh` is the build preset ("fastest", "very-fast", "fast", "medium",
+    /// "slow").
+    #[new]
+    #[pyo3(signature = (scene, max_depth = 5, bvh = "fast"))]
+    fn new(py: Python<'_>, scene: &Scene, max_depth: u32, bvh: &str) -> PyResult<Self> {
+        let bvh = fisheye_rt::bvh::BvhQuality::from_name(bvh).ok_or_else(|| {
+            PyValueError::new_err(format!(
+                "bvh={bvh:?}: use fastest, very-fast, fast, medium or slow"
+            ))
+        })?;
+        let options = RenderOptions {
+            max_depth,
+            bvh,
+            ..RenderOptions::default()
+        };
+        let ctx = context()?;
+        let shared = Arc::clone(&scene.scene);
+        let gpu = py
+            .detach(move || GpuScene::new(ctx, &shared, &options))
+            .map_err(raise)?;
+        Ok(Self {
+            scene: Arc::clone(&scene.scene),
+            options,
+            state: Mutex::new(State {
+                scene: gpu,
+                passes: HashMap::new(),
+            }),
+        })
+    }
+
+    /// The GPU adapter it renders on.
+    #[getter]
+    fn adapter(&self) -> PyResult<String> {
+        Ok(context()?.adapter_name())
+    }
+
+    /// Renders the scene through `lens` from `pose` (a 4×4 `T_scene_camera`, OpenCV camera
+    /// frame, e.g. from `look_at`; the scene's own camera if None) with `spp` rays per pixel
+    /// (a square, 1 to 256), and returns a dict of arrays, one per name in `outputs`:
+    /// "colour" (H×W×4 float32: linear RGB, alpha the lens's coverage), "srgb" (H×W×4 uint8,
+    /// through `exposure` stops and the `tone` curve "aces" or "clamp", as `fisheye render`
+    /// writes PNGs), and the centre ray's ground truth "range" (H×W float32), "normal"
+    /// (H×W×3 float32), "id" (H×W uint32, 4294967295 for none), "direction" (H×W×3 float32,
+    /// scene frame) and "mask" (H×W uint8). The same arrays `fisheye render --outputs`
+    /// writes, bit for bit.
+    #[pyo3(signature = (lens, pose = None, spp = 16, outputs = vec!["colour".to_string(), "srgb".to_string()], exposure = 0.0, tone = "aces"))]
+    #[allow(clippy::too_many_arguments)]
+    fn render<'py>(
+        &self,
+        py: Python<'py>,
+        lens: &Lens,
+        pose: Option<PyArrayLikeDyn<'py, f64, AllowTypeChange>>,
+        spp: u32,
+        outputs: Vec<String>,
+        exposure: f32,
+        tone: &str,
+    ) -> PyResult<Bound<'py, PyDict>> {
+        if let Some(bad) = outputs.iter().find(|o| !OUTPUTS.contains(&o.as_str())) {
+            return Err(PyValueError::new_err(format!(
+                "outputs: {bad:?} is not one of {}",
+                OUTPUTS.join(", ")
+            )));
+        }
+        let tone = match tone {
+            "aces" => Tone::Aces,
+            "clamp" => Tone::Clamp,
+            other => {
+                return Err(PyValueError::new_err(format!(
+                    "tone={other:?}: use \"aces\" or \"clamp\""
+                )));
+            }
+        };
+        if !exposure.is_finite() {
+            return Err(PyValueError::new_err(format!(
+                "exposure={exposure}: give a finite number of stops"
+            )));
+        }
+        let pose = match pose {
+            None => self.scene.camera,
+            Some(array) => {
+                let view = array.as_array();
+                if view.shape() != [4, 4] {
+                    return Err(PyValueError::new_err(format!(
+                        "pose has shape {:?}; give a 4×4 T_scene_camera",
+                        view.shape()
+                    )));
+                }
+                let rows: Vec<Vec<f64>> = view
+                    .outer_iter()
+                    .map(|row| row.iter().copied().collect())
+                    .collect();
+                let t = fisheye_rt::pose::rigid_from_rows(&rows)
+                    .map_err(|e| PyValueError::new_err(format!("pose: {e}")))?;
+                camera_from_transform(&t)
+            }
+        };
+        let ctx = context()?;
+        let camera = lens.camera;
+        let options = self.options;
+        let output = py.detach(|| self.trace(ctx, &camera, &pose, spp, &options))?;
+        let dict = PyDict::new(py);
+        let (h, w) = (camera.size.height as usize, camera.size.width as usize);
+        let directions = world_directions(&camera, &pose);
+        for name in &outputs {
+            let array = match name.as_str() {
+                "colour" => PyArray1::from_vec(py, output.colour.concat())
+                    .reshape(IxDyn(&[h, w, 4]))?
+                    .into_any(),
+                "srgb" => {
+                    let display = Display { exposure, tone };
+                    let image = colour_image_with(output.size, &output.colour, &display);
+                    PyArray1::from_vec(py, image.into_raw())
+                        .reshape(IxDyn(&[h, w, 4]))?
+                        .into_any()
+                }
+                channel => {
+                    let channel = Channel::ALL
+                        .into_iter()
+                        .find(|c| c.name() == channel)
+                        .expect("the names were checked");
+                    match output.values(channel, &directions) {
+                        Values::F32(1, v) => PyArray1::from_vec(py, v)
+                            .reshape(IxDyn(&[h, w]))?
+                            .into_any(),
+                        Values::F32(n, v) => PyArray1::from_vec(py, v)
+                            .reshape(IxDyn(&[h, w, n]))?
+                            .into_any(),
+                        Values::U32(v) => PyArray1::from_vec(py, v)
+                            .reshape(IxDyn(&[h, w]))?
+                            .into_any(),
+                        Values::U8(v) => PyArray1::from_vec(py, v)
+                            .reshape(IxDyn(&[h, w]))?
+                            .into_any(),
+                    }
+                }
+            };
+            dict.set_item(name, array)?;
+        }
+        Ok(dict)
+    }
+}
+
+impl Renderer {
+    /// Traces one frame (a pass per lens and `spp`, made at first use) and reads it back.
+    fn trace(
+        &self,
+        ctx: &GpuContext,
+        camera: &LensCamera,
+        pose: &Camera,
+        spp: u32,
+        options: &RenderOptions,
+    ) -> PyResult<RenderOutput> {
+        let mut state = self
+            .state
+            .lock()
+            .map_err(|_| PyRuntimeError::new_err("an earlier render panicked"))?;
+        let State { scene, passes } = &mut *state;
+        let key = (
+            camera.lens.to_string(),
+            camera.size.width,
+            camera.size.height,
+            spp,
+        );
+        if !passes.contains_key(&key) {
+            let pass = TracePass::supersampled(ctx, camera, scene, options.directions, spp)
+                .map_err(raise)?;
+            passes.insert(key.clone(), pass);
+        }
+        let pass = &passes[&key];
+        ctx.checked("rendering", || {
+            let mut encoder = ctx.device.create_command_encoder(&Default::default());
+            pass.encode_pose(&ctx.device, &mut encoder, scene, pose);
+            pass.encode(&mut encoder, scene, None);
+            ctx.queue.submit([encoder.finish()]);
+        })
+        .map_err(raise)?;
+        pass.read(ctx).map_err(raise)
+    }
+}
+
+/// Lens models, scenes and the GPU tracer of fisheye-rt, with numpy arrays.
+#[pymodule]
+#[pyo3(name = "fisheye_rt")]
+fn fisheye_rt_module(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add("__version__", env!("CARGO_PKG_VERSION"))?;
+    m.add_class::<Lens>()?;
+    m.add_class::<Scene>()?;
+    m.add_class::<Renderer>()?;
+    m.add_function(wrap_pyfunction!(look_at, m)?)?;
+    Ok(())
+}

@@ -1,0 +1,281 @@
+"""Tests of the `fisheye_rt` Python package (built by maturin; `.ci/test` installs and runs
+them). Lens models against other implementations (OpenCV's cv::fisheye, a double sphere in
+numpy written here from Usenko et al. 2018), renders against the `fisheye` command's files bit
+for bit, calibration files against OpenCV's own reader, and bad input as exceptions."""
+
+import ast
+import inspect
+import os
+import subprocess
+import threading
+import time
+from pathlib import Path
+
+import cv2
+import numpy as np
+import pytest
+from PIL import Image
+
+import fisheye_rt as fr
+
+ROOT = Path(__file__).resolve().parents[2]
+# The command-line tool, built by `cargo test --release` before these run.
+FISHEYE = os.environ.get("FISHEYE_BIN", str(ROOT / "target" / "release" / "fisheye"))
+
+
+def directions(n, max_theta, seed=1):
+    """`n` unit directions, uniform in solid angle up to `max_theta` from the optical axis."""
+    rng = np.random.default_rng(seed)
+    z = rng.uniform(np.cos(max_theta), 1.0, n)
+    phi = rng.uniform(0.0, 2 * np.pi, n)
+    s = np.sqrt(1 - z * z)
+    return np.stack([s * np.cos(phi), s * np.sin(phi), z], axis=1)
+
+
+def angle(a, b):
+    """Angles in radians between rows of unit vectors, precise for small angles."""
+    return 2 * np.arcsin(np.clip(np.linalg.norm(a - b, axis=1) / 2, 0, 1))
+
+
+KB = dict(fx=300.5, fy=301.25, cx=319.7, cy=241.3, k=[0.031, -0.0082, 0.0021, -0.00027])
+
+
+def test_kannala_brandt_matches_cv2_fisheye():
+    """The f64 reference projects where cv2.fisheye.projectPoints does, to 1e-9 px, and
+    unprojects cv2's pixels back to the directions, to 1e-9 rad (OpenCV pixel convention)."""
+    k = KB
+    spec = "kb:fx={fx},fy={fy},cx={cx},cy={cy},k1={},k2={},k3={},k4={}".format(*k["k"], **k)
+    lens = fr.Lens.from_spec(spec, size=(640, 480))
+    d = directions(2000, np.radians(85))
+    K = np.array([[k["fx"], 0, k["cx"]], [0, k["fy"], k["cy"]], [0, 0, 1.0]])
+    cv_pixels, _ = cv2.fisheye.projectPoints(
+        d[:, None, :], np.zeros(3), np.zeros(3), K, np.array(k["k"])
+    )
+    cv_pixels = cv_pixels[:, 0, :]
+    inside = (
+        (cv_pixels[:, 0] >= -0.5)
+        & (cv_pixels[:, 0] <= 639.5)
+        & (cv_pixels[:, 1] >= -0.5)
+        & (cv_pixels[:, 1] <= 479.5)
+    )
+    assert inside.sum() > 1000
+    ours = lens.project(d, pixel_origin="opencv")
+    assert np.all(np.isnan(ours[~inside]))
+    assert np.max(np.abs(ours[inside] - cv_pixels[inside])) < 1e-9
+    back = lens.unproject(cv_pixels[inside], pixel_origin="opencv")
+    assert np.max(angle(back, d[inside])) < 1e-9
+    # The project's own convention is half a pixel off OpenCV's.
+    corner = lens.project(d[inside], pixel_origin="corner")
+    assert np.max(np.abs(corner - cv_pixels[inside] - 0.5)) < 1e-9
+
+
+def ds_project(d, fx, fy, cx, cy, xi, alpha):
+    """Double sphere projection (Usenko, Demmel, Cremers, 3DV 2018, eq. 40-45), OpenCV pixels."""
+    x, y, z = d[:, 0], d[:, 1], d[:, 2]
+    d1 = np.sqrt(x * x + y * y + z * z)
+    zx = xi * d1 + z
+    d2 = np.sqrt(x * x + y * y + zx * zx)
+    den = alpha * d2 + (1 - alpha) * zx
+    return np.stack([fx * x / den + cx, fy * y / den + cy], axis=1)
+
+
+def ds_unproject(p, fx, fy, cx, cy, xi, alpha):
+    """Double sphere unprojection (same paper, eq. 46-51): unit directions."""
+    mx, my = (p[:, 0] - cx) / fx, (p[:, 1] - cy) / fy
+    r2 = mx * mx + my * my
+    mz = (1 - alpha * alpha * r2) / (alpha * np.sqrt(1 - (2 * alpha - 1) * r2) + 1 - alpha)
+    k = (mz * xi + np.sqrt(mz * mz + (1 - xi * xi) * r2)) / (mz * mz + r2)
+    v = np.stack([k * mx, k * my, k * mz - xi], axis=1)
+    return v / np.linalg.norm(v, axis=1, keepdims=True)
+
+
+def test_double_sphere_matches_an_independent_numpy_model():
+    """Both directions of the double sphere against the paper's closed forms, to 1e-9."""
+    p = dict(fx=158.28, fy=158.24, cx=254.9, cy=256.9, xi=-0.18, alpha=0.59)
+    lens = fr.Lens.from_spec("ds:" + ",".join(f"{k}={v}" for k, v in p.items()), size=(512, 512))
+    d = directions(2000, np.radians(95), seed=2)
+    expected = ds_project(d, **p)
+    ours = lens.project(d, pixel_origin="opencv")
+    keep = ~np.isnan(ours[:, 0])
+    assert keep.sum() > 1000
+    assert np.max(np.abs(ours[keep] - expected[keep])) < 1e-9
+    back = lens.unproject(expected[keep], pixel_origin="opencv")
+    assert np.max(angle(back, ds_unproject(expected[keep], **p))) < 1e-9
+    assert np.max(angle(back, d[keep])) < 1e-9
+
+
+def test_arrays_keep_their_shape_and_mark_missing_rays_with_nan():
+    """Any leading shape comes back; points outside the image or field are NaN rows; lists
+    and integer arrays are taken; the GPU's f32 answers agree with the f64 reference."""
+    lens = fr.Lens.from_spec("samyang-7.5mm", size=(64, 48))
+    grid = np.stack(np.meshgrid(np.arange(64) + 0.5, np.arange(48) + 0.5), axis=-1)
+    dirs = lens.unproject(grid)
+    assert dirs.shape == (48, 64, 3)
+    one = lens.unproject([32, 24])
+    assert one.shape == (3,)
+    assert np.allclose(one, [0, 0, 1])
+    outside = lens.unproject([[-5, -5], [70, 10]])
+    assert np.all(np.isnan(outside))
+    behind = lens.project([[0, 0, -1]])
+    assert np.all(np.isnan(behind))
+    gpu = lens.unproject(grid, gpu=True)
+    both = ~np.isnan(dirs[..., 0]) & ~np.isnan(gpu[..., 0])
+    assert both.sum() > 0.9 * (~np.isnan(dirs[..., 0])).sum()
+    assert np.max(angle(gpu[both], dirs[both])) < 1e-5
+
+
+def fisheye(*args):
+    return subprocess.run([FISHEYE, *args], check=True, capture_output=True, text=True)
+
+
+def test_a_render_equals_the_commands_files_bit_for_bit(tmp_path):
+    """`Renderer.render` returns the arrays `fisheye render --outputs` writes, bit for bit,
+    and the PNG's pixels as "srgb"."""
+    out = tmp_path / "view.png"
+    fisheye(
+        "render", "builtin:default", "--lens", "samyang-7.5mm", "--size", "96x72", "--spp",
+        "4", "--outputs", "range,normal,id,direction,mask", "-o", str(out),
+    )
+    renderer = fr.Renderer(fr.Scene.load("builtin:default"))
+    lens = fr.Lens.from_spec("samyang-7.5mm", size=(96, 72))
+    names = ["srgb", "range", "normal", "id", "direction", "mask"]
+    arrays = renderer.render(lens, spp=4, outputs=names)
+    for name in names[1:]:
+        written = np.load(tmp_path / f"view.{name}.npy")
+        assert arrays[name].dtype == written.dtype, name
+        assert arrays[name].shape == written.shape, name
+        assert arrays[name].tobytes() == written.tobytes(), name
+    png = np.asarray(Image.open(out).convert("RGBA"))
+    assert np.array_equal(arrays["srgb"], png)
+
+
+def test_the_camera_moves_without_uploading_the_scene_again(tmp_path):
+    """One renderer, three poses: the first pose again gives the same bytes; a pose made with
+    look_at sees what `fisheye render --camera` sees from there (the same triangle at all but
+    the pixels the scene's upload origin rounds across an edge)."""
+    renderer = fr.Renderer(fr.Scene.load("builtin:default"))
+    lens = fr.Lens.from_spec("canon-8-15mm@8mm", size=(64, 48))
+    first = renderer.render(lens, spp=1, outputs=["id", "colour"])
+    pose = fr.look_at((1.0, 1.2, 2.0), (-1.0, 1.0, -2.0))
+    moved = renderer.render(lens, pose=pose, spp=1, outputs=["id", "colour"])
+    again = renderer.render(lens, spp=1, outputs=["id", "colour"])
+    assert not np.array_equal(first["id"], moved["id"])
+    assert first["colour"].tobytes() == again["colour"].tobytes()
+    out = tmp_path / "moved.png"
+    fisheye(
+        "render", "builtin:default", "--lens", "canon-8-15mm@8mm", "--size", "64x48",
+        "--spp", "1", "--camera", "1,1.2,2:-1,1,-2", "--outputs", "id", "-o", str(out),
+    )
+    ids = np.load(tmp_path / "moved.id.npy")
+    assert np.mean(ids == moved["id"]) > 0.999
+
+
+def test_the_gil_is_released_while_the_gpu_renders():
+    """Another Python thread runs while a render is in flight."""
+    renderer = fr.Renderer(fr.Scene.load("builtin:default"))
+    lens = fr.Lens.from_spec("samyang-7.5mm", size=(320, 240))
+    renderer.render(lens, spp=16, outputs=["colour"])  # make the pass once
+    ended = []
+    worker = threading.Thread(
+        target=lambda: (renderer.render(lens, spp=16, outputs=["colour"]), ended.append(time.perf_counter()))
+    )
+    started = time.perf_counter()
+    worker.start()
+    time.sleep(0.02)
+    ran = time.perf_counter()
+    worker.join()
+    assert ended[0] - started > 0.1, "the render was too quick to tell"
+    assert ran < ended[0], "the main thread waited for the render: the GIL was held"
+
+
+def test_bad_input_raises_with_the_librarys_message(tmp_path):
+    """Every mistake is an exception naming what is wrong; none crashes the interpreter."""
+    cases = [
+        (lambda: fr.Lens.from_spec("nope:f=1", size=(10, 10)), ValueError, "nope"),
+        (lambda: fr.Lens.from_spec("equidistant:f=0", size=(10, 10)), ValueError, "f"),
+        (lambda: fr.Lens.from_spec("equidistant:f=1", size=(0, 10)), ValueError, "0x10"),
+        (lambda: fr.Lens.from_calibration(tmp_path / "none.yaml"), ValueError, "none.yaml"),
+        (lambda: fr.Scene.load(tmp_path / "none.obj"), Exception, "none.obj"),
+        (lambda: fr.Scene.load("builtin:nope"), ValueError, "nope"),
+        (lambda: fr.Renderer(fr.Scene.load("builtin:default"), bvh="best"), ValueError, "bvh"),
+        (lambda: fr.look_at((0, 0, 0), (0, 0, 0)), ValueError, "same point"),
+    ]
+    lens = fr.Lens.from_spec("samyang-7.5mm", size=(16, 12))
+    cases += [
+        (lambda: lens.unproject([[1, 2, 3]]), ValueError, "(..., 2)"),
+        (lambda: lens.project([1, 2]), ValueError, "(..., 3)"),
+        (lambda: lens.unproject([[1, 2]], pixel_origin="centre"), ValueError, "pixel_origin"),
+        (lambda: lens.unproject([["a", "b"]]), Exception, ""),
+    ]
+    renderer = fr.Renderer(fr.Scene.load("builtin:default"))
+    shear = np.eye(4)
+    shear[0, 1] = 0.5
+    cases += [
+        (lambda: renderer.render(lens, outputs=["depth"]), ValueError, "depth"),
+        (lambda: renderer.render(lens, spp=3), ValueError, "3"),
+        (lambda: renderer.render(lens, spp=0), ValueError, "0"),
+        (lambda: renderer.render(lens, pose=np.eye(3)), ValueError, "4×4"),
+        (lambda: renderer.render(lens, pose=shear), ValueError, "rotation"),
+        (lambda: renderer.render(lens, tone="filmic"), ValueError, "tone"),
+        (lambda: renderer.render(lens, exposure=float("nan")), ValueError, "exposure"),
+    ]
+    for call, kind, text in cases:
+        with pytest.raises(kind) as caught:
+            call()
+        assert text in str(caught.value), (text, str(caught.value))
+    # Still alive, and still rendering.
+    assert renderer.render(lens, spp=1, outputs=["mask"])["mask"].shape == (12, 16)
+
+
+@pytest.mark.parametrize("fmt,suffix", [("opencv-yaml", "yaml"), ("opencv-xml", "xml")])
+def test_opencv_calibration_files_read_back_in_cv2_filestorage(tmp_path, fmt, suffix):
+    """`fisheye lens convert` writes OpenCV files that OpenCV's own reader takes, holding the
+    values written (the principal point in OpenCV's convention) and the model's flag."""
+    k = KB
+    spec = "kb:fx={fx},fy={fy},cx={cx},cy={cy},k1={},k2={},k3={},k4={}".format(*k["k"], **k)
+    out = tmp_path / f"cam.{suffix}"
+    fisheye("lens", "convert", "--lens", spec, "--size", "640x480", "--format", fmt, "-o", str(out))
+    fs = cv2.FileStorage(str(out), cv2.FILE_STORAGE_READ)
+    assert fs.isOpened()
+    K = fs.getNode("camera_matrix").mat()
+    D = fs.getNode("distortion_coefficients").mat().ravel()
+    assert int(fs.getNode("image_width").real()) == 640
+    assert int(fs.getNode("image_height").real()) == 480
+    assert int(fs.getNode("fisheye_model").real()) == 1
+    assert np.array_equal(K, [[k["fx"], 0, k["cx"]], [0, k["fy"], k["cy"]], [0, 0, 1]])
+    assert np.array_equal(D, k["k"])
+    # And the package reads it back as the same lens.
+    lens = fr.Lens.from_calibration(out)
+    assert lens.size == (640, 480)
+    d = directions(100, np.radians(60))
+    direct = fr.Lens.from_spec(spec, size=(640, 480))
+    assert np.array_equal(lens.project(d), direct.project(d), equal_nan=True)
+
+
+def test_the_type_stubs_name_everything_the_module_has():
+    """fisheye_rt.pyi declares every public class, method and function, and parses."""
+    stub = ast.parse((ROOT / "python" / "fisheye_rt.pyi").read_text())
+    declared = {}
+    for node in stub.body:
+        if isinstance(node, ast.ClassDef):
+            declared[node.name] = {n.name for n in node.body if isinstance(n, ast.FunctionDef)}
+        elif isinstance(node, ast.FunctionDef):
+            declared[node.name] = set()
+    for name in dir(fr):
+        if name.startswith("_") or inspect.ismodule(getattr(fr, name)):
+            continue
+        assert name in declared, f"{name} is not in the stubs"
+        if isinstance(getattr(fr, name), type):
+            members = {m for m in dir(getattr(fr, name)) if not m.startswith("_")}
+            assert members <= declared[name], (name, members - declared[name])
+
+
+def test_the_readmes_example_runs():
+    """The Python example in the README's "Python" section runs as written."""
+    readme = (ROOT / "README.md").read_text()
+    section = readme.split("\n## Python\n", 1)[1].split("\n## ", 1)[0]
+    code = section.split("```python\n", 1)[1].split("```", 1)[0]
+    scope = {}
+    exec(compile(code, "README.md (Python)", "exec"), scope)
+    assert scope["out"]["srgb"].shape == (768, 1024, 4)
+    assert np.isnan(scope["dirs"][1]).all() and not np.isnan(scope["dirs"][0]).any()

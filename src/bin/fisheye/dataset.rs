@@ -1,0 +1,291 @@
+//! `fisheye dataset`: a rig of cameras along a trajectory, every camera at every pose with its
+//! ground truth, in shards that resume; and the merge that writes the manifest.
+
+use std::path::PathBuf;
+use std::time::Instant;
+
+use anyhow::{Context, Result, bail};
+use clap::{Subcommand, ValueEnum};
+use fisheye_rt::dataset::trajectory::{self, TrajectoryFormat};
+use fisheye_rt::dataset::{ArrayFile, Dataset, Shard, Submission};
+use fisheye_rt::gpu::GpuContext;
+use fisheye_rt::lens::calib;
+use fisheye_rt::lens::{ImageSize, LensCamera, parse_spec};
+use fisheye_rt::pose::parse_transform;
+use fisheye_rt::trace::{Channel, ColourFile, Display, RenderOptions};
+use glam::DAffine3;
+
+use crate::args::{ArrayFormat, Output, Quality, ToneArg, load_scene};
+use crate::progress::Progress;
+
+#[derive(Subcommand)]
+pub(crate) enum DatasetCommand {
+    /// Render every camera of a rig at every pose of a trajectory (or the poses of one
+    /// shard) into a folder: per camera, images and ground truth named by frame index and
+    /// time stamp, and a plan.json listing them. Poses whose files all exist are skipped, so
+    /// a killed run finishes when run again. Without --shard, ends with the merge.
+    Render(Box<RenderArgs>),
+    /// Check that every file of a dataset's plan exists (every shard finished) and write its
+    /// manifest.json.
+    Merge {
+        /// The dataset's folder.
+        folder: PathBuf,
+    },
+}
+
+#[derive(clap::Args)]
+pub(crate) struct RenderArgs {
+    /// The scene, as for `render`.
+    #[arg(default_value = "builtin:default")]
+    scene: String,
+    /// The trajectory: poses T_world_body in TUM (`t tx ty tz qx qy qz qw`), KITTI (3×4
+    /// matrices) or EuRoC CSV (`t_ns, px, py, pz, qw, qx, qy, qz, ...`), detected from the
+    /// text unless --trajectory-format says. Every pose is rendered, without interpolation.
+    #[arg(long)]
+    trajectory: PathBuf,
+    /// The trajectory's format, if detection from its text is not wanted.
+    #[arg(long, value_enum)]
+    trajectory_format: Option<FormatArg>,
+    /// Frames a second of a KITTI trajectory (which has no time stamps): pose i is at i/fps s.
+    #[arg(long, default_value_t = 10.0)]
+    fps: f64,
+    /// The rig: a calibration file with every camera and its extrinsics (a Kalibr camchain
+    /// with T_cn_cnm1 or T_cam_imu, a Basalt calibration with T_imu_cam), or one camera of
+    /// OpenCV's. Instead of --lens and --size.
+    #[arg(long, conflicts_with_all = ["lens", "size"])]
+    rig: Option<PathBuf>,
+    /// One camera's lens spec (see `fisheye lens list`), at the body's origin.
+    #[arg(long)]
+    lens: Option<String>,
+    /// Image size of --lens, WIDTHxHEIGHT.
+    #[arg(long, default_value = "1024x768")]
+    size: ImageSize,
+    /// T_body_rig, where the rig sits on the trajectory's body: `tx,ty,tz,qx,qy,qz,qw`.
+    #[arg(long, default_value = "identity", allow_hyphen_values = true)]
+    t_body_rig: String,
+    /// T_scene_world, how the trajectory's world sits in the scene: `identity`, `z-up` (a
+    /// world whose z axis points up, into a y-up scene) or `tx,ty,tz,qx,qy,qz,qw`.
+    #[arg(long, default_value = "identity", allow_hyphen_values = true)]
+    t_scene_world: String,
+    /// Rays per pixel (a square, 1 to 256), box-filtered; ground truth is the centre ray's.
+    #[arg(long, default_value_t = 16)]
+    spp: u32,
+    /// Deepest reflection/refraction bounce (0 to 8).
+    #[arg(long, default_value_t = 5,
+          value_parser = clap::value_parser!(u32).range(0..=i64::from(fisheye_rt::shared::MAX_DEPTH_LIMIT)))]
+    max_depth: u32,
+    /// BVH build preset.
+    #[arg(long, value_enum, default_value = "fast")]
+    bvh: Quality,
+    /// The colour images' format: `png` (sRGB through exposure and tone curve) or `exr`
+    /// (linear).
+    #[arg(long, value_enum, default_value = "png")]
+    colour: ColourArg,
+    /// Bits a channel of the colour images: 8 or 16 for PNG, 16 or 32 for EXR.
+    #[arg(long)]
+    bits: Option<u32>,
+    /// Exposure in stops (EV).
+    #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
+    exposure: f32,
+    /// Tone curve of PNG images (see `render --tone`).
+    #[arg(long, value_enum, default_value = "aces")]
+    tone: ToneArg,
+    /// Ground truth written beside each image: range, normal, id, direction, mask.
+    #[arg(long, value_enum, value_delimiter = ',')]
+    outputs: Vec<Output>,
+    /// File format of the ground-truth arrays.
+    #[arg(long, value_enum, default_value = "npy")]
+    format: ArrayFormat,
+    /// Render only shard I of N (`I/N`, I from 0): a contiguous share of the poses, the same
+    /// on every machine, e.g. `$SLURM_ARRAY_TASK_ID/$SLURM_ARRAY_TASK_COUNT`.
+    #[arg(long, default_value = "0/1")]
+    shard: Shard,
+    /// Finish a dataset begun earlier: refuse a folder that holds none (every run skips the
+    /// poses already complete; this guards against a mistyped folder).
+    #[arg(long)]
+    resume: bool,
+    /// Submit every camera of a pose at once (`pose`), or each alone (`camera`, to measure
+    /// what sharing a submission saves).
+    #[arg(long, value_enum, default_value = "pose")]
+    submission: SubmissionArg,
+    /// The dataset's folder.
+    #[arg(long, short)]
+    out: PathBuf,
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+enum FormatArg {
+    Tum,
+    Kitti,
+    Euroc,
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+enum ColourArg {
+    Png,
+    Exr,
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+enum SubmissionArg {
+    Pose,
+    Camera,
+}
+
+pub(crate) fn run(command: &DatasetCommand) -> Result<()> {
+    match command {
+        DatasetCommand::Render(args) => render(args),
+        DatasetCommand::Merge { folder } => {
+            let path = fisheye_rt::dataset::merge(folder)?;
+            println!("every frame is complete; wrote {}", path.display());
+            Ok(())
+        }
+    }
+}
+
+fn render(args: &RenderArgs) -> Result<()> {
+    let started = Instant::now();
+    if args.resume && !args.out.join("plan.json").is_file() {
+        bail!(
+            "--resume: {} holds no dataset (no plan.json); leave --resume out to begin one",
+            args.out.display()
+        );
+    }
+    let probe = match args.colour {
+        ColourArg::Png => "frame.png",
+        ColourArg::Exr => "frame.exr",
+    };
+    let file = ColourFile::for_path(std::path::Path::new(probe), args.bits)
+        .map_err(|e| anyhow::anyhow!("--bits: {}", e.to_string().replace("frame.", ".")))?;
+    if !args.exposure.is_finite() {
+        bail!(
+            "--exposure {}: give a finite number of stops",
+            args.exposure
+        );
+    }
+    fisheye_rt::trace::sampling::samples_per_side(args.spp)
+        .with_context(|| format!("--spp {}", args.spp))?;
+    let body_from_rig =
+        parse_transform(&args.t_body_rig).map_err(|e| anyhow::anyhow!("--t-body-rig {e}"))?;
+    let scene_from_world =
+        parse_transform(&args.t_scene_world).map_err(|e| anyhow::anyhow!("--t-scene-world {e}"))?;
+    let cameras: Vec<(LensCamera, DAffine3)> = match (&args.rig, &args.lens) {
+        (Some(path), _) => calib::read_rig(path)?
+            .into_iter()
+            .map(|c| {
+                let camera = LensCamera::new(c.calibration.lens, c.calibration.size);
+                (camera, c.body_from_camera)
+            })
+            .collect(),
+        (None, Some(spec)) => vec![(
+            LensCamera::new(parse_spec(spec)?, args.size),
+            DAffine3::IDENTITY,
+        )],
+        (None, None) => bail!("give the cameras: --rig CALIBRATION or --lens SPEC"),
+    };
+    let format = args.trajectory_format.map(|f| match f {
+        FormatArg::Tum => TrajectoryFormat::Tum,
+        FormatArg::Kitti => TrajectoryFormat::Kitti,
+        FormatArg::Euroc => TrajectoryFormat::Euroc,
+    });
+    let (detected, poses) = trajectory::read(&args.trajectory, format, args.fps)?;
+    let scene = load_scene(&args.scene)?;
+    let dataset = Dataset {
+        scene_name: args.scene.clone(),
+        scene,
+        trajectory: (args.trajectory.clone(), detected),
+        poses,
+        cameras,
+        scene_from_world,
+        body_from_rig,
+        options: RenderOptions {
+            max_depth: args.max_depth,
+            bvh: args.bvh.into(),
+            spp: args.spp,
+            ..RenderOptions::default()
+        },
+        colour: (
+            file,
+            Display {
+                exposure: args.exposure,
+                tone: args.tone.into(),
+            },
+        ),
+        outputs: (
+            args.outputs.iter().map(|&o| Channel::from(o)).collect(),
+            match args.format {
+                ArrayFormat::Npy => ArrayFile::Npy,
+                ArrayFormat::Exr => ArrayFile::Exr,
+            },
+        ),
+    };
+    let range = args.shard.poses(dataset.poses.len());
+    println!(
+        "dataset: {} poses ({} trajectory {}), {} camera(s); shard {}/{}: poses {}..{}",
+        dataset.poses.len(),
+        detected.name(),
+        args.trajectory.display(),
+        dataset.cameras.len(),
+        args.shard.index,
+        args.shard.count,
+        range.start,
+        range.end
+    );
+    let ctx = GpuContext::new()?;
+    println!("adapter: {}", ctx.adapter_name());
+    let loaded = started.elapsed().as_secs_f64();
+    let mut progress = Progress::new(range.len(), "poses");
+    let submission = match args.submission {
+        SubmissionArg::Pose => Submission::Pose,
+        SubmissionArg::Camera => Submission::Camera,
+    };
+    let report = dataset.render(&ctx, &args.out, args.shard, submission, &mut |p| {
+        let what = if p.skipped > 0 {
+            format!("{} already complete", p.skipped)
+        } else {
+            String::new()
+        };
+        progress.update(p.done, &what);
+    })?;
+    if report.rendered > 0 {
+        println!(
+            "once: scene, trajectory and device {:.2} s; BVH and upload {:.2} s; kernels \
+             compiled and first dispatch {:.0} ms",
+            loaded,
+            report.upload_seconds,
+            report.compile_seconds * 1e3
+        );
+        let per = |s: f64| 1e3 * s / report.rendered as f64;
+        println!(
+            "rendered {} poses ({} images, {} skipped as complete) in {:.2} s: {:.2} poses/s, \
+             {:.2} M primary rays/s; per pose: trace {:.1} ms, read back {:.1} ms, files \
+             {:.1} ms (written while the next pose renders)",
+            report.rendered,
+            report.images,
+            report.skipped,
+            report.seconds,
+            report.poses_per_second(),
+            report.rays_per_second() * 1e-6,
+            per(report.trace_seconds),
+            per(report.readback_seconds),
+            per(report.write_seconds)
+        );
+    } else {
+        println!(
+            "all {} poses of the shard were already complete",
+            report.poses
+        );
+    }
+    if args.shard == Shard::ALL {
+        println!("wrote {}", args.out.join("manifest.json").display());
+    } else {
+        println!(
+            "shard {}/{} done; once every shard is, `fisheye dataset merge {}` writes the \
+             manifest",
+            args.shard.index,
+            args.shard.count,
+            args.out.display()
+        );
+    }
+    Ok(())
+}

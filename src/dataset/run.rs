@@ -1,0 +1,674 @@
+//! Rendering a dataset: the plan (`plan.json`, what every frame is), the frames of a shard
+//! (all cameras of a pose in one submission, files written by a second thread while the next
+//! pose renders), and the merge that checks every file and writes `manifest.json`.
+
+use std::path::{Path, PathBuf};
+use std::sync::mpsc;
+use std::time::Instant;
+
+use glam::DAffine3;
+use serde_json::{Value, json};
+
+use super::trajectory::{Pose, TrajectoryFormat};
+use super::{Shard, camera_from_transform, frame_stem};
+use crate::error::{Error, Result};
+use crate::gpu::GpuContext;
+use crate::lens::gpu::DirectionSource;
+use crate::lens::{CalibratedModel, Lens, LensCamera};
+use crate::pose::rows;
+use crate::scene::Scene;
+use crate::trace::{
+    Channel, ColourFile, Display, GpuScene, RenderOptions, RenderOutput, Tone, TracePass,
+    world_directions, write_colour, write_file,
+};
+
+/// The plan's file in a dataset's folder: written by every run before it renders, and
+/// compared, so that runs with other settings cannot mix their frames into it.
+const PLAN: &str = "plan.json";
+/// The manifest's file, written by [`merge`] once every frame is complete.
+const MANIFEST: &str = "manifest.json";
+/// What the plan and manifest say they are, for loaders to check.
+const LAYOUT: &str = "fisheye-rt dataset 1";
+
+/// The file format of the ground-truth arrays.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ArrayFile {
+    /// NumPy `.npy`.
+    Npy,
+    /// OpenEXR `.exr`.
+    Exr,
+}
+
+impl ArrayFile {
+    fn extension(self) -> &'static str {
+        match self {
+            Self::Npy => "npy",
+            Self::Exr => "exr",
+        }
+    }
+}
+
+/// How a pose's cameras are submitted to the GPU.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Submission {
+    /// Every camera of a pose in one submission, then one wait (the default).
+    Pose,
+    /// One submission and wait per camera (to measure what sharing saves).
+    Camera,
+}
+
+/// Everything that defines a dataset: the scene, the poses, the rig and how frames are made.
+pub struct Dataset {
+    /// The scene as the user named it (recorded in the plan).
+    pub scene_name: String,
+    /// The scene.
+    pub scene: Scene,
+    /// The trajectory file as given, its format and its poses.
+    pub trajectory: (PathBuf, TrajectoryFormat),
+    /// The poses `T_world_body`.
+    pub poses: Vec<Pose>,
+    /// The rig's cameras, named `cam0`, `cam1`, ... in order, each with `T_rig_camera`.
+    pub cameras: Vec<(LensCamera, DAffine3)>,
+    /// `T_scene_world`.
+    pub scene_from_world: DAffine3,
+    /// `T_body_rig`.
+    pub body_from_rig: DAffine3,
+    /// Bounces, BVH preset and rays per pixel (directions computed, software traversal).
+    pub options: RenderOptions,
+    /// The colour images' format and display.
+    pub colour: (ColourFile, Display),
+    /// The ground truth written beside each image, and in what format.
+    pub outputs: (Vec<Channel>, ArrayFile),
+}
+
+/// Progress of a run: frames (poses) done of the shard's, and how many were already complete.
+#[derive(Clone, Copy, Debug)]
+pub struct Progress {
+    /// Poses finished (rendered or skipped) in this run.
+    pub done: usize,
+    /// Poses in the shard.
+    pub total: usize,
+    /// Of them, already complete before this run.
+    pub skipped: usize,
+}
+
+/// What a run did and how fast.
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct RunReport {
+    /// The shard, `I/N`.
+    pub shard: String,
+    /// Poses of the shard.
+    pub poses: usize,
+    /// Poses already complete, skipped.
+    pub skipped: usize,
+    /// Poses rendered (every camera).
+    pub rendered: usize,
+    /// Images written (poses rendered × cameras).
+    pub images: usize,
+    /// Primary rays traced (pixels with a ray × rays per pixel, over every image).
+    pub rays: u64,
+    /// Seconds building the BVH and uploading the scene, once.
+    pub upload_seconds: f64,
+    /// Seconds compiling the kernels (a one-pixel dispatch of each camera's), once.
+    pub compile_seconds: f64,
+    /// Wall seconds from the first pose to the last file, after upload and compilation.
+    pub seconds: f64,
+    /// Seconds in GPU submissions and waits (the trace).
+    pub trace_seconds: f64,
+    /// Seconds reading outputs back.
+    pub readback_seconds: f64,
+    /// Seconds writing files (on the writer thread, overlapping the next pose's trace).
+    pub write_seconds: f64,
+}
+
+impl RunReport {
+    /// Poses a second.
+    pub fn poses_per_second(&self) -> f64 {
+        self.rendered as f64 / self.seconds.max(1e-9)
+    }
+
+    /// Primary rays a second.
+    pub fn rays_per_second(&self) -> f64 {
+        self.rays as f64 / self.seconds.max(1e-9)
+    }
+}
+
+/// One camera's render of one pose, on its way to the writer thread.
+struct Written {
+    stem: String,
+    camera: usize,
+    pose: crate::scene::Camera,
+    output: RenderOutput,
+}
+
+impl Dataset {
+    /// The cameras' names and folders.
+    fn camera_name(i: usize) -> String {
+        format!("cam{i}")
+    }
+
+    /// `T_scene_camera` of camera `c` at pose `p`.
+    pub fn scene_from_camera(&self, p: usize, c: usize) -> DAffine3 {
+        self.scene_from_world
+            * self.poses[p].world_from_body
+            * self.body_from_rig
+            * self.cameras[c].1
+    }
+
+    fn lens_camera(&self, c: usize) -> LensCamera {
+        self.cameras[c].0
+    }
+
+    /// The files of camera `c` at pose `p`, relative to the dataset's folder: the colour
+    /// image, then each array.
+    fn files(&self, p: usize, c: usize) -> Vec<(String, String)> {
+        let stem = format!(
+            "{}/{}",
+            Self::camera_name(c),
+            frame_stem(p, &self.poses[p].stamp)
+        );
+        let colour = match self.colour.0 {
+            ColourFile::Png8 | ColourFile::Png16 => "png",
+            ColourFile::ExrHalf | ColourFile::ExrFloat => "exr",
+        };
+        let mut files = vec![("colour".to_string(), format!("{stem}.{colour}"))];
+        let ext = self.outputs.1.extension();
+        files.extend(
+            self.outputs
+                .0
+                .iter()
+                .map(|ch| (ch.name().to_string(), format!("{stem}.{}.{ext}", ch.name()))),
+        );
+        files
+    }
+
+    /// The plan: everything the dataset is, frame by frame, as JSON (deterministic bytes).
+    pub fn plan(&self) -> Result<String> {
+        let cameras: Vec<Value> = (0..self.cameras.len())
+            .map(|c| self.camera_json(c))
+            .collect::<Result<_>>()?;
+        let frames: Vec<Value> = (0..self.poses.len())
+            .map(|p| {
+                let pose = &self.poses[p];
+                let views: Vec<Value> = (0..self.cameras.len())
+                    .map(|c| {
+                        let files: serde_json::Map<String, Value> = self
+                            .files(p, c)
+                            .into_iter()
+                            .map(|(what, file)| (what, Value::String(file)))
+                            .collect();
+                        json!({
+                            "camera": Self::camera_name(c),
+                            "T_scene_camera": rows(&self.scene_from_camera(p, c)),
+                            "files": files,
+                        })
+                    })
+                    .collect();
+                json!({
+                    "index": p,
+                    "stamp": pose.stamp,
+                    "seconds": pose.seconds,
+                    "T_world_body": rows(&pose.world_from_body),
+                    "views": views,
+                })
+            })
+            .collect();
+        let (file, display) = self.colour;
+        let plan = json!({
+            "layout": LAYOUT,
+            "tool": format!("fisheye-rt {}", env!("CARGO_PKG_VERSION")),
+            "scene": self.scene_name,
+            "trajectory": {
+                "file": self.trajectory.0.display().to_string(),
+                "format": self.trajectory.1.name(),
+                "poses": self.poses.len(),
+            },
+            "conventions": {
+                "transforms": "T_a_b maps coordinates in frame b to frame a, as 4x4 row-major \
+                               matrices; T_scene_camera = T_scene_world T_world_body T_body_rig \
+                               T_rig_camera",
+                "camera": "OpenCV: x right, y down, z forward",
+                "pixels": "intrinsics put the top-left pixel's corner at (0, 0) (this \
+                           project's convention); opencv.camera_matrix puts its centre there",
+                "arrays": "range: metres to the first hit along the pixel centre's ray (0 where \
+                           none); normal: world unit normal; id: scene triangle (4294967295 for \
+                           none); direction: world unit ray; mask: 1 where the lens has a ray",
+            },
+            "T_scene_world": rows(&self.scene_from_world),
+            "T_body_rig": rows(&self.body_from_rig),
+            "render": {
+                "method": "rt",
+                "spp": self.options.spp,
+                "max_depth": self.options.max_depth,
+                "bvh": self.options.bvh.name(),
+                "colour": match file {
+                    ColourFile::Png8 => "8-bit sRGB PNG",
+                    ColourFile::Png16 => "16-bit sRGB PNG",
+                    ColourFile::ExrHalf => "half-float linear OpenEXR",
+                    ColourFile::ExrFloat => "float linear OpenEXR",
+                },
+                "exposure": display.exposure,
+                "tone": match display.tone {
+                    Tone::Aces => "aces",
+                    Tone::Clamp => "clamp",
+                },
+                "outputs": self.outputs.0.iter().map(|c| c.name()).collect::<Vec<_>>(),
+                "arrays": self.outputs.1.extension(),
+            },
+            "cameras": cameras,
+            "frames": frames,
+        });
+        Ok(serde_json::to_string_pretty(&plan).expect("JSON values serialise") + "\n")
+    }
+
+    /// A camera's calibration in the project's and OpenCV's conventions, and its rig pose.
+    fn camera_json(&self, c: usize) -> Result<Value> {
+        let camera = self.lens_camera(c);
+        let (lens, equivalent) = match camera.lens {
+            Lens::Calibrated(lens) => (lens, Value::Null),
+            Lens::Classic(_) => {
+                let e = crate::lens::fit::calibrated_equivalent(&camera)?;
+                let note = json!({
+                    "lens": camera.lens.to_string(),
+                    "exact": e.exact,
+                    "residual_px": e.residual_px,
+                });
+                (e.lens, note)
+            }
+        };
+        let i = lens.intrinsics();
+        let model = lens.model();
+        let parameters: serde_json::Map<String, Value> = model
+            .parameters()
+            .into_iter()
+            .map(|(k, v)| (k.to_string(), json!(v)))
+            .collect();
+        let (cv_model, distortion) = match model {
+            CalibratedModel::KannalaBrandt { k } => (json!("cv::fisheye"), json!(k)),
+            CalibratedModel::RadTan { k, p } => (
+                json!("cv::calibrateCamera"),
+                json!([k[0], k[1], p[0], p[1], k[2]]),
+            ),
+            _ => (Value::Null, Value::Null),
+        };
+        let (cx, cy) = (i.cx - 0.5, i.cy - 0.5);
+        Ok(json!({
+            "name": Self::camera_name(c),
+            "width": camera.size.width,
+            "height": camera.size.height,
+            "lens": camera.lens.to_string(),
+            "model": model.name(),
+            "intrinsics": {"fx": i.fx, "fy": i.fy, "cx": i.cx, "cy": i.cy},
+            "parameters": parameters,
+            "max_fov_degrees": lens.max_fov().map(f64::to_degrees),
+            "calibrated_equivalent_of": equivalent,
+            "opencv": {
+                "model": cv_model,
+                "camera_matrix": [[i.fx, 0.0, cx], [0.0, i.fy, cy], [0.0, 0.0, 1.0]],
+                "distortion_coefficients": distortion,
+            },
+            "T_rig_camera": rows(&self.cameras[c].1),
+        }))
+    }
+
+    /// Renders the poses of `shard` into `folder`: writes (or checks) the plan, skips the
+    /// poses whose files all exist, removes what killed runs of this shard left half-written,
+    /// and renders the rest. With [`Shard::ALL`], also writes the manifest.
+    pub fn render(
+        &self,
+        ctx: &GpuContext,
+        folder: &Path,
+        shard: Shard,
+        submission: Submission,
+        progress: &mut dyn FnMut(Progress),
+    ) -> Result<RunReport> {
+        let plan = self.plan()?;
+        check_plan(folder, &plan)?;
+        let range = shard.poses(self.poses.len());
+        let complete = |p: usize| {
+            (0..self.cameras.len())
+                .flat_map(|c| self.files(p, c))
+                .all(|(_, file)| folder.join(file).is_file())
+        };
+        for c in 0..self.cameras.len() {
+            remove_leftovers(&folder.join(Self::camera_name(c)), &range)?;
+        }
+        let todo: Vec<usize> = range.clone().filter(|&p| !complete(p)).collect();
+        let skipped = range.len() - todo.len();
+        let mut report = RunReport {
+            shard: format!("{}/{}", shard.index, shard.count),
+            poses: range.len(),
+            skipped,
+            rendered: 0,
+            images: 0,
+            rays: 0,
+            upload_seconds: 0.0,
+            compile_seconds: 0.0,
+            seconds: 0.0,
+            trace_seconds: 0.0,
+            readback_seconds: 0.0,
+            write_seconds: 0.0,
+        };
+        progress(Progress {
+            done: skipped,
+            total: range.len(),
+            skipped,
+        });
+        if !todo.is_empty() {
+            self.render_poses(ctx, folder, &todo, submission, &mut report, &mut |done| {
+                progress(Progress {
+                    done: skipped + done,
+                    total: range.len(),
+                    skipped,
+                })
+            })?;
+        }
+        let record = serde_json::to_string_pretty(&report).expect("a report serialises") + "\n";
+        let name = format!("shards/{}-of-{}.json", shard.index, shard.count);
+        write_file(&folder.join(name), record.as_bytes())?;
+        if shard == Shard::ALL {
+            merge(folder)?;
+        }
+        Ok(report)
+    }
+
+    /// Renders `todo`'s poses: the scene uploaded once (relative to the trajectory's first
+    /// camera, the same for every shard, so that shards write the same bytes), a trace pass
+    /// per camera, files written on a second thread.
+    fn render_poses(
+        &self,
+        ctx: &GpuContext,
+        folder: &Path,
+        todo: &[usize],
+        submission: Submission,
+        report: &mut RunReport,
+        progress: &mut dyn FnMut(usize),
+    ) -> Result<()> {
+        let t = Instant::now();
+        let mut scene = self.scene.clone();
+        scene.set_camera(camera_from_transform(&self.scene_from_camera(0, 0)));
+        let gpu_scene = GpuScene::new(ctx, &scene, &self.options)?;
+        report.upload_seconds = t.elapsed().as_secs_f64();
+        let lens_cameras: Vec<LensCamera> = (0..self.cameras.len())
+            .map(|c| self.lens_camera(c))
+            .collect();
+        let passes: Vec<TracePass> = lens_cameras
+            .iter()
+            .map(|camera| {
+                TracePass::supersampled(
+                    ctx,
+                    camera,
+                    &gpu_scene,
+                    DirectionSource::Computed,
+                    self.options.spp,
+                )
+            })
+            .collect::<Result<_>>()?;
+        // Drivers compile a pipeline at its first dispatch (lavapipe does): one pixel of each
+        // camera's, so that the poses' times are rendering alone.
+        let t = Instant::now();
+        ctx.checked("compiling the kernels", || {
+            let mut encoder = ctx.device.create_command_encoder(&Default::default());
+            let one = crate::lens::ImageSize::new(1, 1).expect("1x1 is a size");
+            for pass in &passes {
+                pass.encode_pose(&ctx.device, &mut encoder, &gpu_scene, &scene.camera);
+                pass.encode_region(&mut encoder, &gpu_scene, 0, one, None);
+            }
+            ctx.queue.submit([encoder.finish()]);
+        })?;
+        ctx.wait()?;
+        report.compile_seconds = t.elapsed().as_secs_f64();
+        let started = Instant::now();
+        let (sender, receiver) = mpsc::sync_channel::<Written>(2 * self.cameras.len());
+        std::thread::scope(|scope| -> Result<()> {
+            let writer = scope.spawn(|| -> Result<f64> {
+                let mut seconds = 0.0;
+                for w in receiver {
+                    let t = Instant::now();
+                    self.write(folder, &lens_cameras, &w)?;
+                    seconds += t.elapsed().as_secs_f64();
+                }
+                Ok(seconds)
+            });
+            let rendered = (|| -> Result<()> {
+                for (done, &p) in todo.iter().enumerate() {
+                    let poses: Vec<crate::scene::Camera> = (0..self.cameras.len())
+                        .map(|c| camera_from_transform(&self.scene_from_camera(p, c)))
+                        .collect();
+                    let groups: Vec<Vec<usize>> = match submission {
+                        Submission::Pose => vec![(0..passes.len()).collect()],
+                        Submission::Camera => (0..passes.len()).map(|c| vec![c]).collect(),
+                    };
+                    let mut outputs = Vec::with_capacity(passes.len());
+                    for group in groups {
+                        let t = Instant::now();
+                        ctx.checked("rendering a dataset frame", || {
+                            let mut encoder =
+                                ctx.device.create_command_encoder(&Default::default());
+                            for &c in &group {
+                                passes[c].encode_pose(
+                                    &ctx.device,
+                                    &mut encoder,
+                                    &gpu_scene,
+                                    &poses[c],
+                                );
+                                passes[c].encode(&mut encoder, &gpu_scene, None);
+                            }
+                            ctx.queue.submit([encoder.finish()]);
+                        })?;
+                        ctx.wait()?;
+                        report.trace_seconds += t.elapsed().as_secs_f64();
+                        let t = Instant::now();
+                        for &c in &group {
+                            outputs.push(passes[c].read(ctx)?);
+                        }
+                        report.readback_seconds += t.elapsed().as_secs_f64();
+                    }
+                    let stem = frame_stem(p, &self.poses[p].stamp);
+                    for (c, output) in outputs.into_iter().enumerate() {
+                        let (valid, _) = output.counts();
+                        report.rays += valid as u64 * u64::from(self.options.spp);
+                        report.images += 1;
+                        let w = Written {
+                            stem: stem.clone(),
+                            camera: c,
+                            pose: poses[c],
+                            output,
+                        };
+                        if sender.send(w).is_err() {
+                            // The writer stopped on an error, which its join reports.
+                            return Ok(());
+                        }
+                    }
+                    report.rendered += 1;
+                    progress(done + 1);
+                }
+                Ok(())
+            })();
+            drop(sender);
+            let written = writer.join().expect("the writer thread does not panic");
+            rendered?;
+            report.write_seconds = written?;
+            Ok(())
+        })?;
+        report.seconds = started.elapsed().as_secs_f64();
+        Ok(())
+    }
+
+    /// Writes one camera's files of one pose, each to a temporary name renamed into place.
+    fn write(&self, folder: &Path, cameras: &[LensCamera], w: &Written) -> Result<()> {
+        let dir = folder.join(Self::camera_name(w.camera));
+        let (file, display) = self.colour;
+        let colour = match file {
+            ColourFile::Png8 | ColourFile::Png16 => "png",
+            ColourFile::ExrHalf | ColourFile::ExrFloat => "exr",
+        };
+        let out = &w.output;
+        write_colour(
+            &dir.join(format!("{}.{colour}", w.stem)),
+            out.size,
+            &out.colour,
+            &display,
+            file,
+        )?;
+        let (channels, arrays) = &self.outputs;
+        if channels.is_empty() {
+            return Ok(());
+        }
+        let directions = world_directions(&cameras[w.camera], &w.pose);
+        for &channel in channels {
+            let path = dir.join(format!(
+                "{}.{}.{}",
+                w.stem,
+                channel.name(),
+                arrays.extension()
+            ));
+            match arrays {
+                ArrayFile::Npy => out.write_npy(channel, &directions, &path)?,
+                ArrayFile::Exr => out.write_exr(channel, &directions, &path)?,
+            }
+        }
+        Ok(())
+    }
+}
+
+/// Writes the plan into `folder`, or checks that the one there is the same.
+fn check_plan(folder: &Path, plan: &str) -> Result<()> {
+    let path = folder.join(PLAN);
+    match std::fs::read(&path) {
+        Ok(existing) if existing == plan.as_bytes() => Ok(()),
+        Ok(existing) => {
+            let line = String::from_utf8_lossy(&existing)
+                .lines()
+                .zip(plan.lines())
+                .position(|(a, b)| a != b)
+                .map_or(String::new(), |l| format!(" (first at line {})", l + 1));
+            Err(Error::Dataset {
+                path,
+                message: format!(
+                    "holds the plan of another dataset{line}: its scene, trajectory, rig or \
+                     settings differ from these. Render into another folder, or remove this \
+                     one to start again"
+                ),
+            })
+        }
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => write_file(&path, plan.as_bytes()),
+        Err(reason) => Err(Error::Io { path, reason }),
+    }
+}
+
+/// Removes the temporary files (`.NAME.PID.tmp`) a killed run left in `dir` for poses in
+/// `range` (another shard's are its own business: it may be writing them now).
+fn remove_leftovers(dir: &Path, range: &std::ops::Range<usize>) -> Result<()> {
+    let entries = match std::fs::read_dir(dir) {
+        Ok(entries) => entries,
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(()),
+        Err(reason) => {
+            return Err(Error::Io {
+                path: dir.to_path_buf(),
+                reason,
+            });
+        }
+    };
+    for entry in entries.flatten() {
+        let name = entry.file_name().to_string_lossy().to_string();
+        let Some(rest) = name.strip_prefix('.').filter(|_| name.ends_with(".tmp")) else {
+            continue;
+        };
+        let index = rest.split('_').next().and_then(|i| i.parse::<usize>().ok());
+        if index.is_some_and(|i| range.contains(&i)) {
+            std::fs::remove_file(entry.path()).map_err(|reason| Error::Io {
+                path: entry.path(),
+                reason,
+            })?;
+        }
+    }
+    Ok(())
+}
+
+/// Checks that every file the plan in `folder` lists exists and writes `manifest.json` (the
+/// plan, which lists every frame's files and poses); the error lists the incomplete poses
+/// by shard-independent ranges.
+pub fn merge(folder: &Path) -> Result<PathBuf> {
+    let plan_path = folder.join(PLAN);
+    let bad = |message: String| Error::Dataset {
+        path: plan_path.clone(),
+        message,
+    };
+    let text = match std::fs::read_to_string(&plan_path) {
+        Ok(text) => text,
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
+            return Err(Error::Dataset {
+                path: folder.to_path_buf(),
+                message: "holds no dataset (no plan.json): `fisheye dataset render` makes one"
+                    .into(),
+            });
+        }
+        Err(reason) => {
+            return Err(Error::Io {
+                path: plan_path,
+                reason,
+            });
+        }
+    };
+    let plan: Value =
+        serde_json::from_str(&text).map_err(|e| bad(format!("not a dataset plan: {e}")))?;
+    if plan["layout"] != LAYOUT {
+        return Err(bad(format!("not a dataset plan of layout {LAYOUT:?}")));
+    }
+    let frames = plan["frames"]
+        .as_array()
+        .ok_or_else(|| bad("no frames list".into()))?;
+    let mut missing: Vec<usize> = Vec::new();
+    for (p, frame) in frames.iter().enumerate() {
+        let files = frame["views"]
+            .as_array()
+            .into_iter()
+            .flatten()
+            .flat_map(|v| v["files"].as_object().into_iter().flatten())
+            .filter_map(|(_, f)| f.as_str());
+        if files.into_iter().any(|f| !folder.join(f).is_file()) {
+            missing.push(p);
+        }
+    }
+    if !missing.is_empty() {
+        return Err(Error::Dataset {
+            path: folder.to_path_buf(),
+            message: format!(
+                "{} of {} poses are incomplete ({}): render their shards (again) and merge then",
+                missing.len(),
+                frames.len(),
+                ranges(&missing)
+            ),
+        });
+    }
+    let path = folder.join(MANIFEST);
+    write_file(&path, text.as_bytes())?;
+    Ok(path)
+}
+
+/// `[0, 1, 2, 5, 7, 8]` as `0-2, 5, 7-8` (at most eight runs, then how many more).
+fn ranges(indices: &[usize]) -> String {
+    let mut runs: Vec<(usize, usize)> = Vec::new();
+    for &i in indices {
+        match runs.last_mut() {
+            Some((_, end)) if *end + 1 == i => *end = i,
+            _ => runs.push((i, i)),
+        }
+    }
+    let mut text: Vec<String> = runs
+        .iter()
+        .take(8)
+        .map(|&(a, b)| {
+            if a == b {
+                a.to_string()
+            } else {
+                format!("{a}-{b}")
+            }
+        })
+        .collect();
+    if runs.len() > 8 {
+        text.push(format!("and {} more runs", runs.len() - 8));
+    }
+    text.join(", ")
+}

@@ -1,0 +1,291 @@
+//! Trajectories: the poses `T_world_body` of a moving body, in the text formats datasets ship.
+//!
+//! - **TUM** (the TUM RGB-D benchmark's `groundtruth.txt`): `timestamp tx ty tz qx qy qz qw`
+//!   per line, seconds and metres, separated by spaces; `#` starts a comment.
+//! - **KITTI** (the odometry benchmark's `poses/NN.txt`): twelve numbers per line, the rows of a
+//!   3×4 `[R | t]`; no time stamps, so frame `i` is at `i / fps` seconds.
+//! - **EuRoC** (the MAV dataset's `state_groundtruth_estimate0/data.csv` or any CSV of its
+//!   layout): `timestamp [ns], p_x, p_y, p_z, q_w, q_x, q_y, q_z[, more columns]` separated by
+//!   commas; lines starting with `#` are headers. Note the quaternion's `w` comes first.
+//!
+//! Every pose is rendered as written: no interpolation to another frame rate.
+
+use std::path::Path;
+
+use glam::{DAffine3, DVec3};
+
+use crate::error::{Error, Result};
+use crate::pose::{rigid, rigid_from_rows, rotation_from_quaternion};
+
+/// A trajectory file format.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum TrajectoryFormat {
+    /// `timestamp tx ty tz qx qy qz qw`.
+    Tum,
+    /// The 12 numbers of a 3×4 `[R | t]` a line.
+    Kitti,
+    /// `timestamp_ns, px, py, pz, qw, qx, qy, qz, ...`, comma-separated.
+    Euroc,
+}
+
+impl TrajectoryFormat {
+    /// Every format with its name.
+    pub const ALL: [(&'static str, TrajectoryFormat); 3] = [
+        ("tum", Self::Tum),
+        ("kitti", Self::Kitti),
+        ("euroc", Self::Euroc),
+    ];
+
+    /// The format's name.
+    pub fn name(self) -> &'static str {
+        Self::ALL
+            .iter()
+            .find(|(_, f)| *f == self)
+            .map_or("", |(n, _)| n)
+    }
+
+    /// The format of a file's text: EuRoC where the first data line has commas, else TUM for
+    /// 8 numbers and KITTI for 12.
+    pub fn detect(text: &str) -> Option<Self> {
+        let line = data_lines(text).next()?.1;
+        if line.contains(',') {
+            return Some(Self::Euroc);
+        }
+        match line.split_whitespace().count() {
+            8 => Some(Self::Tum),
+            12 => Some(Self::Kitti),
+            _ => None,
+        }
+    }
+}
+
+/// One pose of a trajectory.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Pose {
+    /// The time stamp as the file writes it (TUM's seconds, EuRoC's nanoseconds), or the
+    /// seconds made from the frame rate (KITTI, six decimals): digits and at most one point,
+    /// fit for a file name.
+    pub stamp: String,
+    /// The time in seconds.
+    pub seconds: f64,
+    /// `T_world_body`: body coordinates to world coordinates.
+    pub world_from_body: DAffine3,
+}
+
+/// Reads a trajectory file, bounded as [`crate::input::InputKind::Trajectory`]; the format is
+/// detected from the text unless given. Errors name the file and the line.
+pub fn read(
+    path: &Path,
+    format: Option<TrajectoryFormat>,
+    fps: f64,
+) -> Result<(TrajectoryFormat, Vec<Pose>)> {
+    let bad = |message: String| Error::Dataset {
+        path: path.to_path_buf(),
+        message,
+    };
+    let bytes = crate::input::read(path, crate::input::InputKind::Trajectory)
+        .map_err(|e| bad(format!("cannot read the trajectory: {e}")))?;
+    let text = String::from_utf8(bytes).map_err(|e| {
+        bad(format!(
+            "not UTF-8 text (byte {})",
+            e.utf8_error().valid_up_to()
+        ))
+    })?;
+    let format = match format.or_else(|| TrajectoryFormat::detect(&text)) {
+        Some(f) => f,
+        None => {
+            return Err(bad(
+                "not a trajectory this tool reads: TUM (8 numbers a line), KITTI (12) or EuRoC \
+                 CSV (comma-separated, timestamp then position and w-first quaternion)"
+                    .into(),
+            ));
+        }
+    };
+    let poses =
+        parse(&text, format, fps).map_err(|e| bad(format!("{} trajectory: {e}", format.name())))?;
+    if poses.is_empty() {
+        return Err(bad("the trajectory holds no pose".into()));
+    }
+    Ok((format, poses))
+}
+
+/// The lines holding data, numbered from 1: not blank, not comments (`#`), and for EuRoC not
+/// its header.
+fn data_lines(text: &str) -> impl Iterator<Item = (usize, &str)> {
+    text.lines()
+        .enumerate()
+        .map(|(i, l)| (i + 1, l.trim()))
+        .filter(|(_, l)| !l.is_empty() && !l.starts_with('#'))
+}
+
+/// Parses a trajectory's text; errors say the line. `fps` times KITTI's poses.
+pub fn parse(text: &str, format: TrajectoryFormat, fps: f64) -> Result<Vec<Pose>, String> {
+    if format == TrajectoryFormat::Kitti && !(fps.is_finite() && fps > 0.0) {
+        return Err(format!("the frame rate {fps} is not a positive number"));
+    }
+    data_lines(text)
+        .enumerate()
+        .map(|(index, (line, content))| {
+            pose(content, format, index, fps).map_err(|e| format!("line {line}: {e}"))
+        })
+        .collect()
+}
+
+/// One data line's pose.
+fn pose(line: &str, format: TrajectoryFormat, index: usize, fps: f64) -> Result<Pose, String> {
+    let fields: Vec<&str> = match format {
+        TrajectoryFormat::Euroc => line.split(',').map(str::trim).collect(),
+        _ => line.split_whitespace().collect(),
+    };
+    let wanted = match format {
+        TrajectoryFormat::Tum => 8,
+        TrajectoryFormat::Kitti => 12,
+        TrajectoryFormat::Euroc => 8,
+    };
+    let enough = match format {
+        TrajectoryFormat::Euroc => fields.len() >= wanted,
+        _ => fields.len() == wanted,
+    };
+    if !enough {
+        return Err(format!(
+            "{} fields; a {} pose has {wanted}{}",
+            fields.len(),
+            format.name(),
+            if format == TrajectoryFormat::Euroc {
+                " or more"
+            } else {
+                ""
+            }
+        ));
+    }
+    let numbers: Vec<f64> = fields[..wanted]
+        .iter()
+        .map(|f| match f.parse::<f64>() {
+            Ok(v) if v.is_finite() => Ok(v),
+            _ => Err(format!("{f:?} is not a finite number")),
+        })
+        .collect::<Result<_, _>>()?;
+    let n = &numbers;
+    let (stamp, seconds, world_from_body) = match format {
+        TrajectoryFormat::Tum => {
+            let rotation = rotation_from_quaternion(n[4], n[5], n[6], n[7])?;
+            let t = rigid(rotation, DVec3::new(n[1], n[2], n[3]));
+            (stamp_text(fields[0])?, n[0], t)
+        }
+        TrajectoryFormat::Euroc => {
+            let rotation = rotation_from_quaternion(n[5], n[6], n[7], n[4])?;
+            let t = rigid(rotation, DVec3::new(n[1], n[2], n[3]));
+            (stamp_text(fields[0])?, n[0] * 1e-9, t)
+        }
+        TrajectoryFormat::Kitti => {
+            let rows: Vec<Vec<f64>> = n.chunks(4).map(<[f64]>::to_vec).collect();
+            let seconds = index as f64 / fps;
+            (format!("{seconds:.6}"), seconds, rigid_from_rows(&rows)?)
+        }
+    };
+    Ok(Pose {
+        stamp,
+        seconds,
+        world_from_body,
+    })
+}
+
+/// A time stamp's text, kept for file names: digits with at most one decimal point.
+fn stamp_text(field: &str) -> Result<String, String> {
+    let digits = field.chars().filter(char::is_ascii_digit).count();
+    let points = field.chars().filter(|&c| c == '.').count();
+    if digits == 0 || points > 1 || digits + points != field.len() {
+        return Err(format!(
+            "the time stamp {field:?} is not written as plain digits (e.g. 1305031102.175304)"
+        ));
+    }
+    Ok(field.to_string())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The same two poses written in each format read back the same, with the formats'
+    /// quaternion orders and time units.
+    #[test]
+    fn the_three_formats_give_the_same_poses() {
+        // 90° about z (x to y), then 180° about x.
+        let tum = "# timestamp tx ty tz qx qy qz qw\n\
+                   1.5 1 2 3 0 0 0.7071067811865476 0.7071067811865476\n\
+                   \n\
+                   1.6 -1 0 0.5 1 0 0 0\n";
+        let euroc = "#timestamp [ns],p_x,p_y,p_z,q_w,q_x,q_y,q_z,v_x\n\
+                     1500000000,1,2,3,0.7071067811865476,0,0,0.7071067811865476,9\n\
+                     1600000000,-1,0,0.5,0,1,0,0,9\n";
+        let kitti = "0 -1 0 1 1 0 0 2 0 0 1 3\n1 0 0 -1 0 -1 0 0 0 0 -1 0.5\n";
+        for (text, format) in [
+            (tum, TrajectoryFormat::Tum),
+            (euroc, TrajectoryFormat::Euroc),
+            (kitti, TrajectoryFormat::Kitti),
+        ] {
+            assert_eq!(TrajectoryFormat::detect(text), Some(format));
+            let poses = parse(text, format, 10.0).unwrap();
+            assert_eq!(poses.len(), 2, "{format:?}");
+            let a = poses[0].world_from_body;
+            assert!(a.translation.abs_diff_eq(DVec3::new(1.0, 2.0, 3.0), 0.0));
+            assert!(a.transform_vector3(DVec3::X).abs_diff_eq(DVec3::Y, 1e-15));
+            let b = poses[1].world_from_body;
+            assert!(b.transform_vector3(DVec3::Y).abs_diff_eq(-DVec3::Y, 1e-15));
+            assert!(b.transform_vector3(DVec3::Z).abs_diff_eq(-DVec3::Z, 1e-15));
+        }
+        let tum = parse(tum, TrajectoryFormat::Tum, 1.0).unwrap();
+        assert_eq!((tum[0].stamp.as_str(), tum[0].seconds), ("1.5", 1.5));
+        let euroc = parse(euroc, TrajectoryFormat::Euroc, 1.0).unwrap();
+        assert_eq!(euroc[1].stamp, "1600000000");
+        assert!((euroc[1].seconds - 1.6).abs() < 1e-15);
+        let kitti = parse(kitti, TrajectoryFormat::Kitti, 10.0).unwrap();
+        assert_eq!(kitti[1].stamp, "0.100000");
+    }
+
+    /// Bad lines are refused with their line number and what is wrong.
+    #[test]
+    fn bad_lines_name_their_line() {
+        let cases = [
+            (
+                "0 0 0 0 0 0 0 1\n0 0 0\n",
+                TrajectoryFormat::Tum,
+                "line 2: 3 fields",
+            ),
+            (
+                "0 0 0 0 0 0 0 2\n",
+                TrajectoryFormat::Tum,
+                "line 1: the quaternion",
+            ),
+            (
+                "# c\n1e9 0 0 0 0 0 0 1\n",
+                TrajectoryFormat::Tum,
+                "line 2: the time stamp",
+            ),
+            (
+                "0 0 0 nan 0 0 0 1\n",
+                TrajectoryFormat::Tum,
+                "\"nan\" is not a finite",
+            ),
+            (
+                "1 0 0 0 0 1 0 0 0 0 -1 0\n",
+                TrajectoryFormat::Kitti,
+                "determinant",
+            ),
+            (
+                "1,0,0\n",
+                TrajectoryFormat::Euroc,
+                "3 fields; a euroc pose has 8 or more",
+            ),
+        ];
+        for (text, format, wanted) in cases {
+            let error = parse(text, format, 10.0).unwrap_err();
+            assert!(error.contains(wanted), "{error:?} lacks {wanted:?}");
+        }
+        assert!(
+            parse("", TrajectoryFormat::Kitti, 0.0)
+                .unwrap_err()
+                .contains("frame rate")
+        );
+    }
+}

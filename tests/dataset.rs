@@ -1,0 +1,395 @@
+//! `fisheye dataset`: a four-camera rig along the example 100-pose trajectory, rendered in one
+//! process and in four shards at once (one killed midway, a half-written file and a partial
+//! pose planted, then resumed), must give the same bytes; every camera must see what
+//! `fisheye render` sees from the same pose worked out by hand; rigs read from Kalibr and
+//! Basalt files sit where their extrinsics say; the Python loader example reads the result.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Stdio};
+use std::time::{Duration, Instant};
+
+use fisheye_rt::lens::calib::read_rig;
+use glam::{DAffine3, DVec3};
+
+fn fisheye() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_fisheye"))
+}
+
+fn temp_dir(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("fisheye-dataset-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+fn repo(path: &str) -> String {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join(path)
+        .to_string_lossy()
+        .into_owned()
+}
+
+/// The example rig (`scenes/dataset/surround-rig.yaml`) at 96×72 pixels (its intrinsics
+/// scaled by 0.15 about the image corner, so the lens covers the same field).
+fn small_rig(dir: &Path) -> String {
+    let text = std::fs::read_to_string(repo("scenes/dataset/surround-rig.yaml"))
+        .unwrap()
+        .replace("[150.0, 150.0, 319.5, 239.5]", "[22.5, 22.5, 47.5, 35.5]")
+        .replace("[640, 480]", "[96, 72]");
+    let path = dir.join("rig.yaml");
+    std::fs::write(&path, text).unwrap();
+    path.to_string_lossy().into_owned()
+}
+
+fn succeed(command: &mut Command) -> String {
+    let output = command.output().unwrap();
+    let text = format!(
+        "{}{}",
+        String::from_utf8_lossy(&output.stdout),
+        String::from_utf8_lossy(&output.stderr)
+    );
+    assert!(output.status.success(), "{command:?} failed:\n{text}");
+    text
+}
+
+/// Every file under `dir` but the shards' run records, by relative path, with its bytes.
+fn files(dir: &Path) -> Vec<(PathBuf, Vec<u8>)> {
+    fn walk(root: &Path, dir: &Path, out: &mut Vec<(PathBuf, Vec<u8>)>) {
+        for entry in std::fs::read_dir(dir).unwrap() {
+            let path = entry.unwrap().path();
+            let relative = path.strip_prefix(root).unwrap().to_path_buf();
+            if relative.starts_with("shards") {
+                continue;
+            }
+            if path.is_dir() {
+                walk(root, &path, out);
+            } else {
+                out.push((relative, std::fs::read(&path).unwrap()));
+            }
+        }
+    }
+    let mut out = Vec::new();
+    walk(dir, dir, &mut out);
+    out.sort();
+    out
+}
+
+/// Complete images of camera 3 (the last written of a pose) among poses `range`.
+fn written(dir: &Path, range: std::ops::Range<usize>) -> usize {
+    std::fs::read_dir(dir.join("cam3"))
+        .map(|entries| {
+            entries
+                .flatten()
+                .filter_map(|e| {
+                    let name = e.file_name().to_string_lossy().into_owned();
+                    let index = name.strip_suffix(".png")?.split('_').next()?.parse().ok()?;
+                    range.contains(&index).then_some(())
+                })
+                .count()
+        })
+        .unwrap_or(0)
+}
+
+/// The done-when of the datasets issue: a 4-camera rig along a 100-pose trajectory, from one
+/// command and from 4 shards (one killed midway and resumed), byte for byte the same; the
+/// merge refuses while a pose is incomplete; no temporary file is left; the Python loader
+/// reads the dataset and reprojects every hit point onto its pixel with the manifest's OpenCV
+/// calibration and poses.
+#[test]
+fn a_rig_along_a_trajectory_gives_the_same_bytes_in_one_process_or_in_resumed_shards() {
+    let dir = temp_dir("shards");
+    let rig = small_rig(&dir);
+    let trajectory = repo("scenes/dataset/room-loop.tum");
+    let common = |out: &Path| {
+        let mut c = fisheye();
+        c.args([
+            "dataset",
+            "render",
+            "--trajectory",
+            &trajectory,
+            "--rig",
+            &rig,
+        ])
+        .args(["--t-scene-world", "z-up", "--spp", "4"])
+        .args(["--outputs", "range,normal,id,direction,mask"])
+        .arg("-o")
+        .arg(out);
+        c
+    };
+    let one = dir.join("one");
+    let text = succeed(&mut common(&one));
+    assert!(text.contains("rendered 100 poses (400 images"), "{text}");
+    assert!(one.join("manifest.json").is_file());
+
+    // Four shards at once; shard 1 is killed once it has written a pose.
+    let sharded = dir.join("sharded");
+    let mut children: Vec<std::process::Child> = (0..4)
+        .map(|i| {
+            common(&sharded)
+                .args(["--shard", &format!("{i}/4")])
+                .stdout(Stdio::null())
+                .stderr(Stdio::null())
+                .spawn()
+                .unwrap()
+        })
+        .collect();
+    let started = Instant::now();
+    while written(&sharded, 25..50) < 1 {
+        assert!(
+            started.elapsed() < Duration::from_secs(120),
+            "shard 1 wrote nothing"
+        );
+        std::thread::sleep(Duration::from_millis(5));
+    }
+    children[1].kill().unwrap();
+    let killed = children[1].wait().unwrap();
+    assert!(
+        !killed.success(),
+        "shard 1 finished before it could be killed"
+    );
+    for (i, child) in children.iter_mut().enumerate() {
+        if i != 1 {
+            assert!(child.wait().unwrap().success(), "shard {i}");
+        }
+    }
+    let done = written(&sharded, 25..50);
+    assert!(done < 25, "shard 1 had finished all its poses");
+    // What else a kill leaves: a half-written file (a temporary name) and a pose with some
+    // of its files; planted so that resuming must deal with both whatever the kill's timing.
+    let leftover = sharded.join("cam0/.000030_3.0.png.4242.tmp");
+    std::fs::write(&leftover, b"half a PNG").unwrap();
+    std::fs::remove_file(sharded.join("cam2/000026_2.6.range.npy")).ok();
+    let refused = fisheye()
+        .args(["dataset", "merge"])
+        .arg(&sharded)
+        .output()
+        .unwrap();
+    let why = String::from_utf8_lossy(&refused.stderr);
+    assert!(
+        !refused.status.success() && why.contains("incomplete"),
+        "{why}"
+    );
+    let text = succeed(common(&sharded).args(["--shard", "1/4", "--resume"]));
+    assert!(text.contains("skipped as complete"), "{text}");
+    assert!(!leftover.exists(), "the half-written file was not removed");
+    succeed(fisheye().args(["dataset", "merge"]).arg(&sharded));
+
+    let (a, b) = (files(&one), files(&sharded));
+    let names = |f: &[(PathBuf, Vec<u8>)]| f.iter().map(|(p, _)| p.clone()).collect::<Vec<_>>();
+    assert_eq!(names(&a), names(&b), "the two runs wrote different files");
+    // 4 cameras × 100 poses × (PNG + 5 arrays), the plan and the manifest.
+    assert_eq!(a.len(), 4 * 100 * 6 + 2);
+    for ((path, x), (_, y)) in a.iter().zip(&b) {
+        assert!(x == y, "{} differs between the runs", path.display());
+    }
+    assert!(
+        a.iter()
+            .all(|(p, _)| !p.to_string_lossy().ends_with(".tmp"))
+    );
+
+    let output = Command::new("python3")
+        .arg(repo("examples/load_dataset.py"))
+        .arg(&one)
+        .output()
+        .expect("python3 runs (numpy and Pillow: .ci/install-lavapipe)");
+    let text = String::from_utf8_lossy(&output.stdout);
+    assert!(
+        output.status.success(),
+        "{text}{}",
+        String::from_utf8_lossy(&output.stderr)
+    );
+    assert!(text.contains("100 frames, 4 cameras, 400 images"), "{text}");
+    // f32 directions and ranges: 1e-7 relative, a few 1e-6 px at 22.5 px a radian.
+    let px: f64 = text
+        .split("within ")
+        .nth(1)
+        .and_then(|t| t.split_whitespace().next())
+        .and_then(|t| t.parse().ok())
+        .unwrap_or_else(|| panic!("no reprojection error in {text}"));
+    assert!(px < 1e-3, "hit points reproject {px} px from their pixels");
+}
+
+/// Each camera of the rig at two poses sees what `fisheye render` sees through the same
+/// calibration from the eye and look-at point worked out here by hand from the rig's
+/// drawing (front, left, back and right of a body whose x is forward and z up, in a z-up world
+/// turned y-up): the same triangle ids at all but the pixels where the scene's upload origin
+/// (the trajectory's first camera against each render's own) rounds a ray onto the other side
+/// of an edge.
+#[test]
+fn every_camera_sees_what_render_sees_from_its_pose_worked_out_by_hand() {
+    let dir = temp_dir("orientation");
+    let rig = small_rig(&dir);
+    // Two level poses: (position, yaw), z up.
+    let poses = [
+        (DVec3::new(3.2, 0.0, 1.5), 90f64),
+        (DVec3::new(-0.5, -2.5, 1.2), 200.0),
+    ];
+    let tum: String = poses
+        .iter()
+        .enumerate()
+        .map(|(i, (p, yaw))| {
+            let half = yaw.to_radians() / 2.0;
+            format!(
+                "{i}.0 {} {} {} 0 0 {} {}\n",
+                p.x,
+                p.y,
+                p.z,
+                half.sin(),
+                half.cos()
+            )
+        })
+        .collect();
+    let trajectory = dir.join("two.tum");
+    std::fs::write(&trajectory, tum).unwrap();
+    let out = dir.join("set");
+    succeed(
+        fisheye()
+            .args([
+                "dataset",
+                "render",
+                "--rig",
+                &rig,
+                "--t-scene-world",
+                "z-up",
+            ])
+            .args(["--spp", "1", "--outputs", "id", "--trajectory"])
+            .arg(&trajectory)
+            .arg("-o")
+            .arg(&out),
+    );
+    // z-up world to the y-up scene.
+    let scene = |v: DVec3| DVec3::new(v.x, v.z, -v.y);
+    for (p, &(position, yaw)) in poses.iter().enumerate() {
+        let (s, c) = yaw.to_radians().sin_cos();
+        let forward = DVec3::new(c, s, 0.0);
+        let left = DVec3::new(-s, c, 0.0);
+        let mounts = [
+            (0.5 * forward, forward),
+            (0.3 * left, left),
+            (-0.5 * forward, -forward),
+            (-0.3 * left, -left),
+        ];
+        for (camera, (offset, look)) in mounts.into_iter().enumerate() {
+            let eye = scene(position + offset);
+            let at = scene(position + offset + look);
+            let pose = format!("{},{},{}:{},{},{}", eye.x, eye.y, eye.z, at.x, at.y, at.z);
+            let image = dir.join(format!("render-{p}-{camera}.png"));
+            succeed(
+                fisheye()
+                    .args([
+                        "render",
+                        "--calib",
+                        &rig,
+                        "--calib-camera",
+                        &camera.to_string(),
+                    ])
+                    .args(["--camera", &pose, "--spp", "1", "--outputs", "id", "-o"])
+                    .arg(&image),
+            );
+            let ids = |path: PathBuf| -> Vec<u32> {
+                let bytes = std::fs::read(&path).unwrap();
+                npyz::NpyFile::new(&bytes[..]).unwrap().into_vec().unwrap()
+            };
+            let rendered = ids(image.with_extension("id.npy"));
+            let set = ids(out.join(format!("cam{camera}/00000{p}_{p}.0.id.npy")));
+            let same = rendered.iter().zip(&set).filter(|(a, b)| a == b).count();
+            assert!(
+                same as f64 >= 0.999 * set.len() as f64,
+                "pose {p}, cam{camera}: {same} of {} pixels see the same triangle",
+                set.len()
+            );
+        }
+    }
+}
+
+fn assert_pose(t: &DAffine3, forward: DVec3, position: DVec3, what: &str) {
+    let z = t.transform_vector3(DVec3::Z);
+    let y = t.transform_vector3(DVec3::Y);
+    assert!(
+        z.abs_diff_eq(forward, 1e-12),
+        "{what}: looks along {z}, not {forward}"
+    );
+    assert!(y.abs_diff_eq(-DVec3::Z, 1e-12), "{what}: its down is {y}");
+    assert!(
+        t.translation.abs_diff_eq(position, 1e-12),
+        "{what}: at {}, not {position}",
+        t.translation
+    );
+}
+
+/// The example Kalibr rig (cam0 by T_cam_imu, the rest chained by T_cn_cnm1) and a Basalt
+/// rig (T_imu_cam) put each camera where the drawing does; rigs without extrinsics, or with a
+/// transform that is not rigid, are refused naming the camera.
+#[test]
+fn rigs_put_each_camera_where_their_extrinsics_say() {
+    let rig = read_rig(Path::new(&repo("scenes/dataset/surround-rig.yaml"))).unwrap();
+    let mounts = [
+        (DVec3::X, DVec3::new(0.5, 0.0, 0.0)),
+        (DVec3::Y, DVec3::new(0.0, 0.3, 0.0)),
+        (-DVec3::X, DVec3::new(-0.5, 0.0, 0.0)),
+        (-DVec3::Y, DVec3::new(0.0, -0.3, 0.0)),
+    ];
+    assert_eq!(rig.len(), 4);
+    for (n, (camera, (forward, position))) in rig.iter().zip(mounts).enumerate() {
+        assert_pose(
+            &camera.body_from_camera,
+            forward,
+            position,
+            &format!("cam{n}"),
+        );
+    }
+
+    let dir = temp_dir("rigs");
+    // Basalt: two cameras, the second turned 90° about the body's z (qz = sin 45°) and 0.2 m
+    // to the left; the first at the body's origin looking along x (camera z = body x).
+    let s = std::f64::consts::FRAC_1_SQRT_2;
+    let intrinsics = r#"{"camera_type": "kb4", "intrinsics": {"fx": 100, "fy": 100, "cx": 63.5, "cy": 47.5, "k1": 0, "k2": 0, "k3": 0, "k4": 0}}"#;
+    // Camera z along body x, camera y along -z (so camera x along -y).
+    let q0 = glam::DQuat::from_mat3(&glam::DMat3::from_cols(-DVec3::Y, -DVec3::Z, DVec3::X));
+    let cam0 = format!(
+        r#"{{"px": 0, "py": 0, "pz": 0, "qx": {}, "qy": {}, "qz": {}, "qw": {}}}"#,
+        q0.x, q0.y, q0.z, q0.w
+    );
+    // Turned a further 90° about body z: q = (0, 0, s, s) · q0.
+    let q1 = glam::DQuat::from_xyzw(0.0, 0.0, s, s) * q0;
+    let cam1 = format!(
+        r#"{{"px": 0, "py": 0.2, "pz": 0, "qx": {}, "qy": {}, "qz": {}, "qw": {}}}"#,
+        q1.x, q1.y, q1.z, q1.w
+    );
+    let basalt = format!(
+        r#"{{"value0": {{"T_imu_cam": [{cam0}, {cam1}], "intrinsics": [{intrinsics}, {intrinsics}], "resolution": [[128, 96], [128, 96]]}}}}"#
+    );
+    let path = dir.join("basalt.json");
+    std::fs::write(&path, basalt).unwrap();
+    let rig = read_rig(&path).unwrap();
+    assert_pose(
+        &rig[0].body_from_camera,
+        DVec3::X,
+        DVec3::ZERO,
+        "basalt cam0",
+    );
+    assert_pose(
+        &rig[1].body_from_camera,
+        DVec3::Y,
+        DVec3::new(0.0, 0.2, 0.0),
+        "basalt cam1",
+    );
+
+    let kalibr = std::fs::read_to_string(repo("scenes/dataset/surround-rig.yaml")).unwrap();
+    let refused = [
+        (
+            kalibr.replacen("  T_cn_cnm1:", "  T_other:", 1),
+            "cam1: no T_cn_cnm1",
+        ),
+        (
+            kalibr.replacen("[0.0, 0.0, 1.0, 0.5]", "[0.0, 0.0, 2.0, 0.5]", 1),
+            "cam1: T_cn_cnm1: the rotation",
+        ),
+    ];
+    for (text, wanted) in refused {
+        let path = dir.join("bad.yaml");
+        std::fs::write(&path, text).unwrap();
+        let error = read_rig(&path).unwrap_err().to_string();
+        assert!(error.contains(wanted), "{error:?} lacks {wanted:?}");
+    }
+}
