@@ -183,3 +183,20 @@ fn check_lens(lens: Lens) {
         panic!("the spec {lens} that a lens prints does not parse: {e}");
     }
 }
+
+/// The bytes are a glTF file (JSON or GLB); every other file it names is missing, except
+/// paths under `/dev/`, read from the disk. A scene that loads holds up.
+pub fn gltf(data: &[u8]) {
+    let path = Path::new("fuzz.glb");
+    let read = |p: &Path, kind: InputKind| -> Result<Vec<u8>> {
+        if p == path {
+            return Ok(data.to_vec());
+        }
+        special(p, kind).unwrap_or_else(|| Err(not_found(p)))
+    };
+    for scene in [None, Some(1)] {
+        if let Ok(loaded) = fisheye_rt::scene::gltf::load_gltf_from(path, &read, scene) {
+            check_scene(&loaded.scene);
+        }
+    }
+}

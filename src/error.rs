@@ -142,6 +142,14 @@ pub enum Error {
         /// What went wrong.
         message: String,
     },
+    /// A glTF file that could not be loaded, naming the object (accessor, node, image).
+    #[error("{path}: {message}")]
+    Gltf {
+        /// The file.
+        path: std::path::PathBuf,
+        /// What went wrong, and where in the document.
+        message: String,
+    },
     /// A scene file (TOML) that could not be read, parsed or checked.
     #[error("{path}: {message}")]
     SceneFile {

@@ -29,6 +29,8 @@ pub enum InputKind {
     Calibration,
     /// A trajectory of poses (TUM, KITTI, EuRoC text): 256 MiB (a day of poses at 200 Hz).
     Trajectory,
+    /// A glTF file (`.gltf` JSON or `.glb`) or one of its external buffers: 1 GiB, as OBJ.
+    Gltf,
 }
 
 impl InputKind {
@@ -41,6 +43,7 @@ impl InputKind {
             InputKind::SceneFile => "scene files",
             InputKind::Calibration => "calibration files",
             InputKind::Trajectory => "trajectories",
+            InputKind::Gltf => "glTF files and buffers",
         }
     }
 
@@ -48,7 +51,7 @@ impl InputKind {
     pub fn default_budget(self) -> u64 {
         const MIB: u64 = 1 << 20;
         match self {
-            InputKind::Obj => 1024 * MIB,
+            InputKind::Obj | InputKind::Gltf => 1024 * MIB,
             InputKind::Texture | InputKind::Trajectory => 256 * MIB,
             InputKind::Mtl | InputKind::SceneFile | InputKind::Calibration => 16 * MIB,
         }

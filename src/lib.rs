@@ -10,8 +10,8 @@
 //! - [`shared`]: what the GPU and Rust share (ids, limits, workgroup sizes, `repr(C)`
 //!   structs), read by everything and reading nothing.
 //! - [`shader`]: how WGSL files are assembled into modules.
-//! - [`scene`], [`bvh`], [`trace`]: scenes (built-in and OBJ), the CWBVH, and the GPU tracer
-//!   with its f64 reference.
+//! - [`scene`], [`bvh`], [`trace`]: scenes (built-in, OBJ, glTF and scene files), the CWBVH,
+//!   and the GPU tracer with its f64 reference.
 //! - [`renderer`]: rendering on the caller's device into the caller's texture and encoder.
 //! - [`pose`], [`dataset`]: rigid transforms, trajectories (TUM, KITTI, EuRoC) and synthetic
 //!   datasets of a camera rig along them, in shards.

@@ -475,7 +475,14 @@ fn the_readme_table_names_tests_that_exist() {
         .expect("the README has a \"Bad input, limits and faults\" section");
     let section = section.split("\n## ").next().unwrap();
     let mut sources = String::new();
-    for dir in ["tests", "src", "src/scene", "src/lens", "src/trace", "src/dataset"] {
+    for dir in [
+        "tests",
+        "src",
+        "src/scene",
+        "src/lens",
+        "src/trace",
+        "src/dataset",
+    ] {
         for entry in std::fs::read_dir(root.join(dir)).unwrap() {
             let path = entry.unwrap().path();
             if path.extension().is_some_and(|e| e == "rs") {

@@ -54,3 +54,8 @@ fn calibration_corpus() {
 fn trajectory_corpus() {
     replay("trajectory", harness::trajectory);
 }
+
+#[test]
+fn gltf_corpus() {
+    replay("gltf", harness::gltf);
+}

@@ -16,7 +16,9 @@
 //! look_at = [0.0, 1.0, 0.0]
 //!
 //! [[mesh]]
-//! path = "box.obj"                # or shape = "box" (the unit cube) or "sphere" (unit radius)
+//! path = "box.obj"                # OBJ or glTF (.gltf, .glb: its default scene's meshes and
+//!                                 # materials); or shape = "box" (the unit cube) or "sphere"
+//!                                 # (unit radius)
 //! scale = 1.0                     # or [x, y, z]
 //! rotation = [0.0, 90.0, 0.0]     # degrees about x, then y, then z
 //! translation = [0.0, 0.0, 0.0]
@@ -299,7 +301,24 @@ pub fn load_scene_file_from(path: &Path, read: ReadFile) -> Result<Loaded> {
         let transform = check.transform(&what, mesh)?;
         let first = b.len();
         match (&mesh.path, mesh.shape) {
-            (Some(obj), None) => load_into(&dir.join(obj), read, &mut b, &mut warnings)?,
+            (Some(file), None) => {
+                let file = dir.join(file);
+                let gltf = file.extension().and_then(|e| e.to_str()).is_some_and(|e| {
+                    e.eq_ignore_ascii_case("gltf") || e.eq_ignore_ascii_case("glb")
+                });
+                if gltf {
+                    let content = super::gltf::load_into(&file, read, None, &mut b, &mut warnings)?;
+                    if !content.lights.is_empty() || !content.cameras.is_empty() {
+                        warnings.push(format!(
+                            "{}: its lights and cameras are not used in a scene file (give \
+                             [[light]] and [camera])",
+                            file.display()
+                        ));
+                    }
+                } else {
+                    load_into(&file, read, &mut b, &mut warnings)?;
+                }
+            }
             (None, Some(shape)) => {
                 let grey = b.material(Material::diffuse(&what, Vec3::splat(0.8)));
                 match shape {

@@ -251,6 +251,7 @@ impl MeshBuilder {
             ambient,
             camera,
             camera_path: Vec::new(),
+            cameras: Vec::new(),
             headlight: None,
             framed: None,
         }

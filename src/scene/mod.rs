@@ -5,6 +5,7 @@
 
 pub mod builtin;
 pub mod file;
+pub mod gltf;
 mod lint;
 mod mesh;
 pub mod obj;
@@ -200,6 +201,8 @@ pub struct Scene {
     pub camera: Camera,
     /// Keyframes of a camera path (for benchmarks); empty if the scene has none.
     pub camera_path: Vec<Camera>,
+    /// Cameras the scene's file defines (a glTF file's camera nodes), for `--camera gltf:N`.
+    pub cameras: Vec<Camera>,
     /// The point light (index into `lights`) that sits at the camera, as a bare OBJ's
     /// headlight does: [`Scene::set_camera`] moves it with the eye.
     pub headlight: Option<usize>,
@@ -308,6 +311,11 @@ impl Scene {
 
 /// Loads a scene from `builtin:NAME`, a scene file (`.toml`) or a bare OBJ (`.obj`).
 pub fn load(spec: &str) -> crate::error::Result<obj::Loaded> {
+    load_with(spec, None)
+}
+
+/// As [`load`], with the scene `gltf_scene` of a glTF file (its default scene if `None`).
+pub fn load_with(spec: &str, gltf_scene: Option<usize>) -> crate::error::Result<obj::Loaded> {
     use crate::error::Error;
     if let Some(name) = spec.strip_prefix("builtin:") {
         let scene = builtin::scene(name).ok_or_else(|| {
@@ -330,8 +338,10 @@ pub fn load(spec: &str) -> crate::error::Result<obj::Loaded> {
     match extension.as_deref() {
         Some("toml") => file::load_scene_file(path),
         Some("obj") => obj::load_obj(path),
+        Some("gltf" | "glb") => gltf::load_gltf(path, gltf_scene),
         _ => Err(Error::Scene(format!(
-            "{spec:?}: expected `builtin:NAME`, a scene file (.toml) or an OBJ file (.obj)"
+            "{spec:?}: expected `builtin:NAME`, a scene file (.toml), an OBJ file (.obj) or a \
+             glTF file (.gltf, .glb)"
         ))),
     }
 }

@@ -253,16 +253,11 @@ fn add_mesh(
         let k = 2 * i as usize;
         Vec2::new(mesh.texcoords[k] as f32, mesh.texcoords[k + 1] as f32)
     };
-    let (mut non_finite, mut flat) = (0, 0);
+    let mut dropped = Dropped::default();
     for face in mesh.indices.chunks_exact(3) {
         let face = [face[0], face[1], face[2]];
         let corners = face.map(position);
-        if !corners.iter().all(|p| p.is_finite()) {
-            non_finite += 1;
-            continue;
-        }
-        if (corners[1] - corners[0]).cross(corners[2] - corners[0]) == DVec3::ZERO {
-            flat += 1;
+        if !dropped.keeps(&corners) {
             continue;
         }
         let normals = (has_normals && normals_ok)
@@ -271,15 +266,45 @@ fn add_mesh(
         let uvs = (has_uvs && uvs_ok).then(|| face.map(uv));
         b.triangle(corners, normals, uvs, material);
     }
-    if non_finite > 0 {
-        warnings.push(warn(format!(
-            "dropped {non_finite} triangles with non-finite vertices"
-        )));
+    dropped.warn(|what| warnings.push(warn(what)));
+}
+
+/// Counts the triangles a loader drops: non-finite corners (undefined behaviour in hardware
+/// acceleration structures) and no area (no ray hits them).
+#[derive(Default)]
+pub(crate) struct Dropped {
+    non_finite: usize,
+    flat: usize,
+}
+
+impl Dropped {
+    /// Whether a triangle with these corners is kept (else it is counted).
+    pub(crate) fn keeps(&mut self, corners: &[DVec3; 3]) -> bool {
+        if !corners.iter().all(|p| p.is_finite()) {
+            self.non_finite += 1;
+            false
+        } else if (corners[1] - corners[0]).cross(corners[2] - corners[0]) == DVec3::ZERO {
+            self.flat += 1;
+            false
+        } else {
+            true
+        }
     }
-    if flat > 0 {
-        warnings.push(warn(format!(
-            "dropped {flat} triangles of zero area (corners on one line)"
-        )));
+
+    /// A warning for each kind dropped, through `warn`.
+    pub(crate) fn warn(&self, mut warn: impl FnMut(String)) {
+        if self.non_finite > 0 {
+            warn(format!(
+                "dropped {} triangles with non-finite vertices",
+                self.non_finite
+            ));
+        }
+        if self.flat > 0 {
+            warn(format!(
+                "dropped {} triangles of zero area (corners on one line)",
+                self.flat
+            ));
+        }
     }
 }
 

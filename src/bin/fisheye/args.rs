@@ -138,6 +138,18 @@ pub(crate) fn parse_camera(text: &str, scene: &Scene) -> Result<fisheye_rt::scen
         }
         return Ok(scene.camera_on_path(s));
     }
+    if let Some(n) = text.strip_prefix("gltf:") {
+        let n: usize = n
+            .parse()
+            .with_context(|| format!("--camera {text:?}: N must be a camera's number, from 0"))?;
+        return match scene.cameras.get(n) {
+            Some(camera) => Ok(*camera),
+            None => bail!(
+                "--camera {text:?}: the scene's file has {} camera(s)",
+                scene.cameras.len()
+            ),
+        };
+    }
     let triple = |t: &str| -> Option<DVec3> {
         let v: Vec<f64> = t
             .split(',')
@@ -151,7 +163,8 @@ pub(crate) fn parse_camera(text: &str, scene: &Scene) -> Result<fisheye_rt::scen
         .filter(|(p, l)| p != l)
         .with_context(|| {
             format!(
-                "--camera {text:?}: expected X,Y,Z:LX,LY,LZ (two different finite points) or path:S"
+                "--camera {text:?}: expected X,Y,Z:LX,LY,LZ (two different finite points), \
+                 path:S or gltf:N"
             )
         })?;
     Ok(fisheye_rt::scene::Camera {
@@ -368,7 +381,12 @@ impl From<Directions> for DirectionSource {
 
 /// A scene from `builtin:NAME`, a scene file or an OBJ file; warnings go to stderr.
 pub(crate) fn load_scene(spec: &str) -> Result<Scene> {
-    let loaded = fisheye_rt::scene::load(spec)?;
+    load_scene_with(spec, None)
+}
+
+/// As [`load_scene`], with scene `gltf_scene` of a glTF file.
+pub(crate) fn load_scene_with(spec: &str, gltf_scene: Option<usize>) -> Result<Scene> {
+    let loaded = fisheye_rt::scene::load_with(spec, gltf_scene)?;
     for warning in &loaded.warnings {
         eprintln!("warning: {warning}");
     }

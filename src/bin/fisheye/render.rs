@@ -16,15 +16,16 @@ use fisheye_rt::trace::{
 };
 
 use crate::args::{
-    ArrayFormat, CalibArgs, Directions, Method, Output, ShadingArgs, ToneArg, load_scene,
+    ArrayFormat, CalibArgs, Directions, Method, Output, ShadingArgs, ToneArg, load_scene_with,
     parse_camera,
 };
 
 #[derive(clap::Args)]
 pub(crate) struct RenderArgs {
     /// The scene: `builtin:NAME` (see `fisheye scenes`), a scene file (`.toml`, see
-    /// `scenes/`), or an OBJ file, framed from the front for the lens (its bounding sphere
-    /// fills 80% of the picture) with a headlight and a sun.
+    /// `scenes/`), an OBJ file, framed from the front for the lens (its bounding sphere fills
+    /// 80% of the picture) with a headlight and a sun, or a glTF file (`.gltf`, `.glb`: its
+    /// camera and lights where it has them, else framed and lit as an OBJ).
     #[arg(default_value = "builtin:default")]
     pub(crate) scene: String,
     /// Lens spec (see `fisheye lens list`).
@@ -35,9 +36,13 @@ pub(crate) struct RenderArgs {
     pub(crate) size: ImageSize,
     #[command(flatten)]
     pub(crate) calib: CalibArgs,
+    /// Which scene of a glTF file (from 0); its default scene if not given.
+    #[arg(long)]
+    pub(crate) gltf_scene: Option<usize>,
     /// Camera pose instead of the scene's: `X,Y,Z:LX,LY,LZ` (eye and look-at point, y up),
-    /// or `path:S` for the point S ∈ [0, 1] along the scene file's camera path. Coordinates
-    /// may be negative (`--camera -16,-11.5,0:0,-9,0`).
+    /// `path:S` for the point S ∈ [0, 1] along the scene file's camera path, or `gltf:N` for a
+    /// glTF file's camera N (from 0). Coordinates may be negative (`--camera
+    /// -16,-11.5,0:0,-9,0`).
     #[arg(long, allow_hyphen_values = true)]
     pub(crate) camera: Option<String>,
     /// How to make the image: `rt` traces the lens's rays directly, `rq` does too with the
@@ -143,7 +148,7 @@ pub(crate) fn render(args: &RenderArgs) -> Result<()> {
     let camera = args.calib.camera(Some(&args.lens), args.size)?;
     let out = &args.out;
     let scene_spec = &args.scene;
-    let mut scene = load_scene(scene_spec)?;
+    let mut scene = load_scene_with(scene_spec, args.gltf_scene)?;
     if let Some(angle) = scene.frame_for(&camera) {
         println!(
             "framed for the lens: the scene's bounding sphere seen under ±{:.1}°, {:.0}% of the \

@@ -1,0 +1,703 @@
+//! glTF 2.0 scenes (`.gltf` with external or embedded buffers, `.glb`) through the `gltf`
+//! crate's document model and validation. Buffers and images are read here, through the
+//! loader's `read` (so within the input budgets), and every mesh instance is flattened into the
+//! scene's triangles in world space.
+//!
+//! What maps to what (the README's table says the same):
+//! - the default scene (or the one asked for), its node hierarchy with TRS or matrix transforms;
+//! - triangle primitives (strips and fans split into triangles; points and lines skipped with a
+//!   warning), u8/u16/u32 and sparse accessors, normals, the first UV set (v flipped to the
+//!   OBJ convention the shaders use);
+//! - materials: base colour factor and texture (sRGB); emissive factor times
+//!   `KHR_materials_emissive_strength`; `KHR_materials_transmission` ≥ 0.5 is glass of
+//!   `KHR_materials_ior` (1.5 by default) tinted by the base colour; else metallic ≥ 0.5 with
+//!   roughness ≤ 0.25 is a mirror tinted by the base colour; else a diffuse of base colour × (1 -
+//!   metallic) with a Phong lobe of F0 = mix(0.04, base, metallic) and exponent 2/α² - 2 (α =
+//!   roughness², Walter et al.'s Beckmann–Phong correspondence), 1 to 10⁴; alpha `MASK` is opacity
+//!   0 or 1 by the cutoff, `BLEND` the factor's alpha;
+//! - `KHR_lights_punctual`: point lights (candela / 683 lm/W as W/sr), directional (lux / 683 as
+//!   W/m²), spot lights as points without their cone (warned);
+//! - camera nodes: their poses (looking down the node's -z, up its +y), for `--camera gltf:N`;
+//! - anything else (animations, skins, morph targets, other textures, other extensions, sampler
+//!   modes other than repeat and linear) is left out with one warning per feature.
+
+use std::collections::{BTreeSet, HashMap};
+use std::path::Path;
+
+use base64::Engine;
+use glam::{DAffine3, DMat4, DQuat, DVec3, Vec2, Vec3};
+
+use super::obj::{Dropped, Loaded};
+use super::{Camera, Light, Material, MeshBuilder, ReadFile, Surface, Texture};
+use crate::error::{Error, Result};
+use crate::input::InputKind;
+
+/// Extensions whose content is used (others are warned about).
+const USED_EXTENSIONS: [&str; 4] = [
+    "KHR_lights_punctual",
+    "KHR_materials_transmission",
+    "KHR_materials_ior",
+    "KHR_materials_emissive_strength",
+];
+
+/// Nodes nested deeper than this are refused (glTF's hierarchy is a tree; no stack overflow on
+/// hostile input).
+const MAX_DEPTH: usize = 256;
+
+/// What a glTF file gives beyond its triangles and materials.
+pub struct Content {
+    /// Its lights, world space.
+    pub lights: Vec<Light>,
+    /// Its camera nodes' poses, in node order of the traversal.
+    pub cameras: Vec<Camera>,
+}
+
+/// Loads the glTF file at `path` (and the files it names, through `read`) into `b`: the scene
+/// `scene` (else the document's default, else its first). Warnings name what was left out.
+pub fn load_into(
+    path: &Path,
+    read: ReadFile,
+    scene: Option<usize>,
+    b: &mut MeshBuilder,
+    warnings: &mut Vec<String>,
+) -> Result<Content> {
+    let fail = |message: String| Error::Gltf {
+        path: path.to_path_buf(),
+        message,
+    };
+    let bytes =
+        read(path, InputKind::Gltf).map_err(|e| fail(format!("cannot read the file: {e}")))?;
+    // The gltf crate subtracts the 12-byte header from the GLB's declared length unchecked
+    // (an overflow where overflow checks are on; found by fuzzing).
+    if let Some(length) = bytes
+        .strip_prefix(b"glTF")
+        .and_then(|rest| rest.get(4..8))
+        .map(|l| u32::from_le_bytes([l[0], l[1], l[2], l[3]]))
+        .filter(|&l| l < 12)
+    {
+        return Err(fail(format!(
+            "not valid glTF: the GLB header declares {length} bytes, less than the header itself"
+        )));
+    }
+    let unchecked = gltf::Gltf::from_slice_without_validation(&bytes)
+        .map_err(|e| fail(format!("not valid glTF: {e}")))?;
+    let blob = unchecked.blob;
+    let json = unchecked.document.into_json();
+    // gltf-json's validation reads a primitive's POSITION accessor before it checks that the
+    // index exists (and panics if not; found by fuzzing): check attribute indices first.
+    for (m, mesh) in json.meshes.iter().enumerate() {
+        for (p, primitive) in mesh.primitives.iter().enumerate() {
+            if let Some(index) = primitive
+                .attributes
+                .values()
+                .find(|i| i.value() >= json.accessors.len())
+            {
+                return Err(fail(format!(
+                    "not valid glTF: meshes[{m}].primitives[{p}] names accessors[{}], and \
+                     there are {}",
+                    index.value(),
+                    json.accessors.len()
+                )));
+            }
+        }
+    }
+    // Its image accessor unwraps an image's mimeType (with a bufferView) or uri (without).
+    for (i, image) in json.images.iter().enumerate() {
+        let complete = match image.buffer_view {
+            Some(_) => image.mime_type.is_some(),
+            None => image.uri.is_some(),
+        };
+        if !complete {
+            return Err(fail(format!(
+                "not valid glTF: images[{i}] needs a uri, or a bufferView with a mimeType"
+            )));
+        }
+    }
+    let document =
+        &gltf::Document::from_json(json).map_err(|e| fail(format!("not valid glTF: {e}")))?;
+    let dir = path.parent().unwrap_or(Path::new(""));
+    let buffers: Vec<Vec<u8>> = document
+        .buffers()
+        .map(|buffer| {
+            let what = format!("buffers[{}]", buffer.index());
+            let data = match buffer.source() {
+                gltf::buffer::Source::Bin => blob
+                    .clone()
+                    .ok_or_else(|| fail(format!("{what}: no binary chunk in the file")))?,
+                gltf::buffer::Source::Uri(uri) => {
+                    uri_data(uri, dir, read).map_err(|e| fail(format!("{what}: {}", e.text())))?
+                }
+            };
+            if data.len() < buffer.length() {
+                return Err(fail(format!(
+                    "{what} holds {} bytes, not the {} it declares",
+                    data.len(),
+                    buffer.length()
+                )));
+            }
+            Ok(data)
+        })
+        .collect::<Result<_>>()?;
+    let mut ignored = BTreeSet::new();
+    if document.animations().next().is_some() {
+        ignored.insert("animations".to_string());
+    }
+    if document.skins().next().is_some() {
+        ignored.insert("skins".to_string());
+    }
+    for extension in document.extensions_used() {
+        if !USED_EXTENSIONS.contains(&extension) {
+            ignored.insert(format!("the extension {extension}"));
+        }
+    }
+    let chosen = match scene {
+        Some(n) => document.scenes().nth(n).ok_or_else(|| {
+            fail(format!(
+                "no scene {n}: the file has {}",
+                document.scenes().count()
+            ))
+        })?,
+        None => document
+            .default_scene()
+            .or_else(|| document.scenes().next())
+            .ok_or_else(|| fail("no scene to render".into()))?,
+    };
+    let mut loader = Loader {
+        path,
+        dir,
+        read,
+        buffers: &buffers,
+        materials: HashMap::new(),
+        textures: HashMap::new(),
+        content: Content {
+            lights: Vec::new(),
+            cameras: Vec::new(),
+        },
+        ignored,
+        warnings,
+    };
+    for node in chosen.nodes() {
+        loader.node(&node, DMat4::IDENTITY, 0, b)?;
+    }
+    let Loader {
+        ignored,
+        warnings,
+        content,
+        ..
+    } = loader;
+    for what in ignored {
+        warnings.push(format!("{}: {what} not rendered", path.display()));
+    }
+    Ok(content)
+}
+
+/// A glTF file as a scene: its lights (else a headlight and a sun), its first camera (else a
+/// view framing its bounds), and its cameras for `--camera gltf:N`.
+pub fn load_gltf(path: &Path, scene: Option<usize>) -> Result<Loaded> {
+    load_gltf_from(path, &super::disk, scene)
+}
+
+/// As [`load_gltf`], reading the files through `read`.
+pub fn load_gltf_from(path: &Path, read: ReadFile, scene: Option<usize>) -> Result<Loaded> {
+    let mut b = MeshBuilder::new();
+    let mut warnings = Vec::new();
+    let content = load_into(path, read, scene, &mut b, &mut warnings)?;
+    if b.is_empty() {
+        return Err(Error::Gltf {
+            path: path.to_path_buf(),
+            message: format!("no triangles to render{}", super::obj::because(&warnings)),
+        });
+    }
+    let (lo, hi) = b.bounds().unwrap_or((DVec3::ZERO, DVec3::ZERO));
+    let given = content.cameras.first().copied();
+    let camera = given.unwrap_or_else(|| super::obj::framing(lo, hi, super::obj::DEFAULT_DISTANCE));
+    let lit = !content.lights.is_empty();
+    let lights = if lit {
+        content.lights
+    } else {
+        super::obj::headlight_and_sun(&camera)
+    };
+    let mut scene = b.finish(
+        lights,
+        super::obj::DEFAULT_SKY,
+        super::obj::DEFAULT_AMBIENT,
+        camera,
+    );
+    scene.cameras = content.cameras;
+    if !lit {
+        scene.headlight = Some(0);
+    }
+    if given.is_none() {
+        scene.framed = Some((lo, hi));
+    }
+    Ok(Loaded { scene, warnings })
+}
+
+/// Why a URI's bytes could not be had.
+enum Missing {
+    /// The file does not exist (a missing image is a warning).
+    NotFound(String),
+    /// Anything else: a bad URI, a special or oversized file (always an error).
+    Bad(String),
+}
+
+impl Missing {
+    fn text(self) -> String {
+        match self {
+            Missing::NotFound(t) | Missing::Bad(t) => t,
+        }
+    }
+}
+
+/// The bytes of a URI: a `data:` URI's base64, or a file relative to the glTF's folder.
+fn uri_data(uri: &str, dir: &Path, read: ReadFile) -> Result<Vec<u8>, Missing> {
+    if let Some(data) = uri.strip_prefix("data:") {
+        let (header, payload) = data
+            .split_once(',')
+            .ok_or_else(|| Missing::Bad("a data URI without a comma".into()))?;
+        if !header.ends_with(";base64") {
+            return Err(Missing::Bad("a data URI that is not base64".into()));
+        }
+        return base64::engine::general_purpose::STANDARD
+            .decode(payload)
+            .map_err(|e| Missing::Bad(format!("its data URI is not valid base64: {e}")));
+    }
+    let name = percent_decoded(uri).map_err(Missing::Bad)?;
+    let file = dir.join(&name);
+    read(&file, InputKind::Gltf).map_err(|e| {
+        let text = format!("{}: {e}", file.display());
+        if e.kind() == std::io::ErrorKind::NotFound {
+            Missing::NotFound(text)
+        } else {
+            Missing::Bad(text)
+        }
+    })
+}
+
+/// A relative URI's path with its `%XX` escapes decoded.
+fn percent_decoded(uri: &str) -> Result<String, String> {
+    let bytes = uri.as_bytes();
+    let mut out = Vec::with_capacity(bytes.len());
+    let mut i = 0;
+    while i < bytes.len() {
+        if bytes[i] == b'%' {
+            let hex = uri
+                .get(i + 1..i + 3)
+                .and_then(|h| u8::from_str_radix(h, 16).ok())
+                .ok_or_else(|| format!("the URI {uri:?} has a bad % escape"))?;
+            out.push(hex);
+            i += 3;
+        } else {
+            out.push(bytes[i]);
+            i += 1;
+        }
+    }
+    String::from_utf8(out).map_err(|_| format!("the URI {uri:?} is not UTF-8"))
+}
+
+struct Loader<'a> {
+    path: &'a Path,
+    dir: &'a Path,
+    read: ReadFile<'a>,
+    buffers: &'a [Vec<u8>],
+    /// Our material of each glTF material (`None`: the default material).
+    materials: HashMap<Option<usize>, u32>,
+    /// Our texture of each glTF texture (`None`: it could not be loaded).
+    textures: HashMap<usize, Option<u32>>,
+    content: Content,
+    /// Features left out, for one warning each.
+    ignored: BTreeSet<String>,
+    warnings: &'a mut Vec<String>,
+}
+
+impl Loader<'_> {
+    fn fail(&self, message: String) -> Error {
+        Error::Gltf {
+            path: self.path.to_path_buf(),
+            message,
+        }
+    }
+
+    /// Adds a node and its children under `parent`'s transform.
+    fn node(
+        &mut self,
+        node: &gltf::Node,
+        parent: DMat4,
+        depth: usize,
+        b: &mut MeshBuilder,
+    ) -> Result<()> {
+        if depth > MAX_DEPTH {
+            return Err(self.fail(format!(
+                "nodes[{}]: the hierarchy is deeper than {MAX_DEPTH} nodes",
+                node.index()
+            )));
+        }
+        let local = match node.transform() {
+            gltf::scene::Transform::Matrix { matrix } => {
+                DMat4::from_cols_array_2d(&matrix.map(|c| c.map(f64::from)))
+            }
+            gltf::scene::Transform::Decomposed {
+                translation,
+                rotation,
+                scale,
+            } => {
+                let [x, y, z, w] = rotation.map(f64::from);
+                DMat4::from_scale_rotation_translation(
+                    Vec3::from(scale).as_dvec3(),
+                    DQuat::from_xyzw(x, y, z, w).normalize(),
+                    Vec3::from(translation).as_dvec3(),
+                )
+            }
+        };
+        let world = parent * local;
+        if !world.is_finite() {
+            return Err(self.fail(format!(
+                "nodes[{}]: its transform is not finite",
+                node.index()
+            )));
+        }
+        let affine = DAffine3::from_mat4(world);
+        if let Some(mesh) = node.mesh() {
+            if node.skin().is_some() {
+                self.ignored.insert("skins".into());
+            }
+            self.mesh(&mesh, affine, b)?;
+        }
+        if let Some(light) = node.light() {
+            self.light(&light, affine);
+        }
+        if node.camera().is_some() {
+            let position = affine.translation;
+            let forward = -affine.matrix3.z_axis;
+            let up = affine.matrix3.y_axis;
+            if forward.length_squared() > 0.0 && up.length_squared() > 0.0 {
+                self.content.cameras.push(Camera {
+                    position,
+                    look_at: position + forward.normalize(),
+                    up: up.normalize(),
+                });
+            }
+        }
+        for child in node.children() {
+            self.node(&child, world, depth + 1, b)?;
+        }
+        Ok(())
+    }
+
+    fn light(&mut self, light: &gltf::khr_lights_punctual::Light, at: DAffine3) {
+        use gltf::khr_lights_punctual::Kind;
+        let colour = Vec3::from(light.color()) * light.intensity() / 683.0;
+        match light.kind() {
+            Kind::Directional => {
+                let direction = -at.matrix3.z_axis.normalize_or_zero();
+                if direction == DVec3::ZERO {
+                    self.ignored
+                        .insert("directional lights whose nodes scale to nothing".into());
+                    return;
+                }
+                self.content.lights.push(Light::Directional {
+                    direction,
+                    irradiance: colour,
+                });
+            }
+            kind => {
+                if matches!(kind, Kind::Spot { .. }) {
+                    self.ignored
+                        .insert("spot lights' cones (they light as points)".into());
+                }
+                self.content.lights.push(Light::Point {
+                    position: at.translation,
+                    intensity: colour,
+                });
+            }
+        }
+    }
+
+    fn mesh(&mut self, mesh: &gltf::Mesh, at: DAffine3, b: &mut MeshBuilder) -> Result<()> {
+        for primitive in mesh.primitives() {
+            let what = format!("meshes[{}].primitives[{}]", mesh.index(), primitive.index());
+            if primitive.morph_targets().next().is_some() {
+                self.ignored.insert("morph targets".into());
+            }
+            let mode = primitive.mode();
+            use gltf::mesh::Mode;
+            if !matches!(
+                mode,
+                Mode::Triangles | Mode::TriangleStrip | Mode::TriangleFan
+            ) {
+                self.ignored.insert("points and lines".into());
+                continue;
+            }
+            self.check_types(&primitive, &what)?;
+            let material = self.material(&primitive.material(), b)?;
+            let buffers = self.buffers;
+            let reader = primitive.reader(|buffer| buffers.get(buffer.index()).map(Vec::as_slice));
+            let accessor = |semantic: gltf::Semantic| primitive.get(&semantic).map(|a| a.index());
+            let beyond = |index: Option<usize>| {
+                format!(
+                    "{what}: accessors[{}] reaches beyond its buffer",
+                    index.map_or("?".into(), |i| i.to_string())
+                )
+            };
+            let Some(positions) = reader.read_positions() else {
+                return match accessor(gltf::Semantic::Positions) {
+                    None => Err(self.fail(format!("{what}: no POSITION attribute"))),
+                    index => Err(self.fail(beyond(index))),
+                };
+            };
+            let positions: Vec<DVec3> = positions.map(|p| Vec3::from(p).as_dvec3()).collect();
+            let count = positions.len();
+            let normals: Option<Vec<Vec3>> = match reader.read_normals() {
+                Some(n) => Some(n.map(Vec3::from).collect()),
+                None if accessor(gltf::Semantic::Normals).is_some() => {
+                    return Err(self.fail(beyond(accessor(gltf::Semantic::Normals))));
+                }
+                None => None,
+            };
+            let uvs: Option<Vec<Vec2>> = match reader.read_tex_coords(0) {
+                // glTF puts v = 0 at the image's top; the shaders, as OBJ, at its bottom.
+                Some(t) => Some(t.into_f32().map(|[u, v]| Vec2::new(u, 1.0 - v)).collect()),
+                None if accessor(gltf::Semantic::TexCoords(0)).is_some() => {
+                    return Err(self.fail(beyond(accessor(gltf::Semantic::TexCoords(0)))));
+                }
+                None => None,
+            };
+            for (name, len) in [
+                ("NORMAL", normals.as_ref().map(Vec::len)),
+                ("TEXCOORD_0", uvs.as_ref().map(Vec::len)),
+            ] {
+                if len.is_some_and(|n| n != count) {
+                    return Err(self.fail(format!(
+                        "{what}: {name} has {} values for {count} positions",
+                        len.unwrap_or(0)
+                    )));
+                }
+            }
+            let indices: Vec<u32> = match reader.read_indices() {
+                Some(i) => i.into_u32().collect(),
+                None if primitive.indices().is_some() => {
+                    return Err(self.fail(beyond(primitive.indices().map(|a| a.index()))));
+                }
+                None => (0..count as u32).collect(),
+            };
+            if let Some(&bad) = indices.iter().find(|&&i| i as usize >= count) {
+                return Err(self.fail(format!(
+                    "{what}: index {bad} in accessors[{}] is beyond its {count} vertices",
+                    primitive.indices().map_or(0, |a| a.index())
+                )));
+            }
+            let faces: Vec<[u32; 3]> = match mode {
+                Mode::TriangleStrip => (2..indices.len())
+                    .map(|k| {
+                        let (a, b, c) = (indices[k - 2], indices[k - 1], indices[k]);
+                        if k % 2 == 0 { [a, b, c] } else { [b, a, c] }
+                    })
+                    .collect(),
+                Mode::TriangleFan => (2..indices.len())
+                    .map(|k| [indices[0], indices[k - 1], indices[k]])
+                    .collect(),
+                _ => indices
+                    .chunks_exact(3)
+                    .map(|f| [f[0], f[1], f[2]])
+                    .collect(),
+            };
+            let first = b.len();
+            let mut dropped = Dropped::default();
+            for face in faces {
+                let corners = face.map(|i| at.transform_point3(positions[i as usize]));
+                if !dropped.keeps(&corners) {
+                    continue;
+                }
+                let local = face.map(|i| positions[i as usize]);
+                let normal = normals
+                    .as_ref()
+                    .map(|n| face.map(|i| n[i as usize]))
+                    .filter(|n| n.iter().all(|n| n.is_finite() && n.length_squared() > 0.0));
+                let uv = uvs.as_ref().map(|t| face.map(|i| t[i as usize]));
+                b.triangle(local, normal, uv, material);
+            }
+            b.transform_since(first, at);
+            let path = self.path.display().to_string();
+            dropped.warn(|w| self.warnings.push(format!("{path}: {what}: {w}")));
+        }
+        Ok(())
+    }
+
+    /// Refuses accessors of a type the spec does not allow where they are used (the gltf
+    /// crate's validation does not check them, and its readers assume them: found by
+    /// fuzzing).
+    fn check_types(&self, primitive: &gltf::Primitive, what: &str) -> Result<()> {
+        use gltf::accessor::{DataType as D, Dimensions as N};
+        let allowed: [(Option<gltf::Accessor>, &str, &[D], N); 4] = [
+            (
+                primitive.get(&gltf::Semantic::Positions),
+                "POSITION",
+                &[D::F32],
+                N::Vec3,
+            ),
+            (
+                primitive.get(&gltf::Semantic::Normals),
+                "NORMAL",
+                &[D::F32],
+                N::Vec3,
+            ),
+            (
+                primitive.get(&gltf::Semantic::TexCoords(0)),
+                "TEXCOORD_0",
+                &[D::F32, D::U8, D::U16],
+                N::Vec2,
+            ),
+            (
+                primitive.indices(),
+                "indices",
+                &[D::U8, D::U16, D::U32],
+                N::Scalar,
+            ),
+        ];
+        for (accessor, name, types, dimensions) in allowed {
+            let Some(accessor) = accessor else { continue };
+            if !types.contains(&accessor.data_type()) || accessor.dimensions() != dimensions {
+                return Err(self.fail(format!(
+                    "{what}: {name} is accessors[{}], of {:?} {:?}; it must be {dimensions:?} \
+                     of {types:?}",
+                    accessor.index(),
+                    accessor.dimensions(),
+                    accessor.data_type()
+                )));
+            }
+        }
+        Ok(())
+    }
+
+    /// Our material for a glTF material (made at its first use).
+    fn material(&mut self, m: &gltf::Material, b: &mut MeshBuilder) -> Result<u32> {
+        if let Some(&id) = self.materials.get(&m.index()) {
+            return Ok(id);
+        }
+        let pbr = m.pbr_metallic_roughness();
+        let [r, g, bl, alpha] = pbr.base_color_factor();
+        let base = Vec3::new(r, g, bl);
+        let name = m.name().map_or_else(
+            || format!("material {}", m.index().map_or(-1, |i| i as i64)),
+            String::from,
+        );
+        let emission = Vec3::from(m.emissive_factor()) * m.emissive_strength().unwrap_or(1.0);
+        let metallic = pbr.metallic_factor().clamp(0.0, 1.0);
+        let roughness = pbr.roughness_factor().clamp(0.0, 1.0);
+        let transmission = m.transmission().map_or(0.0, |t| t.transmission_factor());
+        let opacity = match m.alpha_mode() {
+            gltf::material::AlphaMode::Opaque => 1.0,
+            gltf::material::AlphaMode::Mask => {
+                f32::from(u8::from(alpha >= m.alpha_cutoff().unwrap_or(0.5)))
+            }
+            gltf::material::AlphaMode::Blend => alpha.clamp(0.0, 1.0),
+        };
+        let mut material = if transmission >= 0.5 {
+            Material {
+                transmission: base,
+                ..Material::glass(&name, m.ior().unwrap_or(1.5))
+            }
+        } else if metallic >= 0.5 && roughness <= 0.25 {
+            Material::mirror(&name, base)
+        } else {
+            let a = (roughness * roughness).max(1e-3);
+            Material {
+                specular: Vec3::splat(0.04).lerp(base, metallic),
+                shininess: (2.0 / (a * a) - 2.0).clamp(1.0, 1e4),
+                ..Material::diffuse(&name, base * (1.0 - metallic))
+            }
+        };
+        material.emission = emission;
+        material.opacity = opacity;
+        if let Some(info) = pbr.base_color_texture() {
+            if info.tex_coord() != 0 {
+                self.ignored
+                    .insert("texture coordinate sets other than the first".into());
+            }
+            if m.alpha_mode() != gltf::material::AlphaMode::Opaque {
+                self.ignored
+                    .insert("alpha from base colour textures".into());
+            }
+            if material.surface == Surface::Diffuse {
+                material.diffuse_texture = self.texture(&info.texture(), b)?;
+            }
+        }
+        for (present, feature) in [
+            (m.normal_texture().is_some(), "normal textures"),
+            (m.occlusion_texture().is_some(), "occlusion textures"),
+            (m.emissive_texture().is_some(), "emissive textures"),
+            (
+                pbr.metallic_roughness_texture().is_some(),
+                "metallic-roughness textures",
+            ),
+        ] {
+            if present {
+                self.ignored.insert(feature.into());
+            }
+        }
+        let id = b.material(material);
+        self.materials.insert(m.index(), id);
+        Ok(id)
+    }
+
+    /// Our texture for a glTF texture, or `None` (warned) where its image is missing or cannot
+    /// be decoded; an error for a special or oversized file or a bad URI.
+    fn texture(&mut self, texture: &gltf::Texture, b: &mut MeshBuilder) -> Result<Option<u32>> {
+        if let Some(&id) = self.textures.get(&texture.index()) {
+            return Ok(id);
+        }
+        use gltf::texture::{MagFilter, WrappingMode};
+        let sampler = texture.sampler();
+        if sampler.wrap_s() != WrappingMode::Repeat || sampler.wrap_t() != WrappingMode::Repeat {
+            self.ignored
+                .insert("texture wrap modes other than repeat (textures repeat)".into());
+        }
+        if sampler.mag_filter() == Some(MagFilter::Nearest) {
+            self.ignored
+                .insert("nearest texture filtering (textures are filtered linearly)".into());
+        }
+        let image = texture.source();
+        let what = format!("images[{}]", image.index());
+        let bytes = match image.source() {
+            gltf::image::Source::View { view, .. } => self
+                .buffers
+                .get(view.buffer().index())
+                .and_then(|data| data.get(view.offset()..view.offset() + view.length()))
+                .map(<[u8]>::to_vec)
+                .ok_or_else(|| {
+                    Missing::Bad(format!(
+                        "bufferViews[{}] reaches beyond its buffer",
+                        view.index()
+                    ))
+                }),
+            gltf::image::Source::Uri { uri, .. } => uri_data(uri, self.dir, self.read),
+        };
+        let decoded = match bytes {
+            Ok(bytes) => {
+                image::load_from_memory(&bytes).map_err(|e| format!("cannot decode it: {e}"))
+            }
+            Err(Missing::NotFound(e)) => Err(e),
+            Err(Missing::Bad(e)) => return Err(self.fail(format!("{what}: {e}"))),
+        };
+        let id = match decoded {
+            Ok(decoded) => {
+                let rgba = decoded.to_rgba8();
+                Some(b.texture(Texture {
+                    name: format!("{} {what}", self.path.display()),
+                    width: rgba.width(),
+                    height: rgba.height(),
+                    rgba: rgba.into_raw(),
+                }))
+            }
+            Err(e) => {
+                self.warnings.push(format!(
+                    "{}: {what}: {e}; its materials use their base colour factor alone",
+                    self.path.display()
+                ));
+                None
+            }
+        };
+        self.textures.insert(texture.index(), id);
+        Ok(id)
+    }
+}
