@@ -173,11 +173,17 @@ def test_the_camera_moves_without_uploading_the_scene_again(tmp_path):
 def test_the_gil_is_released_while_the_gpu_renders():
     """Another Python thread runs while a render is in flight."""
     renderer = fr.Renderer(fr.Scene.load("builtin:default"))
-    lens = fr.Lens.from_spec("samyang-7.5mm", size=(320, 240))
-    renderer.render(lens, spp=16, outputs=["colour"])  # make the pass once
+    # A render long enough to tell (about a second on lavapipe; larger on a fast GPU).
+    for size, spp in [((320, 240), 16), ((1024, 768), 64), ((2048, 1536), 256)]:
+        lens = fr.Lens.from_spec("samyang-7.5mm", size=size)
+        renderer.render(lens, spp=spp, outputs=["colour"])  # make the pass once
+        begun = time.perf_counter()
+        renderer.render(lens, spp=spp, outputs=["colour"])
+        if time.perf_counter() - begun > 0.3:
+            break
     ended = []
     worker = threading.Thread(
-        target=lambda: (renderer.render(lens, spp=16, outputs=["colour"]), ended.append(time.perf_counter()))
+        target=lambda: (renderer.render(lens, spp=spp, outputs=["colour"]), ended.append(time.perf_counter()))
     )
     started = time.perf_counter()
     worker.start()

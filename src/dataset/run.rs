@@ -423,10 +423,18 @@ impl Dataset {
         std::thread::scope(|scope| -> Result<()> {
             let writer = scope.spawn(|| -> Result<f64> {
                 let mut seconds = 0.0;
-                for w in receiver {
+                let kill_after = injected_kill();
+                for (written, w) in receiver.into_iter().enumerate() {
                     let t = Instant::now();
                     self.write(folder, &lens_cameras, &w)?;
                     seconds += t.elapsed().as_secs_f64();
+                    if kill_after == Some(written + 1) {
+                        // SAFETY: kill(2) on this process with SIGKILL takes no pointers and
+                        // does not return; it is the kill this fault stands for.
+                        unsafe {
+                            libc::kill(libc::getpid(), libc::SIGKILL);
+                        }
+                    }
                 }
                 Ok(seconds)
             });
@@ -530,6 +538,16 @@ impl Dataset {
         }
         Ok(())
     }
+}
+
+/// The image count after which the run aborts, from `FISHEYE_INJECT_FAULT=kill-after-images:N`
+/// (see [`crate::gpu::FAULT_VARIABLE`]): a kill at a known point, for the tests of resuming.
+fn injected_kill() -> Option<usize> {
+    std::env::var(crate::gpu::FAULT_VARIABLE)
+        .ok()?
+        .strip_prefix("kill-after-images:")?
+        .parse()
+        .ok()
 }
 
 /// Writes the plan into `folder`, or checks that the one there is the same.

@@ -175,7 +175,9 @@ pub fn submit_over_elements(
 }
 
 /// The environment variable that injects a fault for tests of the error paths: with the value
-/// `device-lost`, every device is destroyed as soon as it is created, as a driver reset would.
+/// `device-lost`, every device is destroyed as soon as it is created, as a driver reset would;
+/// with `kill-after-images:N`, a dataset run kills itself (SIGKILL) once it has written N
+/// images.
 pub const FAULT_VARIABLE: &str = "FISHEYE_INJECT_FAULT";
 
 /// Optional device features the project uses when the adapter has them.
