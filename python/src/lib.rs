@@ -19,7 +19,7 @@ use fisheye_rt::trace::{
     colour_image_with, world_directions,
 };
 use fisheye_rt::{Error, LensError};
-use glam::{DVec2, DVec3};
+use glam::{DAffine3, DVec2, DVec3};
 use numpy::ndarray::IxDyn;
 use numpy::{AllowTypeChange, PyArray1, PyArrayDyn, PyArrayLikeDyn, PyArrayMethods};
 use pyo3::exceptions::{PyOSError, PyRuntimeError, PyValueError};
@@ -217,10 +217,10 @@ impl Lens {
 
 /// The 4×4 `T_scene_camera` (OpenCV camera frame) of a look-at camera.
 fn transform_of(camera: &Camera) -> [[f64; 4]; 4] {
-    let r = camera.rotation();
-    let p = camera.position;
-    let row = |i: usize| [r.x_axis[i], r.y_axis[i], r.z_axis[i], p[i]];
-    [row(0), row(1), row(2), [0.0, 0.0, 0.0, 1.0]]
+    fisheye_rt::pose::rows(&DAffine3 {
+        matrix3: camera.rotation(),
+        translation: camera.position,
+    })
 }
 
 fn matrix<'py>(py: Python<'py>, m: [[f64; 4]; 4]) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
@@ -430,7 +430,13 @@ impl Renderer {
         let output = py.detach(|| self.trace(ctx, &camera, &pose, spp, &options))?;
         let dict = PyDict::new(py);
         let (h, w) = (camera.size.height as usize, camera.size.width as usize);
-        let directions = world_directions(&camera, &pose);
+        // Only the direction and mask arrays read the rays (an f64 lens evaluation a pixel).
+        let rays = outputs.iter().any(|o| o == "direction" || o == "mask");
+        let directions = if rays {
+            world_directions(&camera, &pose)
+        } else {
+            Vec::new()
+        };
         for name in &outputs {
             let array = match name.as_str() {
                 "colour" => PyArray1::from_vec(py, output.colour.concat())

@@ -6,7 +6,7 @@ use std::path::{Path, PathBuf};
 use std::sync::mpsc;
 use std::time::Instant;
 
-use glam::DAffine3;
+use glam::{DAffine3, DVec3};
 use serde_json::{Value, json};
 
 use super::trajectory::{Pose, TrajectoryFormat};
@@ -18,8 +18,8 @@ use crate::lens::{CalibratedModel, Lens, LensCamera};
 use crate::pose::rows;
 use crate::scene::Scene;
 use crate::trace::{
-    Channel, ColourFile, Display, GpuScene, RenderOptions, RenderOutput, Tone, TracePass,
-    world_directions, write_colour, write_file,
+    Channel, ColourFile, Display, GpuScene, RenderOptions, RenderOutput, Tone, TracePass, rotated,
+    write_colour, write_file,
 };
 
 /// The plan's file in a dataset's folder: written by every run before it renders, and
@@ -135,7 +135,7 @@ impl RunReport {
 
 /// One camera's render of one pose, on its way to the writer thread.
 struct Written {
-    stem: String,
+    index: usize,
     camera: usize,
     pose: crate::scene::Camera,
     output: RenderOutput,
@@ -424,9 +424,15 @@ impl Dataset {
             let writer = scope.spawn(|| -> Result<f64> {
                 let mut seconds = 0.0;
                 let kill_after = injected_kill();
+                // The cameras' rays in their own frames, once: each pose only turns them.
+                let directions: Vec<Vec<Option<DVec3>>> = if self.outputs.0.is_empty() {
+                    Vec::new()
+                } else {
+                    lens_cameras.iter().map(LensCamera::directions).collect()
+                };
                 for (written, w) in receiver.into_iter().enumerate() {
                     let t = Instant::now();
-                    self.write(folder, &lens_cameras, &w)?;
+                    self.write(folder, &directions, &w)?;
                     seconds += t.elapsed().as_secs_f64();
                     if kill_after == Some(written + 1) {
                         // SAFETY: kill(2) on this process with SIGKILL takes no pointers and
@@ -472,13 +478,12 @@ impl Dataset {
                         }
                         report.readback_seconds += t.elapsed().as_secs_f64();
                     }
-                    let stem = frame_stem(p, &self.poses[p].stamp);
                     for (c, output) in outputs.into_iter().enumerate() {
                         let (valid, _) = output.counts();
                         report.rays += valid as u64 * u64::from(self.options.spp);
                         report.images += 1;
                         let w = Written {
-                            stem: stem.clone(),
+                            index: p,
                             camera: c,
                             pose: poses[c],
                             output,
@@ -503,17 +508,14 @@ impl Dataset {
         Ok(())
     }
 
-    /// Writes one camera's files of one pose, each to a temporary name renamed into place.
-    fn write(&self, folder: &Path, cameras: &[LensCamera], w: &Written) -> Result<()> {
-        let dir = folder.join(Self::camera_name(w.camera));
+    /// Writes one camera's files of one pose (the names [`Dataset::files`] gives), each to a
+    /// temporary name renamed into place; `directions` holds each camera's camera-frame rays.
+    fn write(&self, folder: &Path, directions: &[Vec<Option<DVec3>>], w: &Written) -> Result<()> {
+        let files = self.files(w.index, w.camera);
         let (file, display) = self.colour;
-        let colour = match file {
-            ColourFile::Png8 | ColourFile::Png16 => "png",
-            ColourFile::ExrHalf | ColourFile::ExrFloat => "exr",
-        };
         let out = &w.output;
         write_colour(
-            &dir.join(format!("{}.{colour}", w.stem)),
+            &folder.join(&files[0].1),
             out.size,
             &out.colour,
             &display,
@@ -523,14 +525,9 @@ impl Dataset {
         if channels.is_empty() {
             return Ok(());
         }
-        let directions = world_directions(&cameras[w.camera], &w.pose);
-        for &channel in channels {
-            let path = dir.join(format!(
-                "{}.{}.{}",
-                w.stem,
-                channel.name(),
-                arrays.extension()
-            ));
+        let directions = rotated(&directions[w.camera], &w.pose);
+        for (&channel, (_, name)) in channels.iter().zip(&files[1..]) {
+            let path = folder.join(name);
             match arrays {
                 ArrayFile::Npy => out.write_npy(channel, &directions, &path)?,
                 ArrayFile::Exr => out.write_exr(channel, &directions, &path)?,

@@ -802,12 +802,14 @@ fn output_bands(
 /// The world-space direction of every pixel's ray (f64 lens model, rotated by the pose),
 /// row-major, `None` where the lens masks the pixel.
 pub fn world_directions(camera: &LensCamera, pose: &crate::scene::Camera) -> Vec<Option<DVec3>> {
+    rotated(&camera.directions(), pose)
+}
+
+/// Camera-frame directions (as [`LensCamera::directions`] gives them, made once per camera)
+/// turned into world space by `pose`.
+pub fn rotated(directions: &[Option<DVec3>], pose: &crate::scene::Camera) -> Vec<Option<DVec3>> {
     let rotation = pose.rotation();
-    camera
-        .directions()
-        .into_iter()
-        .map(|d| d.map(|d| rotation * d))
-        .collect()
+    directions.iter().map(|d| d.map(|d| rotation * d)).collect()
 }
 
 /// Renders `scene` through `camera` in one call: builds and uploads the scene, traces one
