@@ -4,9 +4,11 @@
 //! GPU time from timestamp queries, median of `FRAMES` frames after one warm-up, one run.
 //! A second table compares the software traversal with hardware ray queries (where the
 //! adapter has them), with both build times; a third traces two scenes with each BVH preset,
-//! to choose the default by measurement.
+//! to choose the default by measurement; a fourth measures instancing: the cost of the second
+//! level against the same scene flattened, and the thousand-instance scene.
 //!
-//! `cargo bench --bench trace` (`FRAMES`, default 8; `SIZE`, default 1024x768).
+//! `cargo bench --bench trace` (`FRAMES`, default 8; `SIZE`, default 1024x768; `TABLES`, a
+//! comma-separated choice of `scenes`, `rq`, `presets`, `instancing`, default all of them).
 
 use fisheye_rt::bvh::BvhQuality;
 use fisheye_rt::gpu::{GpuContext, Queries, median};
@@ -73,6 +75,8 @@ fn main() {
         .ok()
         .and_then(|s| s.parse().ok())
         .unwrap_or(ImageSize::new(1024, 768).unwrap());
+    let tables = std::env::var("TABLES").unwrap_or("scenes,rq,presets,instancing".into());
+    let table = |name: &str| tables.split(',').any(|t| t == name);
     std::env::set_current_dir(env!("CARGO_MANIFEST_DIR")).unwrap();
     let ctx = GpuContext::new().expect("a GPU adapter");
     let queries = Queries::new(&ctx, 1).expect("this benchmark needs timestamp queries");
@@ -80,13 +84,16 @@ fn main() {
     println!(
         "{size}, median GPU ms of {frames} frames along the camera path (one warm-up excluded)\n"
     );
-    println!(
-        "| scene | triangles | lens | ms / frame | M primary rays/s | hit | time per ray, fisheye / pinhole |"
-    );
-    println!("|---|---:|---|---:|---:|---:|---:|");
     let options = RenderOptions::default();
     let mut loaded = Vec::new();
-    for spec in SCENES {
+    let needs_scenes = table("scenes") || table("rq") || table("presets");
+    if table("scenes") {
+        println!(
+            "| scene | triangles | lens | ms / frame | M primary rays/s | hit | time per ray, fisheye / pinhole |"
+        );
+        println!("|---|---:|---|---:|---:|---:|---:|");
+    }
+    for spec in SCENES.iter().filter(|_| needs_scenes) {
         let scene = match scene::load(spec) {
             Ok(l) => l.scene,
             Err(e) => {
@@ -94,6 +101,10 @@ fn main() {
                 continue;
             }
         };
+        if !table("scenes") {
+            loaded.push((spec, scene));
+            continue;
+        }
         let gpu_scene = GpuScene::new(&ctx, &scene, &options).unwrap();
         let results: Vec<Measured> = LENSES
             .iter()
@@ -118,7 +129,7 @@ fn main() {
         loaded.push((spec, scene));
     }
 
-    if ctx.has(wgpu::Features::EXPERIMENTAL_RAY_QUERY) {
+    if table("rq") && ctx.has(wgpu::Features::EXPERIMENTAL_RAY_QUERY) {
         println!(
             "\nTraversal: the software CWBVH against hardware ray queries, fisheye, same run\n"
         );
@@ -148,13 +159,14 @@ fn main() {
         }
     }
 
-    println!("\nBVH presets: build time (CPU) and fisheye frame time (GPU)\n");
-    println!("| scene | preset | build ms | nodes | ms / frame |");
-    println!("|---|---|---:|---:|---:|");
-    for (spec, scene) in loaded
-        .iter()
-        .filter(|(s, _)| *s == "builtin:few-detailed" || *s == "scenes/sibenik.toml")
-    {
+    if table("presets") {
+        println!("\nBVH presets: build time (CPU) and fisheye frame time (GPU)\n");
+        println!("| scene | preset | build ms | nodes | ms / frame |");
+        println!("|---|---|---:|---:|---:|");
+    }
+    for (spec, scene) in loaded.iter().filter(|(s, _)| {
+        table("presets") && (**s == "builtin:few-detailed" || **s == "scenes/sibenik.toml")
+    }) {
         for bvh in BvhQuality::ALL {
             let options = RenderOptions { bvh, ..options };
             let gpu_scene = GpuScene::new(&ctx, scene, &options).unwrap();
@@ -167,5 +179,48 @@ fn main() {
                 m.ms
             );
         }
+    }
+
+    if !table("instancing") {
+        return;
+    }
+    println!(
+        "\nInstancing: the two-level BVH against the same scene flattened, fisheye, same run\n"
+    );
+    println!(
+        "| scene | triangles | stored | instances | device MiB | build ms | ms / frame | M primary rays/s |"
+    );
+    println!("|---|---:|---:|---:|---:|---:|---:|---:|");
+    for (spec, flatten) in [
+        ("builtin:instances-few", false),
+        ("builtin:instances-few", true),
+        ("builtin:instances", false),
+    ] {
+        let mut scene = scene::load(spec).unwrap().scene;
+        if flatten {
+            scene = scene.flattened(usize::MAX).unwrap();
+        }
+        let gpu_scene = GpuScene::new(&ctx, &scene, &options).unwrap();
+        let m = measure(
+            &ctx,
+            &queries,
+            &scene,
+            &gpu_scene,
+            LENSES[0].1,
+            size,
+            frames,
+        );
+        let bytes = gpu_scene.bytes;
+        println!(
+            "| {spec}{} | {} | {} | {} | {:.1} | {:.0} | {:.1} | {:.2} |",
+            if flatten { " (flattened)" } else { "" },
+            scene.len(),
+            scene.triangles.len(),
+            scene.instances.len(),
+            (bytes.geometry + bytes.bvh + bytes.shading) as f64 / f64::from(1 << 20),
+            gpu_scene.bvh_build_time.as_secs_f64() * 1e3,
+            m.ms,
+            m.rays as f64 / m.ms * 1e-3
+        );
     }
 }

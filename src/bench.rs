@@ -125,6 +125,8 @@ pub struct SceneSet {
     pub software: GpuScene,
     /// The scene with a ray-query acceleration structure, if asked for.
     pub ray_query: Option<GpuScene>,
+    /// An instanced scene flattened for the rasterizer, if a setup rasterizes it.
+    pub flat: Option<GpuScene>,
 }
 
 impl SceneSet {
@@ -154,16 +156,32 @@ impl SceneSet {
                 GpuScene::new(ctx, scene, &options)
             })
             .transpose()?;
+        let rasterizes = |s: &Setup| matches!(s.method, Method::Cube(CubeMethod::Raster(_)));
+        let flat = (scene.is_instanced() && setups.iter().any(rasterizes))
+            .then(|| {
+                let options = RenderOptions {
+                    traversal: Traversal::Software,
+                    ..*options
+                };
+                GpuScene::new(
+                    ctx,
+                    &scene.flattened(crate::scene::MAX_FLATTENED)?,
+                    &options,
+                )
+            })
+            .transpose()?;
         Ok(Self {
             software,
             ray_query,
+            flat,
         })
     }
 
     /// The scene `method` renders.
     pub fn for_method(&self, method: Method) -> &GpuScene {
-        match (method.traversal(), &self.ray_query) {
-            (Traversal::RayQuery, Some(rq)) => rq,
+        match (method, &self.ray_query, &self.flat) {
+            (Method::Rq, Some(rq), _) => rq,
+            (Method::Cube(CubeMethod::Raster(_)), _, Some(flat)) => flat,
             _ => &self.software,
         }
     }

@@ -5,13 +5,13 @@
 use std::time::{Duration, Instant};
 
 use bytemuck::Zeroable;
-use glam::{DVec3, Vec3A};
+use glam::{DAffine3, DMat3, DVec3, Vec3A};
 use obvhs::BvhBuildParams;
 use obvhs::cwbvh::node::CwBvhNode;
 
 use crate::error::{Error, Result};
 use crate::scene::Scene;
-pub use crate::shared::{GpuTriangle, TRAVERSAL_STACK};
+pub use crate::shared::{GpuInstance, GpuTriangle, TRAVERSAL_STACK};
 
 /// The widest extent, in scene units from the camera, of a scene the BVH is built for. obvhs
 /// computes surface areas in f32, and past about 1e19 they overflow and its build panics
@@ -76,6 +76,12 @@ impl BvhQuality {
 const _: () = assert!(std::mem::size_of::<CwBvhNode>() == 80);
 
 /// A built BVH with its triangles in leaf order, ready to upload.
+///
+/// A flat scene has one BVH over its triangles, camera-relative. An instanced scene has two
+/// levels in the same buffers: a top-level BVH over instances (its nodes first, root 0), whose
+/// leaves name [`GpuInstance`]s, each pointing at the BVH of its mesh (nodes and triangles in
+/// mesh space, stored once however many instances use it); the scene's world triangles are one
+/// more instance, camera-relative under the identity.
 pub struct SceneBvh {
     /// CWBVH nodes (80 bytes each; WGSL reads each as five `vec4<u32>`). Never empty: an empty
     /// scene gets one node with no children, which every ray misses.
@@ -83,98 +89,301 @@ pub struct SceneBvh {
     /// Triangles in the order leaves reference them (a pre-split triangle appears more than
     /// once). Never empty (a zero triangle stands in for none).
     pub triangles: Vec<GpuTriangle>,
-    /// The world position subtracted from every vertex (the camera position).
+    /// Instances in the order the top level's leaves reference them; empty for a flat scene.
+    pub instances: Vec<GpuInstance>,
+    /// The world position subtracted from every world vertex (the camera position).
     pub origin: DVec3,
-    /// Deepest node (root = 1).
+    /// Deepest node (root = 1) of the deepest BVH (either level).
     pub depth: u32,
     /// Time obvhs spent building.
     pub build_time: Duration,
 }
 
+/// A mesh's BVH placed in the top level.
+struct Placed {
+    /// Mesh to world; `None` for the world's own triangles.
+    transform: Option<DAffine3>,
+    /// Its root node (before the top level's nodes are put first).
+    root: u32,
+    /// The scene triangle id of its first triangle.
+    id_base: u32,
+    /// Its first stored triangle.
+    first: u32,
+    /// Its world bounds.
+    bounds: (DVec3, DVec3),
+}
+
+/// One level's BVH as obvhs built it, with its triangles or instances in leaf order.
+struct Level<T> {
+    nodes: Vec<CwBvhNode>,
+    leaves: Vec<T>,
+    depth: u32,
+}
+
+/// `corners` rounded to f32 after subtracting `origin`, checked to be finite there; `first`
+/// numbers them in messages.
+fn rounded(corners: &[[DVec3; 3]], origin: DVec3, first: usize) -> Result<Vec<[Vec3A; 3]>> {
+    let rounded: Vec<[Vec3A; 3]> = corners
+        .iter()
+        .map(|t| t.map(|p| (p - origin).as_vec3().into()))
+        .collect();
+    // Finite in f64 is not enough: the GPU's f32 (and an acceleration structure, where a
+    // non-finite vertex is undefined behaviour) must hold every corner too.
+    if let Some(i) = rounded
+        .iter()
+        .position(|t| !t.iter().all(|p| p.is_finite()))
+    {
+        let show = |t: [DVec3; 3]| {
+            t.map(|p| format!("({:e}, {:e}, {:e})", p.x, p.y, p.z))
+                .join(", ")
+        };
+        let space = if origin == DVec3::ZERO {
+            "in its mesh's space".to_string()
+        } else {
+            format!(
+                "in the world, {} from the camera",
+                show(corners[i].map(|p| p - origin))
+            )
+        };
+        return Err(Error::Scene(format!(
+            "triangle {} lies beyond the f32 range the GPU computes in (magnitudes up to {:e}): \
+             its corners are {} {space}",
+            first + i,
+            f32::MAX,
+            show(corners[i]),
+        )));
+    }
+    check_extent(rounded.iter().flatten().copied())?;
+    Ok(rounded)
+}
+
+/// Refuses points farther than [`MAX_EXTENT`] from the origin, before obvhs would panic.
+fn check_extent(points: impl Iterator<Item = Vec3A>) -> Result<()> {
+    let extent = points.fold(0.0f32, |e, p| e.max(p.abs().max_element()));
+    if f64::from(extent) > MAX_EXTENT {
+        return Err(Error::Scene(format!(
+            "the scene reaches {extent:e} units from the camera; the BVH is built in f32 \
+             for scenes within {MAX_EXTENT:e}"
+        )));
+    }
+    Ok(())
+}
+
+/// Runs obvhs's `build`, adding its time to `build_time`, and checks the BVH's depth.
+fn build_level(
+    build: impl FnOnce(&mut Duration) -> obvhs::cwbvh::CwBvh,
+    build_time: &mut Duration,
+) -> Result<(Vec<CwBvhNode>, Vec<u32>, u32)> {
+    let started = Instant::now();
+    let mut core = Duration::ZERO;
+    let cwbvh = build(&mut core);
+    *build_time += started.elapsed();
+    let depth = node_depth(&cwbvh.nodes, 0);
+    if depth > TRAVERSAL_STACK {
+        return Err(Error::Limit(format!(
+            "the BVH is {depth} levels deep; the GPU traversal stack holds {TRAVERSAL_STACK}"
+        )));
+    }
+    Ok((cwbvh.nodes, cwbvh.primitive_indices, depth))
+}
+
+/// The BVH of stored triangles `first..first + corners.len()` (rounded as given).
+fn triangle_level(
+    scene: &Scene,
+    corners: &[[Vec3A; 3]],
+    first: usize,
+    quality: BvhQuality,
+    build_time: &mut Duration,
+) -> Result<Level<GpuTriangle>> {
+    let tris: Vec<obvhs::triangle::Triangle> = corners
+        .iter()
+        .map(|t| obvhs::triangle::Triangle {
+            v0: t[0],
+            v1: t[1],
+            v2: t[2],
+        })
+        .collect();
+    // From triangles, so that the slow preset's spatial pre-splits apply.
+    let (nodes, order, depth) = build_level(
+        |core| obvhs::cwbvh::builder::build_cwbvh_from_tris(&tris, quality.params(), core),
+        build_time,
+    )?;
+    let leaves = order
+        .iter()
+        .map(|&i| {
+            let t = &corners[i as usize];
+            let stored = first + i as usize;
+            GpuTriangle {
+                v0: t[0].into(),
+                triangle: stored as u32,
+                v1: t[1].into(),
+                material: scene.material_of[stored],
+                v2: t[2].into(),
+                pad: 0,
+            }
+        })
+        .collect();
+    Ok(Level {
+        nodes,
+        leaves,
+        depth,
+    })
+}
+
+/// Rows `[m | t]` of an affine map, rounded to f32.
+fn rows(m: DMat3, t: DVec3) -> [[f32; 4]; 3] {
+    let r = m.transpose();
+    [r.x_axis, r.y_axis, r.z_axis]
+        .map(|row| row.as_vec3())
+        .into_iter()
+        .zip(t.as_vec3().to_array())
+        .map(|(row, w)| [row.x, row.y, row.z, w])
+        .collect::<Vec<_>>()
+        .try_into()
+        .expect("three rows")
+}
+
+/// An instance placing the mesh whose BVH starts at node `root` by `transform` (world, not
+/// camera-relative), for a scene relative to `origin`.
+pub(crate) fn gpu_instance(
+    transform: DAffine3,
+    origin: DVec3,
+    root: u32,
+    id_base: u32,
+    first: u32,
+) -> GpuInstance {
+    let m = transform.matrix3;
+    let inverse = m.inverse();
+    let normal = rows(inverse.transpose(), DVec3::ZERO);
+    GpuInstance {
+        to_mesh: rows(inverse, inverse * (origin - transform.translation)),
+        to_world: rows(m, transform.translation - origin),
+        normal_x: [normal[0][0], normal[0][1], normal[0][2]],
+        root,
+        normal_y: [normal[1][0], normal[1][1], normal[1][2]],
+        id_base,
+        normal_z: [normal[2][0], normal[2][1], normal[2][2]],
+        first,
+    }
+}
+
 impl SceneBvh {
     /// Builds the BVH of `scene` relative to `origin`.
     pub fn build(scene: &Scene, origin: DVec3, quality: BvhQuality) -> Result<Self> {
-        let rounded: Vec<[Vec3A; 3]> = scene
-            .triangles
-            .iter()
-            .map(|t| t.map(|p| (p - origin).as_vec3().into()))
-            .collect();
-        // Finite in f64 is not enough: the GPU's f32 (and an acceleration structure, where a
-        // non-finite vertex is undefined behaviour) must hold every corner too.
-        if let Some(i) = rounded
-            .iter()
-            .position(|t| !t.iter().all(|p| p.is_finite()))
-        {
-            let corners = |t: [DVec3; 3]| {
-                t.map(|p| format!("({:e}, {:e}, {:e})", p.x, p.y, p.z))
-                    .join(", ")
-            };
-            return Err(Error::Scene(format!(
-                "triangle {i} lies beyond the f32 range the GPU computes in (magnitudes up to \
-                 {:e}): its corners are {} in the world, {} from the camera",
-                f32::MAX,
-                corners(scene.triangles[i]),
-                corners(scene.triangles[i].map(|p| p - origin))
-            )));
-        }
-        let extent = rounded
-            .iter()
-            .flatten()
-            .fold(0.0f32, |e, p| e.max(p.abs().max_element()));
-        if f64::from(extent) > MAX_EXTENT {
-            return Err(Error::Scene(format!(
-                "the scene reaches {extent:e} units from the camera; the BVH is built in f32 \
-                 for scenes within {MAX_EXTENT:e}"
-            )));
-        }
-        if rounded.is_empty() {
+        let world = rounded(&scene.triangles[..scene.world_triangles], origin, 0)?;
+        let mut build_time = Duration::ZERO;
+        if scene.is_empty() {
             return Ok(Self {
                 nodes: vec![CwBvhNode::default()],
                 triangles: vec![GpuTriangle::zeroed()],
+                instances: Vec::new(),
                 origin,
                 depth: 1,
-                build_time: Duration::ZERO,
+                build_time,
             });
         }
-        let tris: Vec<obvhs::triangle::Triangle> = rounded
+        if !scene.is_instanced() {
+            let level = triangle_level(scene, &world, 0, quality, &mut build_time)?;
+            return Ok(Self {
+                nodes: level.nodes,
+                triangles: level.leaves,
+                instances: Vec::new(),
+                origin,
+                depth: level.depth,
+                build_time,
+            });
+        }
+        // The bottom level: the world's triangles, then each mesh once.
+        let mut nodes = Vec::new();
+        let mut triangles = Vec::new();
+        let mut depth = 0;
+        let mut append = |level: Level<GpuTriangle>, nodes: &mut Vec<CwBvhNode>| {
+            let (node_base, slot_base) = (nodes.len() as u32, triangles.len() as u32);
+            nodes.extend(level.nodes.into_iter().map(|mut n| {
+                n.child_base_idx += node_base;
+                n.primitive_base_idx += slot_base;
+                n
+            }));
+            triangles.extend(level.leaves);
+            depth = depth.max(level.depth);
+            node_base
+        };
+        let mut placed: Vec<Placed> = Vec::new();
+        if let Some(bounds) = crate::scene::bounds(&scene.triangles[..scene.world_triangles]) {
+            let level = triangle_level(scene, &world, 0, quality, &mut build_time)?;
+            placed.push(Placed {
+                transform: None,
+                root: append(level, &mut nodes),
+                id_base: 0,
+                first: 0,
+                bounds,
+            });
+        }
+        let mut roots = std::collections::HashMap::new();
+        let mut id_base = scene.world_triangles as u32;
+        for instance in &scene.instances {
+            let base = id_base;
+            id_base += instance.count;
+            let Some(bounds) = scene.instance_bounds(instance) else {
+                continue;
+            };
+            let root = match roots.get(&instance.first) {
+                Some(&root) => root,
+                None => {
+                    let first = instance.first as usize;
+                    let mesh = &scene.triangles[first..first + instance.count as usize];
+                    let corners = rounded(mesh, DVec3::ZERO, first)?;
+                    let level = triangle_level(scene, &corners, first, quality, &mut build_time)?;
+                    let root = append(level, &mut nodes);
+                    roots.insert(instance.first, root);
+                    root
+                }
+            };
+            placed.push(Placed {
+                transform: Some(instance.transform),
+                root,
+                id_base: base,
+                first: instance.first,
+                bounds,
+            });
+        }
+        // The top level over the instances' boxes, camera-relative, padded for the roundings
+        // of the f32 transforms (a relative 1e-5 of the box's reach is hundreds of ulp).
+        let boxes: Vec<obvhs::aabb::Aabb> = placed
             .iter()
-            .map(|t| obvhs::triangle::Triangle {
-                v0: t[0],
-                v1: t[1],
-                v2: t[2],
-            })
-            .collect();
-        let started = Instant::now();
-        let mut core = Duration::ZERO;
-        let cwbvh =
-            obvhs::cwbvh::builder::build_cwbvh_from_tris(&tris, quality.params(), &mut core);
-        let build_time = started.elapsed();
-        let triangles = cwbvh
-            .primitive_indices
-            .iter()
-            .map(|&i| {
-                let t = &rounded[i as usize];
-                GpuTriangle {
-                    v0: t[0].into(),
-                    triangle: i,
-                    v1: t[1].into(),
-                    material: scene.material_of[i as usize],
-                    v2: t[2].into(),
-                    pad: 0,
+            .map(|p| {
+                let (lo, hi) = (p.bounds.0 - origin, p.bounds.1 - origin);
+                let pad = DVec3::splat(1e-5 * lo.abs().max(hi.abs()).max_element());
+                obvhs::aabb::Aabb {
+                    min: (lo - pad).as_vec3().into(),
+                    max: (hi + pad).as_vec3().into(),
                 }
             })
             .collect();
-        let depth = node_depth(&cwbvh.nodes, 0);
-        if depth > TRAVERSAL_STACK {
-            return Err(Error::Limit(format!(
-                "the BVH is {depth} levels deep; the GPU traversal stack holds {TRAVERSAL_STACK}"
-            )));
+        check_extent(boxes.iter().flat_map(|b| [b.min, b.max]))?;
+        let (mut top, order, top_depth) = build_level(
+            |core| obvhs::cwbvh::builder::build_cwbvh(&boxes, quality.params(), core),
+            &mut build_time,
+        )?;
+        let shift = top.len() as u32;
+        for n in &mut nodes {
+            n.child_base_idx += shift;
         }
+        top.extend(nodes);
+        let instances = order
+            .iter()
+            .map(|&i| {
+                let p = &placed[i as usize];
+                let transform = p.transform.unwrap_or(DAffine3::from_translation(origin));
+                gpu_instance(transform, origin, p.root + shift, p.id_base, p.first)
+            })
+            .collect();
         Ok(Self {
-            nodes: cwbvh.nodes,
+            nodes: top,
             triangles,
+            instances,
             origin,
-            depth,
+            depth: depth.max(top_depth),
             build_time,
         })
     }

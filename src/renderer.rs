@@ -271,6 +271,14 @@ impl Renderer {
             return Err(Error::Limits(short.join("; ")));
         }
         let ctx = GpuContext::from_device(device, queue);
+        let rasterizes = cube.is_some_and(|c| matches!(c.method, CubeMethod::Raster(_)));
+        let flat;
+        let scene = if rasterizes && scene.is_instanced() {
+            flat = scene.flattened(crate::scene::MAX_FLATTENED)?;
+            &flat
+        } else {
+            scene
+        };
         let gpu_scene = GpuScene::new(&ctx, scene, options)?;
         let rays = (options.directions, options.spp);
         let path = Path::new(&ctx, camera, &gpu_scene, rays, cube)?;

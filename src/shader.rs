@@ -8,7 +8,7 @@ use std::fmt::Write;
 use crate::shared::{wgsl_constants, wgsl_faces, wgsl_float_constants};
 
 /// Every WGSL file of the project, by name (its file stem under `wgsl/`).
-pub const FILES: [(&str, &str); 23] = [
+pub const FILES: [(&str, &str); 24] = [
     ("math", include_str!("../wgsl/math.wgsl")),
     ("calibrated", include_str!("../wgsl/calibrated.wgsl")),
     ("triangles", include_str!("../wgsl/triangles.wgsl")),
@@ -18,6 +18,7 @@ pub const FILES: [(&str, &str); 23] = [
     ("shade", include_str!("../wgsl/shade.wgsl")),
     ("trace", include_str!("../wgsl/trace.wgsl")),
     ("trace_rq", include_str!("../wgsl/trace_rq.wgsl")),
+    ("cast", include_str!("../wgsl/cast.wgsl")),
     ("lens", include_str!("../wgsl/lens.wgsl")),
     ("primary", include_str!("../wgsl/primary.wgsl")),
     ("lens_rays", include_str!("../wgsl/lens_rays.wgsl")),

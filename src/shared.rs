@@ -17,9 +17,9 @@ pub const WORKGROUP_1D: u32 = 64;
 pub const TRAVERSAL_STACK: u32 = 32;
 
 /// Storage buffers the trace kernel binds: the direction table and three outputs (group 0),
-/// and the scene's seven (group 1). wgpu's default limit is 8, so a device made for the tracer
+/// and the scene's eight (group 1). wgpu's default limit is 8, so a device made for the tracer
 /// must ask for more (`renderer::required_limits`).
-pub const TRACE_STORAGE_BUFFERS: u32 = 11;
+pub const TRACE_STORAGE_BUFFERS: u32 = 12;
 
 /// The most samples per pixel side (`RenderOptions::spp` is a square of at most this).
 pub const MAX_SAMPLES_PER_SIDE: u32 = 16;
@@ -373,7 +373,7 @@ pub struct Frame {
 #[repr(C)]
 #[derive(Clone, Copy, Debug, PartialEq, Pod, Zeroable)]
 pub struct GpuTriangle {
-    /// First corner, camera-relative.
+    /// First corner: camera-relative, or in its mesh's space (an instanced mesh's triangle).
     pub v0: [f32; 3],
     /// Index of the triangle in `Scene::triangles`.
     pub triangle: u32,
@@ -388,6 +388,47 @@ pub struct GpuTriangle {
 }
 
 const _: () = assert!(std::mem::size_of::<GpuTriangle>() == 48);
+
+/// A ray as `wgsl/cast.wgsl` reads it (32 bytes): origin relative to the scene's upload origin
+/// (`GpuScene::origin`), direction of any length (distances are measured along it), and the
+/// interval (tmin, tmax] searched.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, PartialEq, Pod, Zeroable)]
+pub struct CastRay {
+    /// Origin, relative to the scene's upload origin.
+    pub origin: [f32; 3],
+    /// Hits at t ≤ tmin do not count.
+    pub tmin: f32,
+    /// Direction.
+    pub dir: [f32; 3],
+    /// Hits beyond tmax do not count.
+    pub tmax: f32,
+}
+
+/// An instance as `wgsl/triangles.wgsl` reads it (144 bytes): a mesh's BVH and the affine
+/// maps between the camera-relative world and the mesh's space.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, PartialEq, Pod, Zeroable)]
+pub struct GpuInstance {
+    /// World (camera-relative) to mesh space: rows of the 3×3 part, translation in `w`.
+    pub to_mesh: [[f32; 4]; 3],
+    /// Mesh space to world (camera-relative), likewise.
+    pub to_world: [[f32; 4]; 3],
+    /// First row of the normal matrix (the inverse transpose of `to_world`'s 3×3 part).
+    pub normal_x: [f32; 3],
+    /// The node the mesh's BVH starts at.
+    pub root: u32,
+    /// Second row of the normal matrix.
+    pub normal_y: [f32; 3],
+    /// The scene triangle id of the mesh's first triangle in this instance.
+    pub id_base: u32,
+    /// Third row of the normal matrix.
+    pub normal_z: [f32; 3],
+    /// The mesh's first stored triangle (`Scene::triangles`).
+    pub first: u32,
+}
+
+const _: () = assert!(std::mem::size_of::<GpuInstance>() == 144);
 
 /// The lens as WGSL's `LensParams` reads it (96 bytes; `wgsl/lens.wgsl` mirrors it and a test
 /// checks the layouts agree). See the WGSL struct for the fields' meaning; the first eight
@@ -463,6 +504,32 @@ mod tests {
                 ("material", offset_of!(GpuTriangle, material)),
                 ("v2", offset_of!(GpuTriangle, v2)),
                 ("pad", offset_of!(GpuTriangle, pad)),
+            ],
+        );
+        assert_wgsl_layout(
+            "cast",
+            "CastRay",
+            size_of::<CastRay>(),
+            &[
+                ("origin", offset_of!(CastRay, origin)),
+                ("tmin", offset_of!(CastRay, tmin)),
+                ("dir", offset_of!(CastRay, dir)),
+                ("tmax", offset_of!(CastRay, tmax)),
+            ],
+        );
+        assert_wgsl_layout(
+            "triangles",
+            "Instance",
+            size_of::<GpuInstance>(),
+            &[
+                ("to_mesh", offset_of!(GpuInstance, to_mesh)),
+                ("to_world", offset_of!(GpuInstance, to_world)),
+                ("normal_x", offset_of!(GpuInstance, normal_x)),
+                ("root", offset_of!(GpuInstance, root)),
+                ("normal_y", offset_of!(GpuInstance, normal_y)),
+                ("id_base", offset_of!(GpuInstance, id_base)),
+                ("normal_z", offset_of!(GpuInstance, normal_z)),
+                ("first", offset_of!(GpuInstance, first)),
             ],
         );
         assert_wgsl_layout(

@@ -333,7 +333,7 @@ fn render_writes_a_masked_png_and_reports() {
         "adapter:",
         "triangles",
         "kernels compiled and first dispatch: ",
-        "bytes a triangle (geometry 48, BVH ",
+        "bytes a stored triangle (geometry 48, BVH ",
         "ms on the GPU (after compilation)",
         "primary rays",
         "wrote",
@@ -1307,4 +1307,42 @@ fn pixel_origin_opencv_shifts_by_half_a_pixel() {
         let lines: Vec<&str> = edge.lines().collect();
         assert!(lines[0] != "none" && lines[1] == "none", "{edge}");
     }
+}
+
+/// An instanced scene: `render` reports the scene's triangles, those stored and the instances;
+/// the rasterized cube map draws a flattened copy where one fits, and where it does not the
+/// error says why and which path draws instances.
+#[test]
+fn render_reports_instances_and_rasterizes_them_flattened() {
+    let dir = std::env::temp_dir().join(format!("fisheye-instances-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let out = dir.join("forest.png");
+    let args = [
+        "render",
+        "builtin:instances",
+        "--size",
+        "64x48",
+        "--spp",
+        "1",
+        "--out",
+        out.to_str().unwrap(),
+    ];
+    let text = stdout(&fisheye(&args, ""));
+    assert!(
+        text.contains("100000002 triangles (100002 stored, 1000 instances)"),
+        "{text}"
+    );
+    let mut raster = args.to_vec();
+    raster.extend(["--method", "cube-forward", "--cube-size", "32"]);
+    let output = fisheye(&raster, "");
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert!(
+        !output.status.success()
+            && stderr.contains("makes 100000002 triangles, more than the 50000000")
+            && stderr.contains("only the BVH traversal draws instances"),
+        "{stderr}"
+    );
+    raster[1] = "builtin:instances-few";
+    stdout(&fisheye(&raster, ""));
+    assert!(out.exists());
 }

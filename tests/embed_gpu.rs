@@ -212,7 +212,7 @@ fn a_device_below_the_required_limits_is_refused_naming_the_limit() {
         .expect("refused")
         .to_string();
     assert!(
-        message.contains("max_storage_buffers_per_shader_stage is 10, the renderer needs 11"),
+        message.contains("max_storage_buffers_per_shader_stage is 11, the renderer needs 12"),
         "{message}"
     );
 }

@@ -176,7 +176,8 @@ fn close(a: DVec3, b: DVec3) -> bool {
 
 /// A parent's TRS (translated, turned 90° about y) and a child's matrix (scaled by 2, moved 1
 /// along its parent's x) place a triangle where the transforms composed by hand do, in every
-/// container (embedded, external buffer with an escaped name, GLB).
+/// container (embedded, external buffer with an escaped name, GLB); both nodes use one mesh,
+/// so it is stored once and placed by two instances.
 #[test]
 fn node_transforms_compose_in_every_container() {
     let dir = temp_dir("hierarchy");
@@ -200,7 +201,11 @@ fn node_transforms_compose_in_every_container() {
         doc.write_glb(&dir, "binary", &[parent]),
     ] {
         let loaded = load_gltf(&path, None).unwrap_or_else(|e| panic!("{e}"));
-        let triangles = &loaded.scene.triangles;
+        // Two nodes use the mesh: it is stored once and placed twice.
+        assert_eq!(loaded.scene.triangles.len(), 1);
+        assert_eq!(loaded.scene.instances.len(), 2);
+        let flat = loaded.scene.flattened(usize::MAX).unwrap();
+        let triangles = &flat.triangles;
         assert_eq!(triangles.len(), 2, "{}", path.display());
         for (got, want) in triangles.iter().zip([expected_parent, expected_child]) {
             for (g, w) in got.iter().zip(want) {
@@ -485,6 +490,17 @@ fn bad_gltf_files_name_the_object() {
         "{\"asset\": {\"version\": \"2.0\"}, \"nodes\": [{\"mesh\": 4}]}",
     )
     .unwrap();
+    // Children shared between parents, 40 levels deep: 2^40 paths to the leaf, refused
+    // after a bounded walk instead of traversed.
+    let mut shared = Doc::default();
+    let positions = shared.positions(&TRIANGLE);
+    let mesh = shared.mesh(vec![json!({"attributes": {"POSITION": positions}})]);
+    let mut below = shared.node(json!({"mesh": mesh}));
+    for _ in 0..40 {
+        let beside = shared.node(json!({"children": [below], "mesh": mesh}));
+        below = shared.node(json!({"children": [beside, below]}));
+    }
+    let lattice = shared.write_glb(&dir, "lattice", &[below]);
     let truncated = dir.join("truncated.glb");
     let whole = std::fs::read(&out_of_range).unwrap();
     std::fs::write(&truncated, &whole[..whole.len() / 2]).unwrap();
@@ -499,6 +515,7 @@ fn bad_gltf_files_name_the_object() {
         (&base64, "not base64"),
         (&broken, "not valid glTF"),
         (&truncated, "not valid glTF"),
+        (&lattice, "children shared between parents"),
     ];
     for (path, wanted) in cases {
         let error = match load_gltf(path, None) {
@@ -621,4 +638,140 @@ fn a_gltf_twin_renders_the_triangles_its_obj_renders() {
     // lacks: at most 0.04 of a surface's irradiance, which the lamp makes about 1.2 on the
     // ceiling beside it (0.048 measured).
     assert!(worst < 0.055, "colours differ by {worst}");
+}
+
+/// Meshes that several nodes use are stored once and placed by instances, a mesh one node uses
+/// is placed in the world; the instanced scene renders as its flattened copy (the same scene
+/// triangle at every pixel off the ids' edges, colours as close as `tests/instancing_gpu.rs`
+/// holds them), on the GPU and in the reference, mirrored node included. Scene files instance
+/// entries that name the same file with the same material, and copy one with another
+/// material.
+#[test]
+fn shared_meshes_are_instanced() {
+    use fisheye_rt::scene::{Camera, Scene};
+    use fisheye_rt::trace::cpu::Reference;
+    let dir = temp_dir("instances");
+    let mut doc = Doc::default();
+    // A unit cube (12 triangles) and a floor square.
+    let corners: Vec<[f32; 3]> = (0..8)
+        .map(|k| [(k & 1) as f32, ((k >> 1) & 1) as f32, ((k >> 2) & 1) as f32])
+        .collect();
+    let cube_faces: [u32; 36] = [
+        0, 2, 1, 1, 2, 3, 4, 5, 6, 5, 7, 6, 0, 1, 4, 1, 5, 4, 2, 6, 3, 3, 6, 7, 0, 4, 2, 2, 4, 6,
+        1, 3, 5, 3, 7, 5,
+    ];
+    let positions = doc.positions(&corners);
+    let indices = doc.indices(&cube_faces, 5123);
+    doc.materials.push(json!({"pbrMetallicRoughness":
+        {"baseColorFactor": [0.8, 0.3, 0.2, 1.0], "metallicFactor": 0.0, "roughnessFactor": 1.0}}));
+    let cube = doc.mesh(vec![
+        json!({"attributes": {"POSITION": positions}, "indices": indices,
+        "material": 0}),
+    ]);
+    let floor_positions = doc.positions(&[
+        [-6.0, 0.0, -12.0],
+        [6.0, 0.0, -12.0],
+        [6.0, 0.0, 2.0],
+        [-6.0, 0.0, 2.0],
+    ]);
+    let floor_indices = doc.indices(&[0, 2, 1, 0, 3, 2], 5121);
+    let floor = doc.mesh(vec![json!({"attributes": {"POSITION": floor_positions},
+        "indices": floor_indices})]);
+    let mut roots = vec![doc.node(json!({"mesh": floor}))];
+    for (t, extra) in [
+        ([-2.0, 0.0, -4.0], json!({})),
+        (
+            [0.5, 0.0, -5.0],
+            json!({"rotation": [0.0, 0.38268343, 0.0, 0.9238795]}),
+        ),
+        ([2.5, 0.0, -4.0], json!({"scale": [-1.0, 1.5, 1.0]})),
+    ] {
+        let mut node = json!({"mesh": cube, "translation": t});
+        for (k, v) in extra.as_object().unwrap() {
+            node[k] = v.clone();
+        }
+        roots.push(doc.node(node));
+    }
+    let path = doc.write_glb(&dir, "cubes", &roots);
+    let mut scene = load_gltf(&path, None)
+        .unwrap_or_else(|e| panic!("{e}"))
+        .scene;
+    assert_eq!((scene.world_triangles, scene.triangles.len()), (2, 14));
+    assert_eq!(scene.instances.len(), 3);
+    assert_eq!(scene.len(), 2 + 3 * 12);
+    scene.set_camera(Camera {
+        position: DVec3::new(0.0, 2.5, 3.0),
+        look_at: DVec3::new(0.0, 0.5, -4.0),
+        up: DVec3::Y,
+    });
+    let flat = scene.flattened(usize::MAX).unwrap();
+    let cam = common::camera("equidistant:f=0.5,fov=180", 128, 96);
+    let pixels = 128 * 96;
+    let gpu = |s: &Scene| render(common::ctx(), s, &cam, &RenderOptions::default()).unwrap();
+    let cpu = |s: &Scene| Reference::new(s, 5).render(&cam);
+    for (what, a, b) in [
+        ("GPU", gpu(&scene), gpu(&flat)),
+        ("reference", cpu(&scene), cpu(&flat)),
+    ] {
+        common::assert_agrees(what, &a, &b, common::real_scene(pixels));
+        for k in 0..3 {
+            let ids = 2 + 12 * k..2 + 12 * (k + 1);
+            assert!(a.ids.iter().any(|id| ids.contains(id)), "{what}: cube {k}");
+        }
+    }
+
+    // A scene file: the same glTF twice, and once with a material of its own.
+    let file = dir.join("scene.toml");
+    std::fs::write(
+        &file,
+        "[[mesh]]\npath = \"cubes.glb\"\n\n[[mesh]]\npath = \"cubes.glb\"\n\
+         translation = [0.0, 0.0, -20.0]\n\n\
+         [[mesh]]\npath = \"cubes.glb\"\ntranslation = [0.0, 0.0, 20.0]\n\
+         material = { diffuse = [0.1, 0.1, 0.9] }\n\n[[light]]\ntype = \"sun\"\n\
+         direction = [0.0, -1.0, 0.0]\nirradiance = [1.0, 1.0, 1.0]\n",
+    )
+    .unwrap();
+    let loaded = fisheye_rt::scene::load(file.to_str().unwrap()).unwrap_or_else(|e| panic!("{e}"));
+    let s = &loaded.scene;
+    // The glTF's own cubes are instanced, so each entry loads it again: its floor is copied
+    // into the world three times, its cube stored three times and placed nine times.
+    assert_eq!(
+        (s.world_triangles, s.triangles.len(), s.instances.len()),
+        (6, 42, 9)
+    );
+    assert_eq!(s.len(), 3 * (2 + 3 * 12));
+    let placed = s.flattened(usize::MAX).unwrap();
+    let lowest = |k: usize| {
+        placed.triangles[k]
+            .iter()
+            .fold(f64::INFINITY, |z, p| z.min(p.z))
+    };
+    // The floors (the world's triangles, first) moved by their entries' translations.
+    for (k, z) in [(0, -12.0), (2, -32.0), (4, 8.0)] {
+        assert!((lowest(k) - z).abs() < 1e-9, "floor {k}: {}", lowest(k));
+    }
+
+    // The same OBJ twice is one mesh placed twice; with another material, a copy.
+    let obj = dir.join("tri.obj");
+    std::fs::write(&obj, "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n").unwrap();
+    std::fs::write(
+        &file,
+        "[[mesh]]\npath = \"tri.obj\"\n\n[[mesh]]\npath = \"tri.obj\"\n\
+         translation = [2.0, 0.0, 0.0]\n\n[[mesh]]\npath = \"tri.obj\"\n\
+         material = { diffuse = [0.1, 0.1, 0.9] }\n\n[[light]]\ntype = \"sun\"\n\
+         direction = [0.0, -1.0, 0.0]\nirradiance = [1.0, 1.0, 1.0]\n",
+    )
+    .unwrap();
+    let s = fisheye_rt::scene::load(file.to_str().unwrap())
+        .unwrap_or_else(|e| panic!("{e}"))
+        .scene;
+    assert_eq!(
+        (s.world_triangles, s.triangles.len(), s.instances.len()),
+        (1, 2, 2)
+    );
+    let flat = s.flattened(usize::MAX).unwrap();
+    // Ids: the copy (world) first, then the instances in entry order.
+    assert!(close(flat.triangles[0][1], DVec3::X));
+    assert!(close(flat.triangles[1][1], DVec3::X));
+    assert!(close(flat.triangles[2][1], DVec3::new(3.0, 0.0, 0.0)));
 }

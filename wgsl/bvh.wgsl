@@ -135,55 +135,115 @@ fn safe_inverse(d: vec3<f32>) -> vec3<f32> {
     return 1.0 / select(d, select(tiny, -tiny, d < vec3<f32>(0.0)), abs(d) < tiny);
 }
 
-// The closest hit (any_hit = false), or any hit (true, for shadow rays), in (tmin, tmax).
-fn bvh_trace(ray: Ray, any_hit: bool) -> Hit {
-    var hit = Hit(ray.tmax, 0.0, 0.0, NO_HIT);
+// obvhs's octant code of a direction: 7 minus its octant, the traversal order's key.
+fn octant_inverse(dir: vec3<f32>) -> u32 {
+    return select(4u, 0u, dir.x < 0.0) | select(2u, 0u, dir.y < 0.0) | select(1u, 0u, dir.z < 0.0);
+}
+
+// A walk down one BVH: the node group being expanded (child base; hit mask in the top byte,
+// imask in the low byte), the leaf group to test (first slot, primitive mask), and the node
+// groups left for later.
+struct Walk {
+    nodes: vec2<u32>,
+    leaves: vec2<u32>,
+    depth: u32,
+    stack: array<vec2<u32>, TRAVERSAL_STACK>,
+}
+
+fn walk_from(root: u32) -> Walk {
+    var w: Walk;
+    w.nodes = vec2<u32>(root, 0x80000000u);
+    w.leaves = vec2<u32>(0u);
+    w.depth = 0u;
+    return w;
+}
+
+// Walks on, nearest child first, until `leaves` holds primitives (true) or no node is left
+// (false). Children farther than `tmax` are culled.
+fn walk_next(w: ptr<function, Walk>, ray: Ray, inv_dir: vec3<f32>, oct_inv: u32, tmax: f32) -> bool {
+    var found = false;
+    loop {
+        if ((*w).nodes.y & 0xff000000u) == 0u {
+            if (*w).depth == 0u {
+                break;
+            }
+            (*w).depth -= 1u;
+            (*w).nodes = (*w).stack[(*w).depth];
+            continue;
+        }
+        let hits_imask = (*w).nodes.y;
+        let bit = firstLeadingBit(hits_imask);
+        (*w).nodes.y = hits_imask & ~(1u << bit);
+        if ((*w).nodes.y & 0xff000000u) != 0u {
+            (*w).stack[(*w).depth] = (*w).nodes;
+            (*w).depth += 1u;
+        }
+        let slot = (bit - 24u) ^ oct_inv;
+        let index = (*w).nodes.x + countOneBits(hits_imask & ~(0xffffffffu << slot));
+        let mask = node_hits(index, ray, inv_dir, oct_inv, tmax);
+        let header = bvh_nodes[5u * index + 1u];
+        (*w).nodes = vec2<u32>(header.x, (mask & 0xff000000u) | (bvh_nodes[5u * index].w >> 24u));
+        (*w).leaves = vec2<u32>(header.y, mask & 0x00ffffffu);
+        if (*w).leaves.y != 0u {
+            found = true;
+            break;
+        }
+    }
+    return found;
+}
+
+// The closest hit (any_hit = false), or any hit (true), in the triangle BVH from node `root`,
+// if better than `best`; hits are tagged with `instance` (the ray is in its mesh's space).
+fn mesh_trace(root: u32, ray: Ray, any_hit: bool, best: Hit, instance: u32) -> Hit {
+    var hit = best;
     let inv_dir = safe_inverse(ray.dir);
     let sh = ray_shear(ray.dir);
-    // obvhs's octant code: 7 minus the octant, the traversal order's key.
-    let oct_inv = select(4u, 0u, ray.dir.x < 0.0) | select(2u, 0u, ray.dir.y < 0.0)
-        | select(1u, 0u, ray.dir.z < 0.0);
-    var stack: array<vec2<u32>, TRAVERSAL_STACK>;
-    var depth = 0u;
-    var nodes = vec2<u32>(0u, 0x80000000u);
-    var triangles = vec2<u32>(0u, 0u);
-    loop {
-        if (nodes.y & 0xff000000u) != 0u {
-            let hits_imask = nodes.y;
-            let bit = firstLeadingBit(hits_imask);
-            nodes.y &= ~(1u << bit);
-            if (nodes.y & 0xff000000u) != 0u {
-                stack[depth] = nodes;
-                depth += 1u;
-            }
-            let slot = (bit - 24u) ^ oct_inv;
-            let index = nodes.x + countOneBits(hits_imask & ~(0xffffffffu << slot));
-            let mask = node_hits(index, ray, inv_dir, oct_inv, hit.t);
-            let header = bvh_nodes[5u * index + 1u];
-            nodes = vec2<u32>(header.x, (mask & 0xff000000u) | (bvh_nodes[5u * index].w >> 24u));
-            triangles = vec2<u32>(header.y, mask & 0x00ffffffu);
-        }
-        while triangles.y != 0u {
-            let bit = firstTrailingBit(triangles.y);
-            triangles.y &= triangles.y - 1u;
-            let slot = triangles.x + bit;
+    let oct_inv = octant_inverse(ray.dir);
+    var w = walk_from(root);
+    while walk_next(&w, ray, inv_dir, oct_inv, hit.t) {
+        while w.leaves.y != 0u {
+            let bit = firstTrailingBit(w.leaves.y);
+            w.leaves.y &= w.leaves.y - 1u;
+            let slot = w.leaves.x + bit;
             let h = triangle_hit(slot, Ray(ray.origin, ray.dir, ray.tmin, hit.t), sh);
             // Exact ties (duplicated or coplanar overlapping triangles) go to the lower scene
             // triangle, so the result does not depend on the BVH; the reference does the same.
             if h.w != 0.0 && (h.x < hit.t || (hit.slot != NO_HIT && h.x == hit.t
-                && bvh_triangles[slot].triangle < bvh_triangles[hit.slot].triangle)) {
-                hit = Hit(h.x, h.y, h.z, slot);
+                && scene_triangle(slot, instance) < scene_triangle(hit.slot, hit.instance))) {
+                hit = Hit(h.x, h.y, h.z, slot, instance);
                 if any_hit {
                     return hit;
                 }
             }
         }
-        if (nodes.y & 0xff000000u) == 0u {
-            if depth == 0u {
-                break;
+    }
+    return hit;
+}
+
+// The closest hit (any_hit = false), or any hit (true, for shadow rays), in (tmin, tmax].
+// An instanced scene walks the top level over instances and, at each instance it reaches,
+// its mesh's BVH with the ray mapped into the mesh's space: the direction is mapped without
+// normalizing, so distances along it are the world's.
+fn bvh_trace(ray: Ray, any_hit: bool) -> Hit {
+    let none = Hit(ray.tmax, 0.0, 0.0, NO_HIT, 0u);
+    if !INSTANCED {
+        return mesh_trace(0u, ray, any_hit, none, 0u);
+    }
+    var hit = none;
+    let inv_dir = safe_inverse(ray.dir);
+    let oct_inv = octant_inverse(ray.dir);
+    var w = walk_from(0u);
+    while walk_next(&w, ray, inv_dir, oct_inv, hit.t) {
+        while w.leaves.y != 0u {
+            let bit = firstTrailingBit(w.leaves.y);
+            w.leaves.y &= w.leaves.y - 1u;
+            let k = w.leaves.x + bit;
+            let to_mesh = instances[k].to_mesh;
+            let local = Ray(affine(to_mesh, ray.origin), linear(to_mesh, ray.dir), ray.tmin, hit.t);
+            hit = mesh_trace(instances[k].root, local, any_hit, hit, k);
+            if any_hit && hit.slot != NO_HIT {
+                return hit;
             }
-            depth -= 1u;
-            nodes = stack[depth];
         }
     }
     return hit;

@@ -20,7 +20,7 @@ fn bvh_trace(ray: Ray, any_hit: bool) -> Hit {
     }
     let hit = rayQueryGetCommittedIntersection(&query);
     if hit.kind != RAY_QUERY_INTERSECTION_TRIANGLE {
-        return Hit(0.0, 0.0, 0.0, NO_HIT);
+        return Hit(0.0, 0.0, 0.0, NO_HIT, 0u);
     }
-    return Hit(hit.t, hit.barycentrics.x, hit.barycentrics.y, hit.primitive_index);
+    return Hit(hit.t, hit.barycentrics.x, hit.barycentrics.y, hit.primitive_index, 0u);
 }

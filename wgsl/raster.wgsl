@@ -115,7 +115,7 @@ fn shadow_visibility(light: Light, s: Surface, to_light: vec3<f32>) -> f32 {
 // The radiance the eye sees at the barycentrics `bary` of BVH slot `slot`, at `world`.
 fn raster_shade(slot: u32, bary: vec2<f32>, world: vec3<f32>) -> vec3<f32> {
     let dir = normalize(world - views.eye.xyz);
-    let s = surface_at(Ray(views.eye.xyz, dir, 0.0, 3.0e38), Hit(0.0, bary.x, bary.y, slot));
+    let s = surface_at(Ray(views.eye.xyz, dir, 0.0, 3.0e38), Hit(0.0, bary.x, bary.y, slot, 0u));
     var colour = s.material.emission;
     if HAS_MIRRORS && s.material.surface == SURFACE_MIRROR {
         return colour + s.material.specular * shading.sky;
@@ -160,7 +160,7 @@ fn deferred_lighting(@builtin(global_invocation_id) id: vec3<u32>) {
     let g = textureLoad(gbuffer, id.xy, id.z, 0);
     var colour = shading.sky;
     if g.x != 0u {
-        let hit = Hit(0.0, bitcast<f32>(g.y), bitcast<f32>(g.z), g.x - 1u);
+        let hit = Hit(0.0, bitcast<f32>(g.y), bitcast<f32>(g.z), g.x - 1u, 0u);
         colour = raster_shade(hit.slot, vec2<f32>(hit.u, hit.v), hit_position(hit));
     }
     textureStore(cube_out, id.xy, id.z, vec4<f32>(colour, 1.0));

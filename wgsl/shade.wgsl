@@ -50,7 +50,7 @@ fn shadow_transmittance(origin: vec3<f32>, to_light: vec3<f32>, distance: f32) -
         if m.surface != SURFACE_DIFFUSE || transmittance < MIN_WEIGHT || layer == MAX_SHADOW_LAYERS {
             return 0.0;
         }
-        let n = normalize(cross(tri.v1 - tri.v0, tri.v2 - tri.v0));
+        let n = hit_face_normal(hit);
         o = offset_origin(hit_position(hit), select(-n, n, dot(n, to_light) > 0.0));
         remaining -= hit.t;
     }
@@ -95,7 +95,7 @@ struct Traced {
 // A primary ray's closest hit and its surface, unshaded (colour zero): the ground truth at a
 // pixel's centre when its colour comes from several samples.
 fn first_hit(primary: Ray) -> Traced {
-    var out = Traced(vec3<f32>(0.0), Hit(0.0, 0.0, 0.0, NO_HIT), vec3<f32>(0.0), NO_HIT);
+    var out = Traced(vec3<f32>(0.0), Hit(0.0, 0.0, 0.0, NO_HIT, 0u), vec3<f32>(0.0), NO_HIT);
     let hit = bvh_trace(primary, false);
     if hit.slot != NO_HIT {
         let s = surface_at(primary, hit);
@@ -109,7 +109,7 @@ fn first_hit(primary: Ray) -> Traced {
 // Whitted's recursion as a loop over a stack of pending rays (depth-first; a binary tree of
 // depth MAX_DEPTH_LIMIT needs one more entry than its depth).
 fn shade(primary: Ray) -> Traced {
-    var out = Traced(vec3<f32>(0.0), Hit(0.0, 0.0, 0.0, NO_HIT), vec3<f32>(0.0), NO_HIT);
+    var out = Traced(vec3<f32>(0.0), Hit(0.0, 0.0, 0.0, NO_HIT, 0u), vec3<f32>(0.0), NO_HIT);
     var stack: array<Pending, MAX_DEPTH_LIMIT + 1u>;
     stack[0] = Pending(primary.origin, 0u, primary.dir, vec3<f32>(1.0));
     var count = 1u;

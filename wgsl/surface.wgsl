@@ -94,16 +94,24 @@ struct Surface {
     // Whether the ray hit the triangle's front (counter-clockwise) side.
     front: bool,
     material: Material,
+    // The scene triangle (as ids name it).
     triangle: u32,
+}
+
+// A vertex normal of the hit's triangle in the world, unit length.
+fn vertex_normal(hit: Hit, n: vec3<f32>) -> vec3<f32> {
+    if INSTANCED {
+        return normalize(world_normal(hit, n));
+    }
+    return n;
 }
 
 fn surface_at(ray: Ray, hit: Hit) -> Surface {
     let tri = bvh_triangles[hit.slot];
-    let triangle = tri.triangle;
     var material = materials[tri.material];
     let w = 1.0 - hit.u - hit.v;
     let position = hit_position(hit);
-    var geometric = normalize(cross(tri.v1 - tri.v0, tri.v2 - tri.v0));
+    var geometric = normalize(hit_face_normal(hit));
     let front = dot(geometric, ray.dir) < 0.0;
     if !front {
         geometric = -geometric;
@@ -116,10 +124,12 @@ fn surface_at(ray: Ray, hit: Hit) -> Surface {
     if HAS_TEXTURES {
         stride += 2u;
     }
-    let base = triangle * stride;
+    let base = tri.triangle * stride;
     if SMOOTH_NORMALS {
-        let n = normalize(w * vertex_data[base].xyz + hit.u * vertex_data[base + 1u].xyz
-            + hit.v * vertex_data[base + 2u].xyz);
+        // Each vertex normal in the world before interpolation, as a flattened copy has it.
+        let n = normalize(w * vertex_normal(hit, vertex_data[base].xyz)
+            + hit.u * vertex_normal(hit, vertex_data[base + 1u].xyz)
+            + hit.v * vertex_normal(hit, vertex_data[base + 2u].xyz));
         // Keep the interpolated normal on the side the ray came from.
         normal = select(-n, n, dot(n, geometric) >= 0.0);
     }
@@ -133,7 +143,7 @@ fn surface_at(ray: Ray, hit: Hit) -> Surface {
         let uv = w * a.xy + hit.u * a.zw + hit.v * b.xy;
         material.diffuse *= sample_texture(material.texture, uv);
     }
-    return Surface(position, geometric, normal, front, material, triangle);
+    return Surface(position, geometric, normal, front, material, scene_triangle(hit.slot, hit.instance));
 }
 
 // A light as it arrives at a point: the unit vector towards it, its distance (3e38 for a

@@ -180,6 +180,13 @@ impl RasterFaces {
         shadow_size: u32,
         cube: &wgpu::Texture,
     ) -> Result<Self> {
+        if scene.features.instanced {
+            return Err(Error::Scene(
+                "the rasterizer draws flat scenes: upload a flattened copy \
+                 (`Scene::flattened`) for it"
+                    .into(),
+            ));
+        }
         let mut multiview_mask = None;
         if method == RasterMethod::SinglePass {
             if !ctx.has(wgpu::Features::MULTIVIEW) {

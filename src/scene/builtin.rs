@@ -6,7 +6,7 @@ use super::mesh::checker;
 use super::{Camera, Light, Material, MeshBuilder, Scene};
 
 /// The names `builtin:NAME` accepts, with what each shows.
-pub const SCENES: [(&str, &str); 4] = [
+pub const SCENES: [(&str, &str); 6] = [
     (
         "default",
         "a room with checker floor and grid walls, a mirror and a glass sphere, shadows and many small objects",
@@ -23,6 +23,14 @@ pub const SCENES: [(&str, &str); 4] = [
         "few-detailed",
         "three tori of 200,000 triangles each (ray tracing's hard case)",
     ),
+    (
+        "instances",
+        "1,000 instances of one 100,000-triangle torus on a plane: 100M triangles, 100k stored",
+    ),
+    (
+        "instances-few",
+        "the first 20 of those instances (2M triangles), small enough to flatten for comparison",
+    ),
 ];
 
 /// The built-in scene called `name`, or `None`.
@@ -32,6 +40,8 @@ pub fn scene(name: &str) -> Option<Scene> {
         "grid" => Some(grid()),
         "many-small" => Some(many_small()),
         "few-detailed" => Some(few_detailed()),
+        "instances" => Some(instances(1000)),
+        "instances-few" => Some(instances(20)),
         _ => None,
     }
 }
@@ -389,6 +399,55 @@ fn few_detailed() -> Scene {
     scene
 }
 
+/// `count` instances of one 100,000-triangle torus standing on a plane, in rows of 40 across
+/// a field 80 m wide, each turned, scaled and coloured by its own hash (the mesh has one
+/// material, so colour comes from the scale's spread under the sun).
+fn instances(count: u64) -> Scene {
+    let mut b = MeshBuilder::new();
+    let ground = b.material(Material::diffuse("ground", Vec3::new(0.45, 0.5, 0.4)));
+    b.quad(
+        DVec3::new(-40.0, 0.0, -60.0),
+        DVec3::Z * 62.0,
+        DVec3::X * 80.0,
+        Vec2::ONE,
+        ground,
+    );
+    let m = b.material(Material {
+        specular: Vec3::splat(0.4),
+        shininess: 40.0,
+        ..Material::diffuse("torus", colour(300))
+    });
+    let first = b.len();
+    // 250 × 200 × 2 = 100,000 triangles, around the y axis, outer radius 0.85.
+    b.torus(DVec3::ZERO, 0.6, 0.25, 250, 200, m);
+    let mesh = b.mesh_since(first);
+    for k in 0..count {
+        let (row, column) = ((k / 40) as f64, (k % 40) as f64);
+        let scale = 0.7 + 0.6 * unit(k, 1);
+        let at = DVec3::new(
+            2.0 * column - 39.0 + 0.6 * unit(k, 2),
+            0.85 * scale,
+            -3.0 - 2.2 * row - 0.6 * unit(k, 3),
+        );
+        // Stood up on its rim, then turned about the vertical.
+        let rotation = glam::DQuat::from_rotation_y(std::f64::consts::TAU * unit(k, 4))
+            * glam::DQuat::from_rotation_x(std::f64::consts::FRAC_PI_2);
+        let placed = b.place(
+            mesh,
+            glam::DAffine3::from_scale_rotation_translation(DVec3::splat(scale), rotation, at),
+        );
+        debug_assert!(placed);
+    }
+    let mut scene = outdoors(b, DVec3::new(0.0, 3.0, 1.5), DVec3::new(0.0, 0.8, -12.0));
+    // Over the field, above the tori (at most 2.2 high), then looking along a row.
+    scene.camera_path = walk(&[
+        ([0.0, 3.0, 1.5], [0.0, 0.8, -12.0]),
+        ([0.0, 3.0, -20.0], [0.0, 0.8, -34.0]),
+        ([-8.0, 3.0, -24.0], [12.0, 0.8, -24.0]),
+    ]);
+    scene
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -398,7 +457,7 @@ mod tests {
         for (name, _) in SCENES {
             let s = scene(name).unwrap();
             assert!(!s.is_empty(), "{name}");
-            assert_eq!(s.material_of.len(), s.len());
+            assert_eq!(s.material_of.len(), s.triangles.len());
             assert!(
                 s.material_of
                     .iter()
@@ -409,6 +468,13 @@ mod tests {
         }
         assert!(scene("many-small").unwrap().len() >= 4000 * 12);
         assert!(scene("few-detailed").unwrap().len() >= 3 * 200_000);
+        // As documented: 100M scene triangles, 100k stored (plus the ground's two).
+        let forest = scene("instances").unwrap();
+        assert_eq!(
+            (forest.len(), forest.triangles.len()),
+            (100_000_002, 100_002)
+        );
+        assert_eq!(scene("instances-few").unwrap().len(), 2_000_002);
         let room = scene("default").unwrap().features();
         assert!(room.mirrors && room.glass && room.textures && room.smooth_normals);
         assert!(scene("no-such").is_none());

@@ -23,6 +23,8 @@
 //! rotation = [0.0, 90.0, 0.0]     # degrees about x, then y, then z
 //! translation = [0.0, 0.0, 0.0]
 //! material = { diffuse = [0.8, 0.8, 0.8] }   # replaces every material of this mesh
+//!                                 # (entries naming the same file or shape with the same
+//!                                 # material are one mesh, stored once and placed by each)
 //!
 //! [[material]]                    # overrides the fields it names in materials of that name
 //! name = "light"
@@ -42,7 +44,7 @@ use serde::Deserialize;
 use super::obj::{
     DEFAULT_AMBIENT, DEFAULT_DISTANCE, DEFAULT_SKY, Loaded, because, framing, load_into,
 };
-use super::{Camera, Light, Material, MeshBuilder, ReadFile, Surface};
+use super::{Camera, Light, Material, MeshBuilder, MeshId, ReadFile, Surface};
 use crate::error::{Error, Result};
 use crate::input::InputKind;
 
@@ -84,7 +86,7 @@ struct Keyframe {
     look_at: Triple,
 }
 
-#[derive(Deserialize, Clone, Copy)]
+#[derive(Deserialize, Clone, Copy, PartialEq)]
 #[serde(rename_all = "lowercase")]
 enum Shape {
     Box,
@@ -118,7 +120,7 @@ struct MeshSpec {
     material: Option<MaterialSpec>,
 }
 
-#[derive(Deserialize, Clone, Copy)]
+#[derive(Deserialize, Clone, Copy, PartialEq)]
 #[serde(rename_all = "lowercase")]
 enum SurfaceSpec {
     Diffuse,
@@ -126,7 +128,7 @@ enum SurfaceSpec {
     Glass,
 }
 
-#[derive(Deserialize, Clone, Default)]
+#[derive(Deserialize, Clone, Default, PartialEq)]
 #[serde(deny_unknown_fields)]
 struct MaterialSpec {
     name: Option<String>,
@@ -266,6 +268,56 @@ impl Check<'_> {
     }
 }
 
+/// Loads the triangles of one `[[mesh]]` entry into `b`, in its own space, with its material
+/// override.
+fn load_mesh(
+    check: &Check,
+    what: &str,
+    mesh: &MeshSpec,
+    dir: &Path,
+    read: ReadFile,
+    b: &mut MeshBuilder,
+    warnings: &mut Vec<String>,
+) -> Result<()> {
+    let first = b.len();
+    match (&mesh.path, mesh.shape) {
+        (Some(file), None) => {
+            let file = dir.join(file);
+            let gltf = file
+                .extension()
+                .and_then(|e| e.to_str())
+                .is_some_and(|e| e.eq_ignore_ascii_case("gltf") || e.eq_ignore_ascii_case("glb"));
+            if gltf {
+                let content = super::gltf::load_into(&file, read, None, b, warnings)?;
+                if !content.lights.is_empty() || !content.cameras.is_empty() {
+                    warnings.push(format!(
+                        "{}: its lights and cameras are not used in a scene file (give \
+                         [[light]] and [camera])",
+                        file.display()
+                    ));
+                }
+            } else {
+                load_into(&file, read, b, warnings)?;
+            }
+        }
+        (None, Some(shape)) => {
+            let grey = b.material(Material::diffuse(what, Vec3::splat(0.8)));
+            match shape {
+                Shape::Box => b.cuboid(DVec3::splat(-0.5), DVec3::splat(0.5), grey),
+                Shape::Sphere => b.sphere(DVec3::ZERO, 1.0, 64, 32, false, grey),
+            }
+        }
+        _ => return check.fail(format!("{what}: give exactly one of path and shape")),
+    }
+    if let Some(spec) = &mesh.material {
+        let mut m = Material::diffuse(what, Vec3::splat(0.8));
+        check.apply(&format!("{what}.material"), spec, &mut m)?;
+        let id = b.material(m);
+        b.set_material_since(first, id);
+    }
+    Ok(())
+}
+
 /// Loads a scene file: its meshes (OBJ files loaded with their MTL, or shapes), material
 /// overrides, lights, sky and camera. Problems that do not stop the load come back as warnings.
 pub fn load_scene_file(path: &Path) -> Result<Loaded> {
@@ -296,47 +348,36 @@ pub fn load_scene_file_from(path: &Path, read: ReadFile) -> Result<Loaded> {
     if file.meshes.is_empty() {
         return check.fail("no [[mesh]]: a scene needs at least one".into());
     }
+    // Entries that name the same file or shape with the same material are one mesh, stored
+    // once and placed by each (a file whose own meshes are instanced is loaded for each).
+    let same = |a: &MeshSpec, b: &MeshSpec| {
+        a.path == b.path && a.shape == b.shape && a.material == b.material
+    };
+    let mut shared: Vec<Option<MeshId>> = vec![None; file.meshes.len()];
     for (i, mesh) in file.meshes.iter().enumerate() {
         let what = format!("mesh {}", i + 1);
         let transform = check.transform(&what, mesh)?;
-        let first = b.len();
-        match (&mesh.path, mesh.shape) {
-            (Some(file), None) => {
-                let file = dir.join(file);
-                let gltf = file.extension().and_then(|e| e.to_str()).is_some_and(|e| {
-                    e.eq_ignore_ascii_case("gltf") || e.eq_ignore_ascii_case("glb")
-                });
-                if gltf {
-                    let content = super::gltf::load_into(&file, read, None, &mut b, &mut warnings)?;
-                    if !content.lights.is_empty() || !content.cameras.is_empty() {
-                        warnings.push(format!(
-                            "{}: its lights and cameras are not used in a scene file (give \
-                             [[light]] and [camera])",
-                            file.display()
-                        ));
-                    }
-                } else {
-                    load_into(&file, read, &mut b, &mut warnings)?;
-                }
+        let kind = file.meshes.iter().position(|m| same(m, mesh)).unwrap_or(i);
+        if let Some(id) = shared[kind] {
+            if !b.place(id, transform) {
+                return check.fail(format!("{what}: its transform flattens the mesh"));
             }
-            (None, Some(shape)) => {
-                let grey = b.material(Material::diffuse(&what, Vec3::splat(0.8)));
-                match shape {
-                    Shape::Box => b.cuboid(DVec3::splat(-0.5), DVec3::splat(0.5), grey),
-                    Shape::Sphere => b.sphere(DVec3::ZERO, 1.0, 64, 32, false, grey),
-                }
-            }
-            _ => return check.fail(format!("{what}: give exactly one of path and shape")),
+            continue;
         }
+        let (first, placed) = (b.len(), b.placed_count());
+        load_mesh(&check, &what, mesh, dir, read, &mut b, &mut warnings)?;
         if b.len() == first {
             warnings.push(format!("{what}: no triangles"));
         }
-        b.transform_since(first, transform);
-        if let Some(spec) = &mesh.material {
-            let mut m = Material::diffuse(&what, Vec3::splat(0.8));
-            check.apply(&format!("{what}.material"), spec, &mut m)?;
-            let id = b.material(m);
-            b.set_material_since(first, id);
+        let repeated = file.meshes[i + 1..].iter().any(|m| same(m, mesh));
+        if repeated && b.len() > first && b.placed_count() == placed {
+            let id = b.mesh_since(first);
+            if !b.place(id, transform) {
+                return check.fail(format!("{what}: its transform flattens the mesh"));
+            }
+            shared[kind] = Some(id);
+        } else {
+            b.transform_since(first, transform);
         }
     }
     for spec in &file.materials {

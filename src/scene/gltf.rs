@@ -1,7 +1,8 @@
 //! glTF 2.0 scenes (`.gltf` with external or embedded buffers, `.glb`) through the `gltf`
 //! crate's document model and validation. Buffers and images are read here, through the
-//! loader's `read` (so within the input budgets), and every mesh instance is flattened into the
-//! scene's triangles in world space.
+//! loader's `read` (so within the input budgets). A mesh that one node uses is placed in world
+//! space; a mesh that several nodes use is stored once, in its own space, and each node places
+//! an instance of it (see [`crate::scene::Instance`]).
 //!
 //! What maps to what (the README's table says the same):
 //! - the default scene (or the one asked for), its node hierarchy with TRS or matrix transforms;
@@ -28,7 +29,7 @@ use base64::Engine;
 use glam::{DAffine3, DMat4, DQuat, DVec3, Vec2, Vec3};
 
 use super::obj::{Dropped, Loaded};
-use super::{Camera, Light, Material, MeshBuilder, ReadFile, Surface, Texture};
+use super::{Camera, Light, Material, MeshBuilder, MeshId, ReadFile, Surface, Texture};
 use crate::error::{Error, Result};
 use crate::input::InputKind;
 
@@ -43,6 +44,11 @@ const USED_EXTENSIONS: [&str; 4] = [
 /// Nodes nested deeper than this are refused (glTF's hierarchy is a tree; no stack overflow on
 /// hostile input).
 const MAX_DEPTH: usize = 256;
+
+/// Node visits (a node as often as the hierarchy reaches it) beyond which a file is refused:
+/// the spec makes the hierarchy a tree, but a file may share children between parents and
+/// reach the same nodes exponentially often.
+const MAX_NODE_VISITS: usize = 1 << 20;
 
 /// What a glTF file gives beyond its triangles and materials.
 pub struct Content {
@@ -162,11 +168,20 @@ pub fn load_into(
             .or_else(|| document.scenes().next())
             .ok_or_else(|| fail("no scene to render".into()))?,
     };
+    // Meshes that several nodes use are stored once and placed by instances.
+    let mut uses = HashMap::new();
+    let mut visits = 0;
+    for node in chosen.nodes() {
+        count_uses(&node, 0, &mut visits, &mut uses);
+    }
     let mut loader = Loader {
         path,
         dir,
         read,
         buffers: &buffers,
+        uses,
+        meshes: HashMap::new(),
+        visits: 0,
         materials: HashMap::new(),
         textures: HashMap::new(),
         content: Content {
@@ -189,6 +204,26 @@ pub fn load_into(
         warnings.push(format!("{}: {what} not rendered", path.display()));
     }
     Ok(content)
+}
+
+/// Counts the nodes under `node` (itself included) that use each mesh, up to [`MAX_DEPTH`]
+/// levels and [`MAX_NODE_VISITS`] nodes (where loading stops with an error anyway).
+fn count_uses(
+    node: &gltf::Node,
+    depth: usize,
+    visits: &mut usize,
+    uses: &mut HashMap<usize, usize>,
+) {
+    *visits += 1;
+    if depth > MAX_DEPTH || *visits > MAX_NODE_VISITS {
+        return;
+    }
+    if let Some(mesh) = node.mesh() {
+        *uses.entry(mesh.index()).or_default() += 1;
+    }
+    for child in node.children() {
+        count_uses(&child, depth + 1, visits, uses);
+    }
 }
 
 /// A glTF file as a scene: its lights (else a headlight and a sun), its first camera (else a
@@ -304,6 +339,12 @@ struct Loader<'a> {
     materials: HashMap<Option<usize>, u32>,
     /// Our texture of each glTF texture (`None`: it could not be loaded).
     textures: HashMap<usize, Option<u32>>,
+    /// How many nodes use each glTF mesh: those used more than once are instanced.
+    uses: HashMap<usize, usize>,
+    /// The stored mesh of each instanced glTF mesh.
+    meshes: HashMap<usize, MeshId>,
+    /// Nodes visited so far.
+    visits: usize,
     content: Content,
     /// Features left out, for one warning each.
     ignored: BTreeSet<String>,
@@ -329,6 +370,14 @@ impl Loader<'_> {
         if depth > MAX_DEPTH {
             return Err(self.fail(format!(
                 "nodes[{}]: the hierarchy is deeper than {MAX_DEPTH} nodes",
+                node.index()
+            )));
+        }
+        self.visits += 1;
+        if self.visits > MAX_NODE_VISITS {
+            return Err(self.fail(format!(
+                "nodes[{}]: the hierarchy reaches more than {MAX_NODE_VISITS} nodes (are \
+                 children shared between parents?)",
                 node.index()
             )));
         }
@@ -361,7 +410,24 @@ impl Loader<'_> {
             if node.skin().is_some() {
                 self.ignored.insert("skins".into());
             }
-            self.mesh(&mesh, affine, b)?;
+            if self.uses.get(&mesh.index()).is_some_and(|&n| n > 1) {
+                let id = match self.meshes.get(&mesh.index()) {
+                    Some(&id) => id,
+                    None => {
+                        let first = b.len();
+                        self.mesh(&mesh, DAffine3::IDENTITY, b)?;
+                        let id = b.mesh_since(first);
+                        self.meshes.insert(mesh.index(), id);
+                        id
+                    }
+                };
+                if !b.place(id, affine) {
+                    self.ignored
+                        .insert("nodes whose transform flattens a shared mesh".into());
+                }
+            } else {
+                self.mesh(&mesh, affine, b)?;
+            }
         }
         if let Some(light) = node.light() {
             self.light(&light, affine);

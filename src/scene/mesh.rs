@@ -4,7 +4,7 @@ use std::f64::consts::{PI, TAU};
 
 use glam::{DAffine3, DVec3, Vec2, Vec3};
 
-use super::{Camera, Light, Material, Scene, Texture, face_normal};
+use super::{Camera, Instance, Light, Material, Scene, Texture, face_normal};
 
 /// Collects triangles with their materials, normals and UVs, then makes a [`Scene`].
 #[derive(Default)]
@@ -15,12 +15,47 @@ pub struct MeshBuilder {
     material_of: Vec<u32>,
     materials: Vec<Material>,
     textures: Vec<Texture>,
+    /// Meshes for instances: ranges `(first, count)` of the triangles above, in mesh space.
+    meshes: Vec<(usize, usize)>,
+    /// Instances: a mesh and its transform to world space.
+    placed: Vec<(usize, DAffine3)>,
 }
+
+/// A mesh [`MeshBuilder::place`] can place (see [`MeshBuilder::mesh_since`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct MeshId(usize);
 
 impl MeshBuilder {
     /// An empty builder.
     pub fn new() -> Self {
         Self::default()
+    }
+
+    /// A builder that starts with these materials and textures.
+    pub fn with_materials(materials: Vec<Material>, textures: Vec<Texture>) -> Self {
+        Self {
+            materials,
+            textures,
+            ..Self::default()
+        }
+    }
+
+    /// Makes the triangles from index `first` on a mesh, in its own space: they are in the
+    /// scene only where [`MeshBuilder::place`] places them, stored once however often.
+    pub fn mesh_since(&mut self, first: usize) -> MeshId {
+        self.meshes.push((first, self.triangles.len() - first));
+        MeshId(self.meshes.len() - 1)
+    }
+
+    /// Places `mesh` in the world by `transform`. Returns false (nothing placed) where the
+    /// transform is not finite or flattens the mesh (a singular 3×3 part).
+    pub fn place(&mut self, mesh: MeshId, transform: DAffine3) -> bool {
+        let det = transform.matrix3.determinant();
+        if !(transform.is_finite() && det.is_normal() && transform.inverse().is_finite()) {
+            return false;
+        }
+        self.placed.push((mesh.0, transform));
+        true
     }
 
     /// Adds a material and returns its index.
@@ -45,9 +80,29 @@ impl MeshBuilder {
         self.textures.len() as u32
     }
 
-    /// The bounds of the triangles so far (`None` if there are none).
+    /// The world bounds of the triangles so far: those of no mesh, and the placed meshes
+    /// (`None` if there are none).
     pub fn bounds(&self) -> Option<(DVec3, DVec3)> {
-        super::bounds(&self.triangles)
+        if self.meshes.is_empty() {
+            return super::bounds(&self.triangles);
+        }
+        let mut in_mesh = vec![false; self.triangles.len()];
+        for &(first, count) in &self.meshes {
+            in_mesh[first..first + count].fill(true);
+        }
+        let world: Vec<[DVec3; 3]> = (0..self.triangles.len())
+            .filter(|&i| !in_mesh[i])
+            .map(|i| self.triangles[i])
+            .collect();
+        self.placed
+            .iter()
+            .fold(super::bounds(&world), |acc, &(m, t)| {
+                let (first, count) = self.meshes[m];
+                super::union(
+                    acc,
+                    super::placed_bounds(&self.triangles[first..first + count], t),
+                )
+            })
     }
 
     /// Number of triangles so far.
@@ -67,11 +122,20 @@ impl MeshBuilder {
 
     /// Moves the triangles from index `first` on by `transform`: corners as points, normals by
     /// the inverse transpose. A mirroring transform swaps two corners so that faces keep their
-    /// side.
+    /// side. Meshes made from `first` on stay in their own space; their instances move instead.
     pub fn transform_since(&mut self, first: usize, transform: DAffine3) {
         let normal_matrix = transform.matrix3.inverse().transpose();
         let mirrored = transform.matrix3.determinant() < 0.0;
-        for i in first..self.triangles.len() {
+        let mut in_mesh = vec![false; self.triangles.len() - first];
+        for &(start, count) in self.meshes.iter().filter(|m| m.0 >= first) {
+            in_mesh[start - first..start - first + count].fill(true);
+        }
+        for (mesh, placed) in &mut self.placed {
+            if self.meshes[*mesh].0 >= first {
+                *placed = transform * *placed;
+            }
+        }
+        for i in (first..self.triangles.len()).filter(|&i| !in_mesh[i - first]) {
             let t = &mut self.triangles[i];
             *t = t.map(|p| transform.transform_point3(p));
             let n = &mut self.normals[i];
@@ -224,26 +288,57 @@ impl MeshBuilder {
         }
     }
 
-    /// The finished scene.
+    /// Instances placed so far.
+    pub fn placed_count(&self) -> usize {
+        self.placed.len()
+    }
+
+    /// The finished scene: world triangles first, then the placed meshes (a mesh no instance
+    /// placed is left out).
     pub fn finish(self, lights: Vec<Light>, sky: Vec3, ambient: Vec3, camera: Camera) -> Scene {
+        // The stored order: triangles of no mesh, then each placed mesh's.
+        let mut in_mesh = vec![false; self.triangles.len()];
+        for &(first, count) in &self.meshes {
+            in_mesh[first..first + count].fill(true);
+        }
+        let mut order: Vec<usize> = (0..self.triangles.len()).filter(|&i| !in_mesh[i]).collect();
+        let world_triangles = order.len();
+        let mut mesh_first = vec![None; self.meshes.len()];
+        let mut instances = Vec::with_capacity(self.placed.len());
+        for &(mesh, transform) in &self.placed {
+            let (first, count) = self.meshes[mesh];
+            let stored = *mesh_first[mesh].get_or_insert_with(|| {
+                order.extend(first..first + count);
+                order.len() - count
+            });
+            instances.push(Instance {
+                first: stored as u32,
+                count: count as u32,
+                transform,
+            });
+        }
         let normals = self.normals.iter().any(Option::is_some).then(|| {
-            self.normals
+            order
                 .iter()
-                .zip(&self.triangles)
-                .map(|(n, t)| n.unwrap_or_else(|| [face_normal(t).as_vec3(); 3]))
+                .map(|&i| {
+                    self.normals[i]
+                        .unwrap_or_else(|| [face_normal(&self.triangles[i]).as_vec3(); 3])
+                })
                 .collect()
         });
         let uvs = self.uvs.iter().any(Option::is_some).then(|| {
-            self.uvs
+            order
                 .iter()
-                .map(|t| t.unwrap_or([Vec2::ZERO; 3]))
+                .map(|&i| self.uvs[i].unwrap_or([Vec2::ZERO; 3]))
                 .collect()
         });
         Scene {
-            triangles: self.triangles,
+            triangles: order.iter().map(|&i| self.triangles[i]).collect(),
+            world_triangles,
+            instances,
             normals,
             uvs,
-            material_of: self.material_of,
+            material_of: order.iter().map(|&i| self.material_of[i]).collect(),
             materials: self.materials,
             textures: self.textures,
             lights,

@@ -10,12 +10,12 @@ mod lint;
 mod mesh;
 pub mod obj;
 
-use glam::{DMat3, DVec3, Vec2, Vec3};
+use glam::{DAffine3, DMat3, DVec3, Vec2, Vec3};
 
 use crate::input::InputKind;
 use crate::lens::LensCamera;
 
-pub use mesh::{MeshBuilder, checker};
+pub use mesh::{MeshBuilder, MeshId, checker};
 
 /// How loaders read the files a scene names: [`disk`], or bytes held in memory (tests and the
 /// fuzz targets).
@@ -176,12 +176,40 @@ impl Camera {
     }
 }
 
+/// A mesh placed in the world by a transform: its triangles are stored once (in
+/// [`Scene::triangles`], in the mesh's own space) however many instances place them.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Instance {
+    /// The mesh's first stored triangle.
+    pub first: u32,
+    /// Its number of triangles.
+    pub count: u32,
+    /// Mesh space to world space (its 3×3 part invertible).
+    pub transform: DAffine3,
+}
+
+/// The most triangles an instanced scene is flattened to for the paths that draw world
+/// triangles only (the rasterized cube map): 50M, 2.4 GB of f64 corners on the host and more
+/// than the rasterizer could draw at interactive rates anyway.
+pub const MAX_FLATTENED: usize = 50_000_000;
+
 /// Everything the tracer renders.
+///
+/// Triangles are stored once: the first [`Scene::world_triangles`] in world space, then the
+/// meshes [`Scene::instances`] place, each in its own space. A scene triangle (as ids name it)
+/// is a stored world triangle, numbered first, or a triangle of an instance: instance k's
+/// triangles follow those of instances before it, in mesh order, as [`Scene::flattened`]
+/// lays them out.
 #[derive(Clone, Debug)]
 pub struct Scene {
-    /// The corners of every triangle, world space.
+    /// The corners of every stored triangle: world space, then mesh space.
     pub triangles: Vec<[DVec3; 3]>,
-    /// Per-triangle vertex normals, if any mesh had them (others get their face normal).
+    /// How many of `triangles` (the first) are in world space; the rest are meshes.
+    pub world_triangles: usize,
+    /// The placed meshes; empty in a flat scene.
+    pub instances: Vec<Instance>,
+    /// Per stored triangle: vertex normals, if any mesh had them (others get their face
+    /// normal).
     pub normals: Option<Vec<[Vec3; 3]>>,
     /// Per-triangle texture coordinates, if any mesh had them (others get zeros).
     pub uvs: Option<Vec<[Vec2; 3]>>,
@@ -223,14 +251,70 @@ pub const FRAME_FILL: f64 = 0.8;
 pub const WIDEST_FRAMING: f64 = 80.0;
 
 impl Scene {
-    /// Number of triangles.
+    /// Number of scene triangles: the world's and every instance's (100M for a thousand
+    /// instances of a 100k-triangle mesh, of which only 100k are stored).
     pub fn len(&self) -> usize {
-        self.triangles.len()
+        self.world_triangles
+            + self
+                .instances
+                .iter()
+                .map(|i| i.count as usize)
+                .sum::<usize>()
     }
 
     /// Whether the scene has no triangles.
     pub fn is_empty(&self) -> bool {
-        self.triangles.is_empty()
+        self.len() == 0
+    }
+
+    /// Whether some mesh is placed by instances.
+    pub fn is_instanced(&self) -> bool {
+        !self.instances.is_empty()
+    }
+
+    /// The scene with every instance's triangles copied into world space, numbered as scene
+    /// triangles are (mirroring transforms swap two corners, so faces keep their side, as
+    /// [`MeshBuilder::transform_since`] does). Refuses a result of more than `limit`
+    /// triangles, before allocating it.
+    pub fn flattened(&self, limit: usize) -> crate::error::Result<Scene> {
+        if !self.is_instanced() {
+            return Ok(self.clone());
+        }
+        if self.len() > limit {
+            return Err(crate::error::Error::Limit(format!(
+                "flattening the scene's {} instances makes {} triangles, more than the {limit} \
+                 this path takes (only the BVH traversal draws instances without copying them)",
+                self.instances.len(),
+                self.len()
+            )));
+        }
+        let mut b = MeshBuilder::with_materials(self.materials.clone(), self.textures.clone());
+        let copy = |b: &mut MeshBuilder, i: usize| {
+            b.triangle(
+                self.triangles[i],
+                self.normals.as_ref().map(|n| n[i]),
+                self.uvs.as_ref().map(|t| t[i]),
+                self.material_of[i],
+            )
+        };
+        for i in 0..self.world_triangles {
+            copy(&mut b, i);
+        }
+        for instance in &self.instances {
+            let first = b.len();
+            for i in instance.first..instance.first + instance.count {
+                copy(&mut b, i as usize);
+            }
+            b.transform_since(first, instance.transform);
+        }
+        let flat = b.finish(self.lights.clone(), self.sky, self.ambient, self.camera);
+        Ok(Scene {
+            camera_path: self.camera_path.clone(),
+            cameras: self.cameras.clone(),
+            headlight: self.headlight,
+            framed: self.framed,
+            ..flat
+        })
     }
 
     /// Puts the camera at `pose`, and the headlight, if the scene has one, at its eye.
@@ -260,9 +344,19 @@ impl Scene {
         Some(angle)
     }
 
-    /// The axis-aligned bounds of all triangles (`None` when empty).
+    /// The axis-aligned bounds of all triangles (`None` when empty); an instance counts with
+    /// the box around its mesh's transformed bounding box.
     pub fn bounds(&self) -> Option<(DVec3, DVec3)> {
-        bounds(&self.triangles)
+        let world = bounds(&self.triangles[..self.world_triangles]);
+        self.instances
+            .iter()
+            .fold(world, |acc, i| union(acc, self.instance_bounds(i)))
+    }
+
+    /// The world bounds of `instance` (see [`placed_bounds`]).
+    pub fn instance_bounds(&self, instance: &Instance) -> Option<(DVec3, DVec3)> {
+        let mesh = &self.triangles[instance.first as usize..][..instance.count as usize];
+        placed_bounds(mesh, instance.transform)
     }
 
     /// The pose at `s` ∈ [0, 1] along the camera path: keyframes equally spaced, positions and
@@ -305,6 +399,7 @@ impl Scene {
             textures: self.uvs.is_some() && used.iter().any(|m| m.diffuse_texture.is_some()),
             smooth_normals: self.normals.is_some(),
             translucent: used.iter().any(|m| m.opacity < 1.0),
+            instanced: self.is_instanced(),
         }
     }
 }
@@ -359,6 +454,8 @@ pub struct Features {
     pub smooth_normals: bool,
     /// Some surface is partially transparent (`d` < 1).
     pub translucent: bool,
+    /// Meshes are placed by instances (a two-level BVH).
+    pub instanced: bool,
 }
 
 /// The axis-aligned bounds of some triangles (`None` when there are none).
@@ -366,6 +463,32 @@ pub fn bounds(triangles: &[[DVec3; 3]]) -> Option<(DVec3, DVec3)> {
     let mut corners = triangles.iter().flatten();
     let first = *corners.next()?;
     Some(corners.fold((first, first), |(lo, hi), p| (lo.min(*p), hi.max(*p))))
+}
+
+/// The box around the transformed bounding box of `mesh` (`None` when empty): bounds a
+/// placed mesh without transforming its triangles.
+pub fn placed_bounds(mesh: &[[DVec3; 3]], transform: DAffine3) -> Option<(DVec3, DVec3)> {
+    let (lo, hi) = bounds(mesh)?;
+    let corners: Vec<[DVec3; 3]> = (0..8)
+        .map(|k| {
+            let pick = |bit: u32, a: f64, b: f64| if k & bit == 0 { a } else { b };
+            let c = DVec3::new(
+                pick(1, lo.x, hi.x),
+                pick(2, lo.y, hi.y),
+                pick(4, lo.z, hi.z),
+            );
+            [transform.transform_point3(c); 3]
+        })
+        .collect();
+    bounds(&corners)
+}
+
+/// The union of two optional boxes.
+pub fn union(a: Option<(DVec3, DVec3)>, b: Option<(DVec3, DVec3)>) -> Option<(DVec3, DVec3)> {
+    match (a, b) {
+        (Some(a), Some(b)) => Some((a.0.min(b.0), a.1.max(b.1))),
+        (a, b) => a.or(b),
+    }
 }
 
 /// The vertex normal of a triangle's face (not normalized when degenerate).

@@ -2,8 +2,10 @@
 //!
 //! It sees exactly the data the GPU sees (camera-relative vertices, lights and camera axes
 //! rounded to f32 once, then promoted), shades with the same Whitted model, but computes in
-//! f64 and finds hits with its own binary BVH (median splits; independent of obvhs), itself
-//! tested against brute force. Rays come from the f64 lens reference.
+//! f64 and finds hits with its own binary BVHs (median splits; independent of obvhs), itself
+//! tested against brute force: one over the world's triangles, one per mesh, and one over the
+//! instances that place meshes, whose rays it maps into the mesh's space with the f32 maps the
+//! GPU gets. Rays come from the f64 lens reference.
 
 use glam::{DMat3, DVec2, DVec3, Vec3};
 
@@ -17,14 +19,18 @@ const MIN_WEIGHT: f64 = crate::shared::MIN_WEIGHT as f64;
 /// A hit: distance, barycentric weights of corners 1 and 2, scene triangle.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Hit {
-    /// Distance along the (unit) ray.
+    /// Distance along the ray (the world's, in an instance too).
     pub t: f64,
     /// Weight of corner 1.
     pub u: f64,
     /// Weight of corner 2.
     pub v: f64,
-    /// Scene triangle index.
+    /// Scene triangle index (as ids name it).
     pub triangle: u32,
+    /// The stored triangle (`Scene::triangles`).
+    pub stored: u32,
+    /// The instance it was hit in (index into `Scene::instances`), if any.
+    pub instance: Option<u32>,
 }
 
 enum Node {
@@ -42,14 +48,164 @@ enum Node {
     },
 }
 
+/// A binary BVH (median splits) over boxes named by ids.
+struct Tree {
+    nodes: Vec<Node>,
+    order: Vec<u32>,
+}
+
+impl Tree {
+    /// The tree over `ids`, whose boxes `bounds` gives.
+    fn new(ids: Vec<u32>, bounds: &dyn Fn(u32) -> (DVec3, DVec3)) -> Self {
+        let mut tree = Self {
+            nodes: Vec::new(),
+            order: ids,
+        };
+        if !tree.order.is_empty() {
+            tree.build(0, tree.order.len(), bounds);
+        }
+        tree
+    }
+
+    /// Builds the subtree over `order[first..first + count]`, returns its node index.
+    fn build(&mut self, first: usize, count: usize, bounds: &dyn Fn(u32) -> (DVec3, DVec3)) -> u32 {
+        let (lo, hi) = self.order[first..first + count]
+            .iter()
+            .map(|&i| bounds(i))
+            .fold(
+                (DVec3::INFINITY, DVec3::NEG_INFINITY),
+                |(lo, hi), (a, b)| (lo.min(a), hi.max(b)),
+            );
+        let index = self.nodes.len() as u32;
+        if count <= 4 {
+            self.nodes.push(Node::Leaf {
+                lo,
+                hi,
+                first: first as u32,
+                count: count as u32,
+            });
+            return index;
+        }
+        let axis = (hi - lo).max_position();
+        let centroid = |i: &u32| {
+            let (a, b) = bounds(*i);
+            (a + b)[axis]
+        };
+        self.order[first..first + count].sort_by(|a, b| centroid(a).total_cmp(&centroid(b)));
+        self.nodes.push(Node::Leaf {
+            lo,
+            hi,
+            first: 0,
+            count: 0,
+        });
+        let half = count / 2;
+        let left = self.build(first, half, bounds);
+        let right = self.build(first + half, count - half, bounds);
+        self.nodes[index as usize] = Node::Inner {
+            lo,
+            hi,
+            left,
+            right,
+        };
+        index
+    }
+
+    /// Calls `visit` with each id whose leaf box the ray reaches before `limit()`, until it
+    /// returns true.
+    fn walk(
+        &self,
+        origin: DVec3,
+        dir: DVec3,
+        tmin: f64,
+        limit: &dyn Fn() -> f64,
+        visit: &mut dyn FnMut(u32) -> bool,
+    ) {
+        if self.nodes.is_empty() {
+            return;
+        }
+        let inv = DVec3::ONE / dir;
+        let mut stack = vec![0u32];
+        while let Some(index) = stack.pop() {
+            match self.nodes[index as usize] {
+                Node::Leaf {
+                    lo,
+                    hi,
+                    first,
+                    count,
+                } => {
+                    if !box_hit(lo, hi, origin, inv, tmin, limit()) {
+                        continue;
+                    }
+                    for &id in &self.order[first as usize..(first + count) as usize] {
+                        if visit(id) {
+                            return;
+                        }
+                    }
+                }
+                Node::Inner {
+                    lo,
+                    hi,
+                    left,
+                    right,
+                } => {
+                    if box_hit(lo, hi, origin, inv, tmin, limit()) {
+                        stack.extend([left, right]);
+                    }
+                }
+            }
+        }
+    }
+}
+
+fn box_hit(lo: DVec3, hi: DVec3, origin: DVec3, inv: DVec3, tmin: f64, tmax: f64) -> bool {
+    let a = (lo - origin) * inv;
+    let b = (hi - origin) * inv;
+    let near = a.min(b).max_element().max(tmin);
+    let far = a.max(b).min_element().min(tmax);
+    // f64 rounding is ~1e-16 relative: a relative pad of 1e-12 is conservative.
+    near <= far * (1.0 + 1e-12) + 1e-300
+}
+
+/// An affine map read from the rows the GPU gets.
+#[derive(Clone, Copy)]
+struct Affine {
+    m: DMat3,
+    t: DVec3,
+}
+
+impl Affine {
+    fn from_rows(rows: [[f32; 4]; 3]) -> Self {
+        let row = |r: [f32; 4]| DVec3::new(r[0].into(), r[1].into(), r[2].into());
+        Self {
+            m: DMat3::from_cols(row(rows[0]), row(rows[1]), row(rows[2])).transpose(),
+            t: DVec3::new(rows[0][3].into(), rows[1][3].into(), rows[2][3].into()),
+        }
+    }
+}
+
+/// An instance as the reference uses it: the f32 maps the GPU gets, promoted.
+struct Placed {
+    to_mesh: Affine,
+    to_world: Affine,
+    normal: DMat3,
+    /// Index into `Reference::meshes`.
+    mesh: usize,
+    id_base: u32,
+    first: u32,
+}
+
 /// The reference tracer for one scene.
 pub struct Reference<'a> {
     scene: &'a Scene,
     features: Features,
-    /// Camera-relative corners, f32-rounded then promoted.
+    /// Stored triangles' corners, f32-rounded then promoted: world ones camera-relative, mesh
+    /// ones in their mesh's space.
     corners: Vec<[DVec3; 3]>,
-    nodes: Vec<Node>,
-    order: Vec<u32>,
+    /// The BVH of the world's triangles, then one per mesh.
+    meshes: Vec<Tree>,
+    /// The instances, and the BVH over their boxes (empty for a flat scene).
+    instances: Vec<Placed>,
+    top: Tree,
     rotation: DMat3,
     lights: Vec<(bool, DVec3, DVec3)>,
     max_depth: u32,
@@ -68,11 +224,57 @@ impl<'a> Reference<'a> {
     pub fn new(scene: &'a Scene, max_depth: u32) -> Self {
         assert!(max_depth <= MAX_DEPTH_LIMIT);
         let origin = scene.camera.position;
+        let world = scene.world_triangles;
         let corners: Vec<[DVec3; 3]> = scene
             .triangles
             .iter()
-            .map(|t| t.map(|p| round32(p - origin)))
+            .enumerate()
+            .map(|(i, t)| {
+                let shift = if i < world { origin } else { DVec3::ZERO };
+                t.map(|p| round32(p - shift))
+            })
             .collect();
+        let triangle_box = |i: u32| {
+            let c = corners[i as usize];
+            (c[0].min(c[1]).min(c[2]), c[0].max(c[1]).max(c[2]))
+        };
+        let mut meshes = vec![Tree::new((0..world as u32).collect(), &triangle_box)];
+        let mut mesh_of = std::collections::HashMap::new();
+        let mut instances = Vec::new();
+        let mut boxes = Vec::new();
+        let mut id_base = world as u32;
+        for instance in &scene.instances {
+            let mesh = *mesh_of.entry(instance.first).or_insert_with(|| {
+                let ids = (instance.first..instance.first + instance.count).collect();
+                meshes.push(Tree::new(ids, &triangle_box));
+                meshes.len() - 1
+            });
+            let gpu =
+                crate::bvh::gpu_instance(instance.transform, origin, 0, id_base, instance.first);
+            let row = |r: [f32; 3]| DVec3::new(r[0].into(), r[1].into(), r[2].into());
+            instances.push(Placed {
+                to_mesh: Affine::from_rows(gpu.to_mesh),
+                to_world: Affine::from_rows(gpu.to_world),
+                normal: DMat3::from_cols(row(gpu.normal_x), row(gpu.normal_y), row(gpu.normal_z))
+                    .transpose(),
+                mesh,
+                id_base,
+                first: instance.first,
+            });
+            // The mesh's box through the f32 map, padded by far more than its roundings.
+            let (lo, hi) = crate::scene::placed_bounds(
+                &scene.triangles[instance.first as usize..][..instance.count as usize],
+                instance.transform,
+            )
+            .unwrap_or((DVec3::INFINITY, DVec3::NEG_INFINITY));
+            let pad =
+                DVec3::splat(1e-5 * (lo - origin).abs().max((hi - origin).abs()).max_element());
+            boxes.push((lo - origin - pad, hi - origin + pad));
+            id_base += instance.count;
+        }
+        let top = Tree::new((0..instances.len() as u32).collect(), &|k| {
+            boxes[k as usize]
+        });
         let rotation = scene.camera.rotation();
         let rotation = DMat3::from_cols(
             round32(rotation.x_axis),
@@ -87,79 +289,28 @@ impl<'a> Reference<'a> {
                 (point, vector.as_dvec3(), colour.as_dvec3())
             })
             .collect();
-        let mut reference = Self {
+        Self {
             scene,
             features: scene.features(),
             corners,
-            nodes: Vec::new(),
-            order: (0..scene.len() as u32).collect(),
+            meshes,
+            instances,
+            top,
             rotation,
             lights,
             max_depth,
-        };
-        if !reference.order.is_empty() {
-            reference.build(0, scene.len());
         }
-        reference
-    }
-
-    fn bounds(&self, range: &[u32]) -> (DVec3, DVec3) {
-        range
-            .iter()
-            .flat_map(|&i| self.corners[i as usize])
-            .fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), p| {
-                (lo.min(p), hi.max(p))
-            })
-    }
-
-    /// Builds the subtree over `order[first..first + count]`, returns its node index.
-    fn build(&mut self, first: usize, count: usize) -> u32 {
-        let (lo, hi) = self.bounds(&self.order[first..first + count]);
-        let index = self.nodes.len() as u32;
-        if count <= 4 {
-            self.nodes.push(Node::Leaf {
-                lo,
-                hi,
-                first: first as u32,
-                count: count as u32,
-            });
-            return index;
-        }
-        let axis = (hi - lo).max_position();
-        let centroid = |i: &u32| {
-            let c = self.corners[*i as usize];
-            (c[0] + c[1] + c[2])[axis]
-        };
-        let mut slice = std::mem::take(&mut self.order);
-        slice[first..first + count].sort_by(|a, b| centroid(a).total_cmp(&centroid(b)));
-        self.order = slice;
-        self.nodes.push(Node::Leaf {
-            lo,
-            hi,
-            first: 0,
-            count: 0,
-        });
-        let half = count / 2;
-        let left = self.build(first, half);
-        let right = self.build(first + half, count - half);
-        self.nodes[index as usize] = Node::Inner {
-            lo,
-            hi,
-            left,
-            right,
-        };
-        index
     }
 
     /// Watertight ray/triangle test (Woop, Benthin and Wald 2013) in f64, edges inclusive, for
-    /// t in (tmin, tmax].
+    /// t in (tmin, tmax]; the hit is scene triangle `id`.
     fn triangle_hit(
         &self,
-        triangle: u32,
+        stored: u32,
+        id: u32,
         origin: DVec3,
         dir: DVec3,
-        tmin: f64,
-        tmax: f64,
+        (tmin, tmax): (f64, f64),
     ) -> Option<Hit> {
         let kz = dir.abs().max_position();
         let mut kx = (kz + 1) % 3;
@@ -168,7 +319,7 @@ impl<'a> Reference<'a> {
             std::mem::swap(&mut kx, &mut ky);
         }
         let (sx, sy, sz) = (dir[kx] / dir[kz], dir[ky] / dir[kz], 1.0 / dir[kz]);
-        let [a, b, c] = self.corners[triangle as usize].map(|p| p - origin);
+        let [a, b, c] = self.corners[stored as usize].map(|p| p - origin);
         let (ax, ay) = (a[kx] - sx * a[kz], a[ky] - sy * a[kz]);
         let (bx, by) = (b[kx] - sx * b[kz], b[ky] - sy * b[kz]);
         let (cx, cy) = (c[kx] - sx * c[kz], c[ky] - sy * c[kz]);
@@ -187,78 +338,98 @@ impl<'a> Reference<'a> {
             t,
             u: v / det,
             v: w / det,
-            triangle,
+            triangle: id,
+            stored,
+            instance: None,
         })
     }
 
-    fn box_hit(lo: DVec3, hi: DVec3, origin: DVec3, inv: DVec3, tmin: f64, tmax: f64) -> bool {
-        let a = (lo - origin) * inv;
-        let b = (hi - origin) * inv;
-        let near = a.min(b).max_element().max(tmin);
-        let far = a.max(b).min_element().min(tmax);
-        // f64 rounding is ~1e-16 relative: a relative pad of 1e-12 is conservative.
-        near <= far * (1.0 + 1e-12) + 1e-300
+    /// Tests the ray (in mesh `mesh`'s space) against the mesh, keeping the best hit in
+    /// `best`; true where `any` and something was hit.
+    #[allow(clippy::too_many_arguments)]
+    fn trace_mesh(
+        &self,
+        mesh: usize,
+        instance: Option<u32>,
+        origin: DVec3,
+        dir: DVec3,
+        (tmin, tmax): (f64, f64),
+        any: bool,
+        best: &std::cell::Cell<Option<Hit>>,
+    ) -> bool {
+        let id = |stored: u32| match instance {
+            Some(k) => {
+                let p = &self.instances[k as usize];
+                p.id_base + stored - p.first
+            }
+            None => stored,
+        };
+        let limit = || best.get().map_or(tmax, |h| h.t);
+        let mut found = false;
+        self.meshes[mesh].walk(origin, dir, tmin, &limit, &mut |stored| {
+            if let Some(mut hit) =
+                self.triangle_hit(stored, id(stored), origin, dir, (tmin, limit()))
+                && closer(&hit, best.get().as_ref(), tmax)
+            {
+                hit.instance = instance;
+                best.set(Some(hit));
+                found = true;
+            }
+            any && found
+        });
+        any && found
     }
 
     /// The closest hit in (tmin, tmax), or with `any` the first one found.
     pub fn trace(&self, origin: DVec3, dir: DVec3, tmin: f64, tmax: f64, any: bool) -> Option<Hit> {
-        if self.nodes.is_empty() {
-            return None;
+        let best = std::cell::Cell::new(None);
+        // The world's triangles, then the instances.
+        if self.trace_mesh(0, None, origin, dir, (tmin, tmax), any, &best)
+            || self.instances.is_empty()
+        {
+            return best.get();
         }
-        let inv = DVec3::ONE / dir;
-        let mut best: Option<Hit> = None;
-        let mut stack = vec![0u32];
-        while let Some(index) = stack.pop() {
-            let limit = best.map_or(tmax, |h| h.t);
-            match self.nodes[index as usize] {
-                Node::Leaf {
-                    lo,
-                    hi,
-                    first,
-                    count,
-                } => {
-                    if !Self::box_hit(lo, hi, origin, inv, tmin, limit) {
-                        continue;
-                    }
-                    for &tri in &self.order[first as usize..(first + count) as usize] {
-                        let limit = best.map_or(tmax, |h| h.t);
-                        if let Some(hit) = self.triangle_hit(tri, origin, dir, tmin, limit)
-                            && closer(&hit, best.as_ref(), tmax)
-                        {
-                            best = Some(hit);
-                            if any {
-                                return best;
-                            }
-                        }
-                    }
-                }
-                Node::Inner {
-                    lo,
-                    hi,
-                    left,
-                    right,
-                } => {
-                    if Self::box_hit(lo, hi, origin, inv, tmin, limit) {
-                        stack.extend([left, right]);
-                    }
-                }
-            }
-        }
-        best
+        let limit = || best.get().map_or(tmax, |h: Hit| h.t);
+        self.top.walk(origin, dir, tmin, &limit, &mut |k| {
+            let p = &self.instances[k as usize];
+            let local_origin = p.to_mesh.m * origin + p.to_mesh.t;
+            let local_dir = p.to_mesh.m * dir;
+            self.trace_mesh(
+                p.mesh,
+                Some(k),
+                local_origin,
+                local_dir,
+                (tmin, tmax),
+                any,
+                &best,
+            )
+        });
+        best.get()
     }
 
-    /// Brute force over every triangle (to test [`Reference::trace`]).
+    /// Brute force over every scene triangle (to test [`Reference::trace`]).
     pub fn trace_brute_force(&self, origin: DVec3, dir: DVec3) -> Option<Hit> {
-        let mut best: Option<Hit> = None;
-        for tri in 0..self.corners.len() as u32 {
-            let limit = best.map_or(f64::INFINITY, |h| h.t);
-            if let Some(hit) = self.triangle_hit(tri, origin, dir, 0.0, limit)
-                && closer(&hit, best.as_ref(), f64::INFINITY)
+        let best = std::cell::Cell::new(None);
+        let test = |stored: u32, id: u32, instance: Option<u32>, o: DVec3, d: DVec3| {
+            let limit = best.get().map_or(f64::INFINITY, |h: Hit| h.t);
+            if let Some(mut hit) = self.triangle_hit(stored, id, o, d, (0.0, limit))
+                && closer(&hit, best.get().as_ref(), f64::INFINITY)
             {
-                best = Some(hit);
+                hit.instance = instance;
+                best.set(Some(hit));
+            }
+        };
+        for stored in 0..self.scene.world_triangles as u32 {
+            test(stored, stored, None, origin, dir);
+        }
+        for (k, p) in self.instances.iter().enumerate() {
+            let count = self.scene.instances[k].count;
+            let (o, d) = (p.to_mesh.m * origin + p.to_mesh.t, p.to_mesh.m * dir);
+            for j in 0..count {
+                test(p.first + j, p.id_base + j, Some(k as u32), o, d);
             }
         }
-        best
+        best.get()
     }
 
     /// Renders every pixel of `camera` with one ray through its centre (rows split over the
@@ -338,15 +509,16 @@ impl<'a> Reference<'a> {
                 let n = s.normal.as_vec3();
                 first = ([n.x, n.y, n.z, hit.t as f32], hit.triangle);
             }
-            let m = &self.scene.materials[self.scene.material_of[hit.triangle as usize] as usize];
+            let m = &self.scene.materials[self.scene.material_of[hit.stored as usize] as usize];
             let children = depth < self.max_depth;
             let push = |stack: &mut Vec<_>, origin, dir, w: DVec3| {
                 if children && w.max_element() >= MIN_WEIGHT {
                     stack.push((origin, dir, w, depth + 1));
                 }
             };
-            let above = s.position + s.geometric * 1e-9 * (1.0 + s.position.length());
-            let below = s.position - s.geometric * 1e-9 * (1.0 + s.position.length());
+            let offset = self.offset(&hit, s.position);
+            let above = s.position + s.geometric * offset;
+            let below = s.position - s.geometric * offset;
             let mut surface_weight = weight;
             if self.features.translucent && m.surface == Surface::Diffuse && m.opacity < 1.0 {
                 let opacity = f64::from(m.opacity);
@@ -398,12 +570,35 @@ impl<'a> Reference<'a> {
         ([c.x, c.y, c.z, 1.0], first.0, first.1)
     }
 
+    /// How far rays leaving `hit` (at `p`) start off its surface: by far more than f64's
+    /// roundings; off an instance's, by more than the round trip of its f32 maps (a few 1e-8
+    /// of the reach of the point and of the instance's translation), since those rays are
+    /// mapped into its space again.
+    fn offset(&self, hit: &Hit, p: DVec3) -> f64 {
+        let reach = 1.0 + p.length();
+        match hit.instance {
+            Some(k) => 1e-6 * (reach + self.instances[k as usize].to_world.t.length()),
+            None => 1e-9 * reach,
+        }
+    }
+
     fn surface(&self, dir: DVec3, hit: &Hit) -> SurfacePoint {
-        let i = hit.triangle as usize;
+        let i = hit.stored as usize;
         let [a, b, c] = self.corners[i];
         let w = 1.0 - hit.u - hit.v;
-        let position = w * a + hit.u * b + hit.v * c;
-        let mut geometric = (b - a).cross(c - a).normalize();
+        let placed = hit.instance.map(|k| &self.instances[k as usize]);
+        let (to_world, normal_matrix) = match placed {
+            Some(p) => (p.to_world, p.normal),
+            None => (
+                Affine {
+                    m: DMat3::IDENTITY,
+                    t: DVec3::ZERO,
+                },
+                DMat3::IDENTITY,
+            ),
+        };
+        let position = to_world.m * (w * a + hit.u * b + hit.v * c) + to_world.t;
+        let mut geometric = (normal_matrix * (b - a).cross(c - a)).normalize();
         let front = geometric.dot(dir) < 0.0;
         if !front {
             geometric = -geometric;
@@ -411,7 +606,13 @@ impl<'a> Reference<'a> {
         let mut normal = geometric;
         if self.features.smooth_normals {
             let n = self.scene.normals.as_ref().unwrap()[i];
-            let n = (w * v3(n[0]) + hit.u * v3(n[1]) + hit.v * v3(n[2])).normalize();
+            // Each vertex normal in the world before interpolation, as a flattened copy has
+            // it.
+            let n = n.map(|n| match placed {
+                Some(_) => (normal_matrix * v3(n)).normalize(),
+                None => v3(n),
+            });
+            let n = (w * n[0] + hit.u * n[1] + hit.v * n[2]).normalize();
             normal = if n.dot(geometric) >= 0.0 { n } else { -n };
         }
         let m = &self.scene.materials[self.scene.material_of[i] as usize];
@@ -474,8 +675,7 @@ impl Reference<'_> {
             let Some(hit) = self.trace(o, to_light, 0.0, remaining, false) else {
                 return transmittance;
             };
-            let i = hit.triangle as usize;
-            let m = &self.scene.materials[self.scene.material_of[i] as usize];
+            let m = &self.scene.materials[self.scene.material_of[hit.stored as usize] as usize];
             transmittance *= 1.0 - f64::from(m.opacity);
             if m.surface != Surface::Diffuse
                 || transmittance < MIN_WEIGHT
@@ -484,7 +684,7 @@ impl Reference<'_> {
                 return 0.0;
             }
             let p = o + to_light * hit.t;
-            o = p + to_light * 1e-9 * (1.0 + p.length());
+            o = p + to_light * self.offset(&hit, p);
             remaining -= hit.t;
         }
         0.0

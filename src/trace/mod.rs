@@ -1,7 +1,9 @@
 //! The ray tracer: a scene on the GPU ([`GpuScene`], built and uploaded once), the trace pass
 //! for a lens and image size ([`TracePass`]), and [`render`], which does both in one call.
-//! `cpu` holds the f64 reference the GPU output is tested against.
+//! `cpu` holds the f64 reference the GPU output is tested against; `cast` casts arbitrary rays
+//! with the same traversal.
 
+pub mod cast;
 pub mod cpu;
 mod display;
 mod output;
@@ -89,10 +91,11 @@ fn to3(v: glam::Vec3) -> [f32; 3] {
     v.to_array()
 }
 
-/// Per scene triangle: vertex normals when smooth, UVs when textured, as `vec4<f32>`s.
+/// Per stored triangle: vertex normals when smooth, UVs when textured, as `vec4<f32>`s.
 pub fn shading_vertices(scene: &Scene, features: Features) -> Vec<[f32; 4]> {
-    let mut out = Vec::with_capacity(scene.len() * shading_vectors_per_triangle(features));
-    for i in 0..scene.len() {
+    let stored = scene.triangles.len();
+    let mut out = Vec::with_capacity(stored * shading_vectors_per_triangle(features));
+    for i in 0..stored {
         if features.smooth_normals {
             let n = scene.normals.as_ref().expect("smooth normals")[i];
             out.extend(n.map(|n| [n.x, n.y, n.z, 0.0]));
@@ -142,7 +145,8 @@ fn shading_vectors_per_triangle(f: Features) -> usize {
 /// of the adapter, with the numbers, before the BVH is built for nothing.
 fn check_scene_size(ctx: &GpuContext, scene: &Scene, features: Features) -> Result<()> {
     let limit = ctx.device.limits().max_storage_buffer_binding_size;
-    let triangles = scene.len() as u64;
+    // Instances share their mesh's triangles: what is stored counts.
+    let triangles = scene.triangles.len() as u64;
     let mib = |bytes: u64| bytes as f64 / f64::from(1 << 20);
     let per_triangle = [
         ("triangle data", size_of::<crate::bvh::GpuTriangle>() as u64),
@@ -183,13 +187,14 @@ fn check_scene_size(ctx: &GpuContext, scene: &Scene, features: Features) -> Resu
 
 /// The overrides of `wgsl/surface.wgsl` for a scene's features: code for what the scene does
 /// not use is dead.
-pub fn surface_constants(f: Features) -> [(&'static str, f64); 4] {
+pub fn surface_constants(f: Features) -> [(&'static str, f64); 5] {
     let flag = |b: bool| f64::from(u8::from(b));
     [
         ("HAS_MIRRORS", flag(f.mirrors)),
         ("HAS_GLASS", flag(f.glass)),
         ("HAS_TEXTURES", flag(f.textures)),
         ("SMOOTH_NORMALS", flag(f.smooth_normals)),
+        ("INSTANCED", flag(f.instanced)),
     ]
 }
 
@@ -261,8 +266,12 @@ pub struct GpuScene {
     pub features: Features,
     /// The world position the scene was made relative to (the camera's).
     pub origin: DVec3,
-    /// Triangles (in BVH order on the GPU): the rasterizer draws `3 × triangles` vertices.
+    /// Triangles stored (in BVH order on the GPU): the rasterizer draws `3 × triangles`
+    /// vertices of a flat scene.
     pub triangles: u32,
+    /// Scene triangles: the stored ones where the scene is flat, every instance's where it is
+    /// not.
+    pub scene_triangles: u64,
     /// The lights as uploaded.
     pub lights: Vec<GpuLight>,
     /// Layers the rasterizer's shadow maps need (see [`GpuLight::shadow_layer`]).
@@ -290,7 +299,7 @@ pub struct GpuScene {
 pub struct SceneBytes {
     /// The triangles the traversal tests (48 bytes each).
     pub geometry: u64,
-    /// The BVH's nodes (80 bytes each, obvhs's CWBVH).
+    /// The BVH's nodes (80 bytes each, obvhs's CWBVH) and instances (144 bytes each).
     pub bvh: u64,
     /// Shading data: per-vertex normals and UVs, materials, lights.
     pub shading: u64,
@@ -317,6 +326,15 @@ impl GpuScene {
         if options.traversal == Traversal::RayQuery {
             RayQueryScene::check(ctx, scene.len() as u64)?;
         }
+        // The driver's acceleration structure takes the scene flattened (its instancing is not
+        // exposed through wgpu's ray queries here).
+        let flat;
+        let scene = if options.traversal == Traversal::RayQuery && scene.is_instanced() {
+            flat = scene.flattened(usize::MAX)?;
+            &flat
+        } else {
+            scene
+        };
         let features = scene.features();
         check_scene_size(ctx, scene, features)?;
         let origin = scene.camera.position;
@@ -375,6 +393,7 @@ impl GpuScene {
             )?,
             storage(ctx, "fisheye.scene.texture_info", &texture_info)?,
             storage(ctx, "fisheye.scene.texels", &texels)?,
+            storage(ctx, "fisheye.scene.instances", &bvh.instances)?,
         ];
         let scene = ctx.checked("uploading the scene", || {
             let device = &ctx.device;
@@ -388,6 +407,7 @@ impl GpuScene {
             // wgsl/surface.wgsl; the rasterizer reads them in its vertex and fragment stages.
             let mut entries: Vec<_> = (0..7).map(|b| storage_entry(b, true)).collect();
             entries.push(uniform_entry(7));
+            entries.push(storage_entry(8, true));
             for entry in &mut entries {
                 entry.visibility = crate::gpu::ALL_STAGES;
             }
@@ -395,14 +415,15 @@ impl GpuScene {
                 label: Some("fisheye.scene"),
                 entries: &entries,
             });
-            let mut resources: Vec<&wgpu::Buffer> = buffers.iter().collect();
-            resources.push(&uniform);
+            let mut resources: Vec<&wgpu::Buffer> = buffers[..7].iter().collect();
+            resources.extend([&uniform, &buffers[7]]);
             let bind_group = bind_buffers(device, "fisheye.scene", &layout, &resources);
             let ray_query = (options.traversal == Traversal::RayQuery)
                 .then(|| RayQueryScene::new(ctx, &buffers[1], scene.len() as u32));
             let size = |k: usize| buffers[k].size();
             let bytes = SceneBytes {
-                bvh: size(0),
+                // The instances' buffer holds one unused element in a flat scene.
+                bvh: size(0) + (size_of::<crate::bvh::GpuInstance>() * bvh.instances.len()) as u64,
                 geometry: size(1),
                 shading: size(2) + size(3) + size(4),
                 textures: size(5) + size(6),
@@ -411,7 +432,8 @@ impl GpuScene {
                 layout,
                 bind_group,
                 features,
-                triangles: scene.len() as u32,
+                triangles: scene.triangles.len() as u32,
+                scene_triangles: scene.len() as u64,
                 lights,
                 shadow_layers,
                 sky: scene.sky,

@@ -37,6 +37,9 @@ pub(crate) struct StudyArgs {
     /// The scene, as for `render`.
     #[arg(default_value = "builtin:default")]
     pub(crate) scene: String,
+    /// Which scene of a glTF file (from 0); its default scene if not given.
+    #[arg(long)]
+    pub(crate) gltf_scene: Option<usize>,
     /// Lens specs to measure (repeatable); or give --calib.
     #[arg(long, default_value = "canon-8-15mm@8mm")]
     pub(crate) lens: Vec<String>,
@@ -379,12 +382,8 @@ impl From<Directions> for DirectionSource {
     }
 }
 
-/// A scene from `builtin:NAME`, a scene file or an OBJ file; warnings go to stderr.
-pub(crate) fn load_scene(spec: &str) -> Result<Scene> {
-    load_scene_with(spec, None)
-}
-
-/// As [`load_scene`], with scene `gltf_scene` of a glTF file.
+/// A scene from `builtin:NAME`, a scene file, an OBJ file or glTF file (its scene
+/// `gltf_scene`, else its default); warnings go to stderr.
 pub(crate) fn load_scene_with(spec: &str, gltf_scene: Option<usize>) -> Result<Scene> {
     let loaded = fisheye_rt::scene::load_with(spec, gltf_scene)?;
     for warning in &loaded.warnings {

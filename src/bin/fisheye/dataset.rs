@@ -15,7 +15,7 @@ use fisheye_rt::pose::parse_transform;
 use fisheye_rt::trace::{Channel, ColourFile, Display, RenderOptions};
 use glam::DAffine3;
 
-use crate::args::{ArrayFormat, Output, Quality, ToneArg, load_scene};
+use crate::args::{ArrayFormat, Output, Quality, ToneArg, load_scene_with};
 use crate::progress::Progress;
 
 #[derive(Subcommand)]
@@ -38,6 +38,9 @@ pub(crate) struct RenderArgs {
     /// The scene, as for `render`.
     #[arg(default_value = "builtin:default")]
     scene: String,
+    /// Which scene of a glTF file (from 0); its default scene if not given.
+    #[arg(long)]
+    gltf_scene: Option<usize>,
     /// The trajectory: poses T_world_body in TUM (`t tx ty tz qx qy qz qw`), KITTI (3×4
     /// matrices) or EuRoC CSV (`t_ns, px, py, pz, qw, qx, qy, qz, ...`), detected from the
     /// text unless --trajectory-format says. Every pose is rendered, without interpolation.
@@ -189,9 +192,13 @@ fn render(args: &RenderArgs) -> Result<()> {
         FormatArg::Euroc => TrajectoryFormat::Euroc,
     });
     let (detected, poses) = trajectory::read(&args.trajectory, format, args.fps)?;
-    let scene = load_scene(&args.scene)?;
+    let scene = load_scene_with(&args.scene, args.gltf_scene)?;
     let dataset = Dataset {
-        scene_name: args.scene.clone(),
+        // The plan records the scene by this name: a glTF file's other scene is another.
+        scene_name: match args.gltf_scene {
+            Some(n) => format!("{} (glTF scene {n})", args.scene),
+            None => args.scene.clone(),
+        },
         scene,
         trajectory: (args.trajectory.clone(), detected),
         poses,

@@ -165,8 +165,18 @@ pub(crate) fn render(args: &RenderArgs) -> Result<()> {
     println!("adapter: {}", ctx.adapter_name());
     let scenes = SceneSet::new(&ctx, &scene, &options, &[setup])?;
     let gpu_scene = scenes.for_method(setup.method);
+    let stored = if scene.is_instanced() {
+        format!(
+            " ({} stored, {} instances)",
+            scene.triangles.len(),
+            scene.instances.len()
+        )
+    } else {
+        String::new()
+    };
     println!(
-        "scene: {scene_spec}, {} triangles; BVH ({}) {} nodes, depth {}, built in {:.1} ms",
+        "scene: {scene_spec}, {} triangles{stored}; BVH ({}) {} nodes, depth {}, built in \
+         {:.1} ms",
         scene.len(),
         options.bvh.name(),
         gpu_scene.bvh_nodes,
@@ -176,8 +186,9 @@ pub(crate) fn render(args: &RenderArgs) -> Result<()> {
     let bytes = gpu_scene.bytes;
     let per = |b: u64| b as f64 / f64::from(gpu_scene.triangles.max(1));
     println!(
-        "on the device: {:.0} bytes a triangle (geometry {:.0}, BVH {:.1}, shading {:.1}), \
-         textures {:.1} MiB",
+        "on the device: {:.1} MiB, {:.0} bytes a stored triangle (geometry {:.0}, BVH {:.1}, \
+         shading {:.1}), textures {:.1} MiB",
+        (bytes.geometry + bytes.bvh + bytes.shading) as f64 / f64::from(1 << 20),
         bytes.per_triangle(gpu_scene.triangles),
         per(bytes.geometry),
         per(bytes.bvh),

@@ -11,7 +11,7 @@ use fisheye_rt::scene::Scene;
 use fisheye_rt::trace::RenderOptions;
 use fisheye_rt::trace::sampling::samples_per_side;
 
-use crate::args::{PathArg, StudyArgs, load_scene, parse_camera};
+use crate::args::{PathArg, StudyArgs, load_scene_with, parse_camera};
 
 #[derive(clap::Args)]
 pub(crate) struct BenchArgs {
@@ -106,7 +106,7 @@ pub(crate) fn prepare(args: &StudyArgs, command: &str) -> Result<Prepared> {
         samples_per_side(spp).with_context(|| format!("--spp {spp}"))?;
     }
     let setups = Setup::all(&methods, &args.cube_size, &args.spp);
-    let mut scene = load_scene(&args.scene)?;
+    let mut scene = load_scene_with(&args.scene, args.gltf_scene)?;
     if let Some(text) = &args.camera {
         let pose = parse_camera(text, &scene)?;
         scene.set_camera(pose);

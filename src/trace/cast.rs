@@ -1,0 +1,154 @@
+//! Arbitrary rays cast into a scene on the GPU ([`RayCast`]): the tracer's own traversal
+//! (`wgsl/bvh.wgsl`, through `wgsl/cast.wgsl`) without lens or shading, for rays the caller
+//! makes (shadow rays, bounces, a peer's rays in the peer benchmark).
+
+use super::GpuScene;
+use crate::error::Result;
+use crate::gpu::GpuContext;
+use crate::shader;
+use crate::shared::WORKGROUP_1D;
+pub use crate::shared::{CastRay, NO_HIT};
+
+/// What a cast ray found.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct CastHit {
+    /// Distance along the ray's direction (its tmax on a miss).
+    pub t: f32,
+    /// The scene triangle hit (as ids name it), [`NO_HIT`] on a miss.
+    pub triangle: u32,
+    /// Barycentric weights of the triangle's corners 1 and 2.
+    pub uv: [f32; 2],
+}
+
+/// The cast kernel for one scene: closest hits, or any hit (shadow rays).
+pub struct RayCast {
+    pipeline: wgpu::ComputePipeline,
+}
+
+/// Rays uploaded for [`RayCast::encode`], and where their hits go.
+pub struct CastBatch {
+    bind_group: wgpu::BindGroup,
+    hits: wgpu::Buffer,
+    count: u32,
+}
+
+impl RayCast {
+    /// The kernel for `scene` (specialised to its instancing), finding the closest hit or,
+    /// with `any_hit`, any hit.
+    pub fn new(ctx: &GpuContext, scene: &GpuScene, any_hit: bool) -> Result<Self> {
+        ctx.checked("creating the ray-cast pass", || {
+            let constants = [
+                ("ANY_HIT", f64::from(u8::from(any_hit))),
+                ("INSTANCED", f64::from(u8::from(scene.features.instanced))),
+            ];
+            let layout = ctx
+                .device
+                .create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+                    label: Some("fisheye.cast"),
+                    entries: &[
+                        crate::gpu::storage_entry(0, true),
+                        crate::gpu::storage_entry(1, false),
+                    ],
+                });
+            Self {
+                pipeline: shader::compute_pipeline(
+                    &ctx.device,
+                    "cast",
+                    "main",
+                    &constants,
+                    &[&layout, &scene.layout],
+                ),
+            }
+        })
+    }
+
+    /// Uploads `rays` (origins relative to the scene's [`GpuScene::origin`]); refuses more
+    /// than one dispatch or one storage binding holds.
+    pub fn upload(&self, ctx: &GpuContext, rays: &[CastRay]) -> Result<CastBatch> {
+        let limits = ctx.device.limits();
+        let most = u64::from(limits.max_compute_workgroups_per_dimension) * u64::from(WORKGROUP_1D);
+        if rays.len() as u64 > most {
+            return Err(crate::error::Error::Limit(format!(
+                "{} rays in one cast; one dispatch takes at most {most}",
+                rays.len()
+            )));
+        }
+        ctx.check_binding("the cast rays", std::mem::size_of_val(rays) as u64)?;
+        let zero = [bytemuck::Zeroable::zeroed()];
+        let data: &[CastRay] = if rays.is_empty() { &zero } else { rays };
+        ctx.checked("uploading the cast rays", || {
+            let device = &ctx.device;
+            let input = crate::gpu::buffer_init(
+                device,
+                "fisheye.cast.rays",
+                bytemuck::cast_slice(data),
+                wgpu::BufferUsages::STORAGE,
+            );
+            let hits = device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("fisheye.cast.hits"),
+                size: input.size() / 2,
+                usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
+                mapped_at_creation: false,
+            });
+            let bind_group = crate::gpu::bind_buffers(
+                device,
+                "fisheye.cast",
+                &self.pipeline.get_bind_group_layout(0),
+                &[&input, &hits],
+            );
+            CastBatch {
+                bind_group,
+                hits,
+                count: rays.len() as u32,
+            }
+        })
+    }
+
+    /// Records the cast of `batch` into `encoder`, timed by `timestamps` if given.
+    pub fn encode(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        scene: &GpuScene,
+        batch: &CastBatch,
+        timestamps: Option<wgpu::ComputePassTimestampWrites<'_>>,
+    ) {
+        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+            label: Some("fisheye.cast"),
+            timestamp_writes: timestamps,
+        });
+        pass.set_pipeline(&self.pipeline);
+        pass.set_bind_group(0, &batch.bind_group, &[]);
+        pass.set_bind_group(1, &scene.bind_group, &[]);
+        pass.dispatch_workgroups(batch.count.div_ceil(WORKGROUP_1D), 1, 1);
+    }
+
+    /// The hits of `batch`, once its cast has been submitted.
+    pub fn read(&self, ctx: &GpuContext, batch: &CastBatch) -> Result<Vec<CastHit>> {
+        let raw: Vec<[f32; 4]> = ctx.read_buffer(&batch.hits)?;
+        Ok(raw
+            .into_iter()
+            .take(batch.count as usize)
+            .map(|h| CastHit {
+                t: h[0],
+                triangle: h[1].to_bits(),
+                uv: [h[2], h[3]],
+            })
+            .collect())
+    }
+
+    /// Uploads, casts and reads back `rays` in one call.
+    pub fn cast(
+        &self,
+        ctx: &GpuContext,
+        scene: &GpuScene,
+        rays: &[CastRay],
+    ) -> Result<Vec<CastHit>> {
+        let batch = self.upload(ctx, rays)?;
+        ctx.checked("casting rays", || {
+            let mut encoder = ctx.device.create_command_encoder(&Default::default());
+            self.encode(&mut encoder, scene, &batch, None);
+            ctx.queue.submit([encoder.finish()]);
+        })?;
+        self.read(ctx, &batch)
+    }
+}
