@@ -15,6 +15,7 @@
 //! - [`renderer`]: rendering on the caller's device into the caller's texture and encoder.
 //! - [`pose`], [`dataset`]: rigid transforms, trajectories (TUM, KITTI, EuRoC) and synthetic
 //!   datasets of a camera rig along them, in shards.
+//! - `peer` (feature `peer-embree`): Embree 3 casting the same rays, for the peer benchmark.
 //! - [`cube`], [`raster`]: the cube-map path (faces ray traced or rasterized, then resampled),
 //!   to compare with direct ray tracing.
 //!
@@ -69,6 +70,10 @@ pub mod plot;
 pub mod report;
 #[cfg(feature = "cli")]
 pub mod validate;
+
+// Embree as the peer of the benchmark (the `peer-embree` feature).
+#[cfg(feature = "peer-embree")]
+pub mod peer;
 
 pub use error::{Error, LensError, Result};
 

@@ -223,7 +223,13 @@ fn paths_overrides_lights_and_camera_path() {
 fn bad_scene_files_are_clear_errors() {
     let dir = temp_dir("bad-scenes");
     write(&dir, "tri.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
-    let cases: [(&str, &[&str]); 12] = [
+    let cases: [(&str, &[&str]); 13] = [
+        (
+            // Two entries of one mesh, the second scaled so small that its determinant
+            // underflows: an instance cannot invert it.
+            "[[mesh]]\npath = \"tri.obj\"\n[[mesh]]\npath = \"tri.obj\"\nscale = 1e-200\n",
+            &["mesh 2", "flattens the mesh"],
+        ),
         (
             "[camera]\npositon = [0.0, 0.0, 1.0]\nlook_at = [0.0, 0.0, 0.0]\n",
             &["unknown field `positon`", "line 2"],
