@@ -11,8 +11,8 @@
 
 use fisheye_rt::gpu::{GpuContext, Queries, median};
 use fisheye_rt::lens::{ImageSize, LensCamera, parse_spec};
-use fisheye_rt::peer::{Agreement, Embree, Workload, with_embree};
-use fisheye_rt::scene::{self, Light, Scene};
+use fisheye_rt::peer::{Agreement, Embree, Workload, light, with_embree};
+use fisheye_rt::scene;
 use fisheye_rt::trace::cast::{CastRay, NO_HIT, RayCast};
 use fisheye_rt::trace::{GpuScene, RenderOptions};
 use glam::DVec3;
@@ -35,22 +35,6 @@ fn cpu_ms(frames: usize, mut run: impl FnMut()) -> f64 {
         })
         .collect();
     median(&samples)
-}
-
-/// The scene's first point light, else a point above its bounds, camera-relative.
-fn light(scene: &Scene) -> glam::Vec3 {
-    let at = scene
-        .lights
-        .iter()
-        .find_map(|l| match l {
-            Light::Point { position, .. } => Some(*position),
-            _ => None,
-        })
-        .unwrap_or_else(|| {
-            let (lo, hi) = scene.bounds().unwrap();
-            (lo + hi) / 2.0 + DVec3::Y * (hi - lo).length()
-        });
-    (at - scene.camera.position).as_vec3()
 }
 
 struct Bench<'a> {

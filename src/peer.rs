@@ -236,6 +236,23 @@ fn packet8(batch: &[CastRay]) -> Box<sys::RTCRayHit8> {
     })
 }
 
+/// Where the peer benchmark's shadow rays go, camera-relative: the scene's first point light,
+/// else a point above the middle of its bounds, as high as they are wide.
+pub fn light(scene: &Scene) -> Vec3 {
+    let at = scene
+        .lights
+        .iter()
+        .find_map(|l| match l {
+            crate::scene::Light::Point { position, .. } => Some(*position),
+            _ => None,
+        })
+        .unwrap_or_else(|| {
+            let (lo, hi) = scene.bounds().unwrap_or_default();
+            (lo + hi) / 2.0 + DVec3::Y * (hi - lo).length()
+        });
+    (at - scene.camera.position).as_vec3()
+}
+
 /// The rays of the peer benchmark, the same for both tracers: a lens's primary rays from the
 /// eye; from each primary hit (Embree's), a shadow ray to `light` (camera-relative) and one
 /// diffuse bounce (cosine-distributed about the face's normal, towards the eye's side, from a

@@ -6,27 +6,11 @@
 mod common;
 
 use common::{camera, ctx};
-use fisheye_rt::peer::{Agreement, Workload, with_embree};
-use fisheye_rt::scene::{Light, Scene, builtin};
+use fisheye_rt::peer::{Agreement, Workload, light, with_embree};
+use fisheye_rt::scene::{Scene, builtin};
 use fisheye_rt::trace::cast::{NO_HIT, RayCast};
 use fisheye_rt::trace::{GpuScene, RenderOptions};
 use glam::DVec3;
-
-/// The scene's first point light, else a point above its bounds, camera-relative.
-fn light(scene: &Scene) -> glam::Vec3 {
-    let at = scene
-        .lights
-        .iter()
-        .find_map(|l| match l {
-            Light::Point { position, .. } => Some(*position),
-            _ => None,
-        })
-        .unwrap_or_else(|| {
-            let (lo, hi) = scene.bounds().unwrap();
-            (lo + hi) / 2.0 + DVec3::Y * (hi - lo).length()
-        });
-    (at - scene.camera.position).as_vec3()
-}
 
 /// Both tracers cast the same f32 rays into the same f32 triangles, so they differ only where
 /// a ray passes within rounding of an edge (each breaks such ties its own way) or grazes a
