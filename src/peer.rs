@@ -11,6 +11,7 @@ use glam::{DVec3, Vec3};
 
 use crate::error::{Error, Result};
 use crate::scene::{MAX_FLATTENED, Scene};
+pub use crate::trace::cast::light;
 use crate::trace::cast::{CastHit, CastRay, NO_HIT};
 
 /// A scene committed to Embree (its default build quality), with the corners it was given.
@@ -78,13 +79,15 @@ pub fn with_embree<R>(scene: &Scene, work: impl FnOnce(&Embree, f64) -> R) -> Re
     Ok(work(&embree, seconds))
 }
 
-/// `rays` split over `threads` threads, each mapping its share with `each`.
-fn parallel<T: Send + Clone + Default>(
+/// `rays` split over `threads` threads, each mapping its share with `each` into answers that
+/// start as `blank`.
+fn parallel<T: Send + Clone>(
     rays: &[CastRay],
     threads: usize,
+    blank: T,
     each: impl Fn(&[CastRay], &mut [T]) + Sync,
 ) -> Vec<T> {
-    let mut out = vec![T::default(); rays.len()];
+    let mut out = vec![blank; rays.len()];
     let chunk = rays.len().div_ceil(threads.max(1)).max(1);
     std::thread::scope(|s| {
         for (input, output) in rays.chunks(chunk).zip(out.chunks_mut(chunk)) {
@@ -120,16 +123,10 @@ fn missed() -> CastHit {
     }
 }
 
-impl Default for CastHit {
-    fn default() -> Self {
-        missed()
-    }
-}
-
 impl Embree<'_> {
     /// The closest hits with `rtcIntersect1`, on `threads` threads.
     pub fn intersect1(&self, rays: &[CastRay], threads: usize) -> Vec<CastHit> {
-        parallel(rays, threads, |input, output| {
+        parallel(rays, threads, missed(), |input, output| {
             let mut context = embree::IntersectContext::incoherent();
             for (ray, out) in input.iter().zip(output) {
                 let mut hit = embree::RayHit::new(single(ray));
@@ -152,7 +149,7 @@ impl Embree<'_> {
 
     /// Whether anything is hit, with `rtcOccluded1`, on `threads` threads.
     pub fn occluded1(&self, rays: &[CastRay], threads: usize) -> Vec<bool> {
-        parallel(rays, threads, |input, output| {
+        parallel(rays, threads, false, |input, output| {
             let mut context = embree::IntersectContext::incoherent();
             for (ray, out) in input.iter().zip(output) {
                 let mut r = single(ray);
@@ -166,7 +163,7 @@ impl Embree<'_> {
     /// The closest hits with `rtcIntersect8` (packets of 8 consecutive rays, a coherent
     /// context), on `threads` threads.
     pub fn intersect8(&self, rays: &[CastRay], threads: usize) -> Vec<CastHit> {
-        parallel(rays, threads, |input, output| {
+        parallel(rays, threads, missed(), |input, output| {
             let mut context = embree::IntersectContext::coherent();
             for (batch, out) in input.chunks(8).zip(output.chunks_mut(8)) {
                 let mut packet = packet8(batch);
@@ -234,23 +231,6 @@ fn packet8(batch: &[CastRay]) -> Box<sys::RTCRayHit8> {
             instID: [[u32::MAX; 8]; 1],
         },
     })
-}
-
-/// Where the peer benchmark's shadow rays go, camera-relative: the scene's first point light,
-/// else a point above the middle of its bounds, as high as they are wide.
-pub fn light(scene: &Scene) -> Vec3 {
-    let at = scene
-        .lights
-        .iter()
-        .find_map(|l| match l {
-            crate::scene::Light::Point { position, .. } => Some(*position),
-            _ => None,
-        })
-        .unwrap_or_else(|| {
-            let (lo, hi) = scene.bounds().unwrap_or_default();
-            (lo + hi) / 2.0 + DVec3::Y * (hi - lo).length()
-        });
-    (at - scene.camera.position).as_vec3()
 }
 
 /// The rays of the peer benchmark, the same for both tracers: a lens's primary rays from the

@@ -6,7 +6,7 @@ mod common;
 
 use common::{camera, ctx};
 use fisheye_rt::scene::{Scene, builtin};
-use fisheye_rt::trace::cast::{CastRay, NO_HIT, RayCast};
+use fisheye_rt::trace::cast::{CastRay, NO_HIT, RayCast, light};
 use fisheye_rt::trace::cpu::Reference;
 use fisheye_rt::trace::{GpuScene, RenderOptions};
 use glam::DVec3;
@@ -38,19 +38,7 @@ fn agrees_with_the_reference(name: &str, scene: &Scene) {
     let hits = closest.cast(ctx(), &gpu_scene, &rays).unwrap();
     let (mut differ, mut hit, mut distance) = (0, 0, 0.0f64);
     let mut shadow_rays = Vec::new();
-    // The scene's first point light, else a point high above it.
-    let light = scene
-        .lights
-        .iter()
-        .find_map(|l| match l {
-            fisheye_rt::scene::Light::Point { position, .. } => Some(*position),
-            _ => None,
-        })
-        .unwrap_or_else(|| {
-            let (lo, hi) = scene.bounds().unwrap();
-            (lo + hi) / 2.0 + DVec3::Y * (hi - lo).length()
-        });
-    let light = (light - scene.camera.position).as_vec3();
+    let light = light(scene);
     for (d, h) in dirs.iter().zip(&hits) {
         let r = reference.trace(DVec3::ZERO, *d, 0.0, f64::INFINITY, false);
         match r {

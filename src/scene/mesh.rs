@@ -86,10 +86,7 @@ impl MeshBuilder {
         if self.meshes.is_empty() {
             return super::bounds(&self.triangles);
         }
-        let mut in_mesh = vec![false; self.triangles.len()];
-        for &(first, count) in &self.meshes {
-            in_mesh[first..first + count].fill(true);
-        }
+        let in_mesh = self.in_meshes(0);
         let world: Vec<[DVec3; 3]> = (0..self.triangles.len())
             .filter(|&i| !in_mesh[i])
             .map(|i| self.triangles[i])
@@ -126,10 +123,7 @@ impl MeshBuilder {
     pub fn transform_since(&mut self, first: usize, transform: DAffine3) {
         let normal_matrix = transform.matrix3.inverse().transpose();
         let mirrored = transform.matrix3.determinant() < 0.0;
-        let mut in_mesh = vec![false; self.triangles.len() - first];
-        for &(start, count) in self.meshes.iter().filter(|m| m.0 >= first) {
-            in_mesh[start - first..start - first + count].fill(true);
-        }
+        let in_mesh = self.in_meshes(first);
         for (mesh, placed) in &mut self.placed {
             if self.meshes[*mesh].0 >= first {
                 *placed = transform * *placed;
@@ -288,6 +282,16 @@ impl MeshBuilder {
         }
     }
 
+    /// For each triangle from `first` on, whether it belongs to a mesh (made from `first` on)
+    /// rather than to the world.
+    fn in_meshes(&self, first: usize) -> Vec<bool> {
+        let mut in_mesh = vec![false; self.triangles.len() - first];
+        for &(start, count) in self.meshes.iter().filter(|m| m.0 >= first) {
+            in_mesh[start - first..start - first + count].fill(true);
+        }
+        in_mesh
+    }
+
     /// Instances placed so far.
     pub fn placed_count(&self) -> usize {
         self.placed.len()
@@ -297,10 +301,7 @@ impl MeshBuilder {
     /// placed is left out).
     pub fn finish(self, lights: Vec<Light>, sky: Vec3, ambient: Vec3, camera: Camera) -> Scene {
         // The stored order: triangles of no mesh, then each placed mesh's.
-        let mut in_mesh = vec![false; self.triangles.len()];
-        for &(first, count) in &self.meshes {
-            in_mesh[first..first + count].fill(true);
-        }
+        let in_mesh = self.in_meshes(0);
         let mut order: Vec<usize> = (0..self.triangles.len()).filter(|&i| !in_mesh[i]).collect();
         let world_triangles = order.len();
         let mut mesh_first = vec![None; self.meshes.len()];

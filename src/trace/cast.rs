@@ -2,12 +2,33 @@
 //! (`wgsl/bvh.wgsl`, through `wgsl/cast.wgsl`) without lens or shading, for rays the caller
 //! makes (shadow rays, bounces, a peer's rays in the peer benchmark).
 
+use glam::{DVec3, Vec3};
+
 use super::GpuScene;
 use crate::error::Result;
 use crate::gpu::GpuContext;
+use crate::scene::{Light, Scene};
 use crate::shader;
 use crate::shared::WORKGROUP_1D;
 pub use crate::shared::{CastRay, NO_HIT};
+
+/// Where shadow rays of cast tests and the peer benchmark go, relative to the scene's camera
+/// (the upload origin): the scene's first point light, else a point above the middle of its
+/// bounds, as high as they are wide.
+pub fn light(scene: &Scene) -> Vec3 {
+    let at = scene
+        .lights
+        .iter()
+        .find_map(|l| match l {
+            Light::Point { position, .. } => Some(*position),
+            _ => None,
+        })
+        .unwrap_or_else(|| {
+            let (lo, hi) = scene.bounds().unwrap_or_default();
+            (lo + hi) / 2.0 + DVec3::Y * (hi - lo).length()
+        });
+    (at - scene.camera.position).as_vec3()
+}
 
 /// What a cast ray found.
 #[derive(Clone, Copy, Debug, PartialEq)]
