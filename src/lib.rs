@@ -9,7 +9,8 @@
 //! - [`gpu`]: the one place that creates the adapter and device.
 //! - [`shared`]: what the GPU and Rust share (ids, limits, workgroup sizes, `repr(C)`
 //!   structs), read by everything and reading nothing.
-//! - [`shader`]: how WGSL files are assembled into modules.
+//! - [`shader`]: how WGSL files are assembled into modules; [`split`]: the scene's arrays
+//!   split across as many storage bindings as they need.
 //! - [`scene`], [`bvh`], [`trace`]: scenes (built-in, OBJ, glTF and scene files), the CWBVH,
 //!   and the GPU tracer with its f64 reference.
 //! - [`renderer`]: rendering on the caller's device into the caller's texture and encoder.
@@ -55,6 +56,7 @@ pub mod renderer;
 pub mod scene;
 pub mod shader;
 pub mod shared;
+pub mod split;
 pub mod trace;
 
 // The tools of the `fisheye` command (the default `cli` feature).

@@ -1,11 +1,18 @@
 //! WGSL assembly: every shader file is embedded, `#import NAME` lines pull in shared files
 //! (each once, dependencies first), and constants defined once in Rust ([`crate::shared`]) are
 //! prepended as WGSL `const` lines. Pipeline specialisations (lens model, direction formula) are WGSL
-//! `override`s, set per pipeline.
+//! `override`s, set per pipeline. One module is generated rather than embedded:
+//! `scene_arrays`, the scene's arrays split across as many storage bindings as the scene
+//! needs ([`crate::split`]), so kernels that read a scene are composed for it
+//! ([`compose_for`]).
 
 use std::fmt::Write;
 
 use crate::shared::{wgsl_constants, wgsl_faces, wgsl_float_constants};
+use crate::split::SceneArrays;
+
+/// The name `#import` gives the generated module of the scene's arrays.
+const SCENE_ARRAYS: &str = "scene_arrays";
 
 /// Every WGSL file of the project, by name (its file stem under `wgsl/`).
 pub const FILES: [(&str, &str); 24] = [
@@ -50,6 +57,7 @@ fn file(name: &str) -> &'static str {
 /// the `enable` directives (which WGSL wants before any declaration).
 #[derive(Default)]
 struct Composition {
+    arrays: SceneArrays,
     seen: Vec<String>,
     swaps: Vec<(String, String)>,
     enables: Vec<String>,
@@ -68,6 +76,11 @@ impl Composition {
             return;
         }
         self.seen.push(name.clone());
+        if name == SCENE_ARRAYS {
+            writeln!(self.body, "// ---- {SCENE_ARRAYS}").unwrap();
+            self.body.push_str(&self.arrays.wgsl());
+            return;
+        }
         let text = file(&name);
         for line in text.lines().map(str::trim) {
             if let Some((from, to)) = line.strip_prefix("#swap ").and_then(|s| s.split_once(' ')) {
@@ -94,9 +107,18 @@ impl Composition {
 
 /// The complete WGSL source of the module whose entry file is `entry`: its `enable`
 /// directives, the constants, then every file it imports (dependencies first, each once; a
-/// `#swap A B` line makes later `#import A`s pull in `B` instead), then the entry file.
+/// `#swap A B` line makes later `#import A`s pull in `B` instead), then the entry file; a
+/// scene's arrays each in one binding.
 pub fn compose(entry: &str) -> String {
-    let mut c = Composition::default();
+    compose_for(entry, &SceneArrays::default())
+}
+
+/// As [`compose`], for a scene whose arrays are split as `arrays` says.
+pub fn compose_for(entry: &str, arrays: &SceneArrays) -> String {
+    let mut c = Composition {
+        arrays: *arrays,
+        ..Default::default()
+    };
     c.append(entry);
     let mut out = String::new();
     for enable in &c.enables {
@@ -115,9 +137,10 @@ pub fn compose(entry: &str) -> String {
     out
 }
 
-/// Creates the shader module for `entry`, labelled `fisheye.<entry>`.
-pub fn module(device: &wgpu::Device, entry: &str) -> wgpu::ShaderModule {
-    module_from(device, entry, compose(entry))
+/// Creates the shader module for `entry`, labelled `fisheye.<entry>`, for a scene whose
+/// arrays are split as `arrays` says (the default for kernels that read no scene).
+pub fn module(device: &wgpu::Device, entry: &str, arrays: &SceneArrays) -> wgpu::ShaderModule {
+    module_from(device, entry, compose_for(entry, arrays))
 }
 
 fn module_from(device: &wgpu::Device, entry: &str, source: String) -> wgpu::ShaderModule {
@@ -138,7 +161,21 @@ pub fn compute_pipeline(
     constants: &[(&str, f64)],
     layouts: &[&wgpu::BindGroupLayout],
 ) -> wgpu::ComputePipeline {
-    compute_pipeline_edited(device, file, |s| s, entry_point, constants, layouts)
+    pipeline_from(device, file, compose(file), entry_point, constants, layouts)
+}
+
+/// As [`compute_pipeline`], for a kernel that reads a scene whose arrays are split as
+/// `arrays` says.
+pub fn scene_pipeline(
+    device: &wgpu::Device,
+    file: &str,
+    arrays: &SceneArrays,
+    entry_point: &str,
+    constants: &[(&str, f64)],
+    layouts: &[&wgpu::BindGroupLayout],
+) -> wgpu::ComputePipeline {
+    let source = compose_for(file, arrays);
+    pipeline_from(device, file, source, entry_point, constants, layouts)
 }
 
 /// As [`compute_pipeline`], with the composed source passed through `edit` first: WGSL has no
@@ -148,6 +185,24 @@ pub fn compute_pipeline_edited(
     device: &wgpu::Device,
     file: &str,
     edit: impl FnOnce(String) -> String,
+    entry_point: &str,
+    constants: &[(&str, f64)],
+    layouts: &[&wgpu::BindGroupLayout],
+) -> wgpu::ComputePipeline {
+    pipeline_from(
+        device,
+        file,
+        edit(compose(file)),
+        entry_point,
+        constants,
+        layouts,
+    )
+}
+
+fn pipeline_from(
+    device: &wgpu::Device,
+    file: &str,
+    source: String,
     entry_point: &str,
     constants: &[(&str, f64)],
     layouts: &[&wgpu::BindGroupLayout],
@@ -165,7 +220,7 @@ pub fn compute_pipeline_edited(
     device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
         label: Some(&label),
         layout: layout.as_ref(),
-        module: &module_from(device, file, edit(compose(file))),
+        module: &module_from(device, file, source),
         entry_point: Some(entry_point),
         compilation_options: wgpu::PipelineCompilationOptions {
             constants,
@@ -204,11 +259,26 @@ pub(crate) fn assert_wgsl_layout(file: &str, name: &str, size: usize, fields: &[
 mod tests {
     use super::*;
 
-    /// Parses and validates every WGSL file, composed with its imports, with naga: no GPU.
+    /// Parses and validates every WGSL file, composed with its imports, with naga: no GPU;
+    /// those that read a scene also with its arrays split into several bindings.
     #[test]
     fn every_wgsl_file_validates() {
-        for (name, _) in FILES {
-            let source = compose(name);
+        let split = SceneArrays::plan(1 << 20, 30_000, 50_000, 200_000);
+        let reads_scene = |name: &str| compose(name).contains("// ---- scene_arrays\n");
+        let readers: Vec<&str> = FILES
+            .iter()
+            .map(|(name, _)| *name)
+            .filter(|name| reads_scene(name))
+            .collect();
+        for kernel in ["trace", "trace_rq", "cast", "raster", "raster_multiview"] {
+            assert!(readers.contains(&kernel), "{kernel} reads the scene");
+        }
+        let sources = FILES.iter().map(|(name, _)| (*name, compose(name))).chain(
+            readers
+                .iter()
+                .map(|name| (*name, compose_for(name, &split))),
+        );
+        for (name, source) in sources {
             let module = naga::front::wgsl::parse_str(&source)
                 .unwrap_or_else(|e| panic!("{name}: {}", e.emit_to_string(&source)));
             naga::valid::Validator::new(

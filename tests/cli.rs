@@ -205,6 +205,22 @@ fn info_reports_adapter_features_and_precision() {
     }
 }
 
+/// `info --scene` builds and uploads the scene and says what it takes: the grid's twelve
+/// triangles (two a face of its cube), 48 bytes of geometry each (`GpuTriangle`), and the
+/// limits a split scene meets.
+#[test]
+fn info_reports_a_scenes_bytes_per_triangle() {
+    let text = stdout(&fisheye(&["info", "--scene", "builtin:grid"], ""));
+    for needle in [
+        "storage buffers a stage",
+        "scene: builtin:grid, 12 triangles;",
+        "bytes a stored triangle (geometry 48, BVH",
+    ] {
+        assert!(text.contains(needle), "{needle} missing from:\n{text}");
+    }
+    assert!(!text.contains("split across"), "{text}");
+}
+
 #[test]
 fn demo_writes_one_png_per_lens() {
     let dir = std::env::temp_dir().join(format!("fisheye-demo-test-{}", std::process::id()));

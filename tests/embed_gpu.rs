@@ -217,6 +217,57 @@ fn a_device_below_the_required_limits_is_refused_naming_the_limit() {
     );
 }
 
+/// A scene split across storage bindings needs one more storage buffer per chunk beyond each
+/// array's first: on a device with exactly the documented storage buffers (and 1 MiB
+/// bindings, so that the grid's 12 triangles take one and a scene of 30,000 triangles
+/// two) the first uploads and the second is refused with the chunks, the buffers and the
+/// limit; a device with one storage buffer more uploads it.
+#[test]
+fn split_scenes_need_the_storage_buffers_they_name() {
+    use fisheye_rt::scene::{Material, MeshBuilder};
+    let mut limits = fisheye_rt::renderer::required_limits();
+    limits.max_storage_buffer_binding_size = 1 << 20;
+    let options = RenderOptions::default();
+    let mut b = MeshBuilder::new();
+    let grey = b.material(Material::diffuse("grey", glam::Vec3::splat(0.8)));
+    for i in 0..30_000 {
+        let p = DVec3::new(f64::from(i % 200), f64::from(i / 200), -10.0);
+        b.triangle([p, p + DVec3::X, p + DVec3::Y], None, None, grey);
+    }
+    let camera = Camera {
+        position: DVec3::new(100.0, 75.0, 50.0),
+        look_at: DVec3::new(100.0, 75.0, -10.0),
+        up: DVec3::Y,
+    };
+    let large = b.finish(Vec::new(), glam::Vec3::ONE, glam::Vec3::ZERO, camera);
+    let (device, queue) = device_with(limits.clone());
+    let ctx = GpuContext::from_device(&device, &queue);
+    let grid = builtin::scene("grid").unwrap();
+    assert!(
+        !GpuScene::new(&ctx, &grid, &options)
+            .unwrap()
+            .arrays
+            .is_split()
+    );
+    let message = GpuScene::new(&ctx, &large, &options)
+        .err()
+        .expect("refused")
+        .to_string();
+    for wanted in [
+        "30000 triangles are too many for this device",
+        "storage bindings of at most 1.00 MiB",
+        "take 1, 2 and 1 bindings",
+        "would bind 13 storage buffers, above the device's limit of 12 per shader stage",
+    ] {
+        assert!(message.contains(wanted), "{message:?} lacks {wanted:?}");
+    }
+    limits.max_storage_buffers_per_shader_stage += 1;
+    let (device, queue) = device_with(limits);
+    let ctx = GpuContext::from_device(&device, &queue);
+    let split = GpuScene::new(&ctx, &large, &options).unwrap();
+    assert_eq!(split.arrays.triangles.chunks, 2);
+}
+
 /// Textures the renderer cannot write are errors that say what it writes.
 #[test]
 fn unwritable_targets_are_errors_naming_what_is_wanted() {

@@ -278,3 +278,102 @@ fn a_thousand_instances_render() {
     instances.dedup();
     assert!(instances.len() > 50, "{} instances seen", instances.len());
 }
+
+/// A scene whose nodes, triangles and shading data each exceed one storage binding is stored
+/// in several (`fisheye_rt::split`; forced here on an adapter whose bindings stop at a third
+/// of the triangles' bytes) and gives bit for bit what it gives in one binding each: the
+/// placed scene instanced and flattened (smooth normals, UVs, a texture, mirror and glass),
+/// traced, cast (closest and any hit), and the flattened one rasterized into a cube map;
+/// and with ray queries, where the adapter has them, the same triangle on every ray (one
+/// geometry per chunk in the acceleration structure).
+#[test]
+fn scenes_split_across_bindings_render_bit_identically() {
+    use fisheye_rt::cube::{CubeMap, CubeMethod, CubeSettings};
+    use fisheye_rt::gpu::GpuContext;
+    use fisheye_rt::raster::RasterMethod;
+    use fisheye_rt::trace::Traversal;
+    use fisheye_rt::trace::cast::{CastRay, RayCast};
+    let instanced = placed_scene();
+    let flat = instanced.flattened(usize::MAX).unwrap();
+    let options = RenderOptions::default();
+    let lens = camera(LENS, 64, 48);
+    for (name, scene) in [("instanced", &instanced), ("flattened", &flat)] {
+        let whole = GpuScene::new(ctx(), scene, &options).unwrap();
+        assert!(!whole.arrays.is_split(), "{name}");
+        // Bindings of a third of the triangles' bytes: three chunks of them or more, and more
+        // of the shading data (80 bytes a triangle). The instanced scene's few nodes are split
+        // too, at half their bytes (the flattened one's would take too many bindings: lavapipe
+        // has 48 a stage). The rest of the scene's buffers (the texture's 16 KiB) and the
+        // 64x48 outputs (in bands) fit.
+        let nodes = 80 * whole.bvh_nodes as u64;
+        let third = whole.bytes.geometry / 3;
+        let limit = if scene.is_instanced() {
+            third.min(nodes / 2).max(1 << 14)
+        } else {
+            third
+        };
+        let small = GpuContext::with_binding_limit(limit).unwrap();
+        let split = GpuScene::new(&small, scene, &options).unwrap();
+        let arrays = split.arrays;
+        eprintln!("{name}: {arrays:?} at {limit} bytes a binding");
+        assert!(
+            arrays.triangles.chunks >= 3
+                && arrays.vertices.chunks >= 3
+                && (arrays.nodes.chunks >= 2 || !scene.is_instanced()),
+            "{name}: {arrays:?}"
+        );
+        assert_eq!(split.bytes, whole.bytes, "{name}: the same bytes, split");
+        let a = render(ctx(), scene, &lens, &options).unwrap();
+        let b = render(&small, scene, &lens, &options).unwrap();
+        assert!(a.counts().1 > 500, "{name}: the scene is in view");
+        assert!(a.ids == b.ids, "{name}: ids");
+        assert!(a.geometry == b.geometry, "{name}: geometry");
+        assert!(a.colour == b.colour, "{name}: colour");
+        let rays: Vec<CastRay> = lens
+            .directions()
+            .into_iter()
+            .flatten()
+            // Every eighth pixel's: 384 rays of 32 bytes fit the small binding.
+            .step_by(8)
+            .map(|d| CastRay {
+                origin: [0.0; 3],
+                tmin: 0.0,
+                dir: (scene.camera.rotation() * d).as_vec3().to_array(),
+                tmax: 12.0,
+            })
+            .collect();
+        for any_hit in [false, true] {
+            let cast = |ctx: &GpuContext, gpu: &GpuScene| {
+                let pass = RayCast::new(ctx, gpu, any_hit).unwrap();
+                pass.cast(ctx, gpu, &rays).unwrap()
+            };
+            assert!(
+                cast(ctx(), &whole) == cast(&small, &split),
+                "{name}: cast, any hit {any_hit}"
+            );
+        }
+        // (Ray queries take an instanced scene flattened: the flattened one covers both.)
+        if ctx().has(wgpu::Features::EXPERIMENTAL_RAY_QUERY) && !scene.is_instanced() {
+            let rq = RenderOptions {
+                traversal: Traversal::RayQuery,
+                ..options
+            };
+            let a = render(ctx(), scene, &lens, &rq).unwrap();
+            let b = render(&small, scene, &lens, &rq).unwrap();
+            assert!(a.ids == b.ids, "{name}: ray-query ids");
+        }
+        if scene.is_instanced() {
+            continue;
+        }
+        let settings = CubeSettings::new(24, CubeMethod::Raster(RasterMethod::Forward));
+        let lens = camera(LENS, 32, 24);
+        let cube = |ctx: &GpuContext, gpu: &GpuScene| {
+            let cube = CubeMap::new(ctx, &lens, gpu, &settings).unwrap();
+            cube.render(ctx, gpu, &scene.camera).unwrap()
+        };
+        assert!(
+            cube(ctx(), &whole) == cube(&small, &split),
+            "rasterized cube map"
+        );
+    }
+}

@@ -11,7 +11,8 @@
 // [2] child_min_x[0..8], child_max_x[0..8]   (two words each)
 // [3] child_min_y, child_max_y
 // [4] child_min_z, child_max_z
-@group(1) @binding(0) var<storage, read> bvh_nodes: array<vec4<u32>>;
+// read by `node_word(node, word)` from `bvh_nodes` (group 1, binding 0) and, in a scene too
+// large for one binding, its further chunks (see `fisheye_rt::split`).
 
 // 4 ulp: covers the roundings of the slab test and of obvhs's quantization.
 const BOX_PAD: f32 = 4.0 * 1.1920929e-7;
@@ -53,7 +54,7 @@ fn edge(a: f32, d: f32, b: f32, c: f32) -> f32 {
 
 // Watertight ray/triangle test; returns (t, u, v, 1) on a hit within (tmin, tmax], else 0.
 fn triangle_hit(slot: u32, ray: Ray, sh: Shear) -> vec4<f32> {
-    let tri = bvh_triangles[slot];
+    let tri = triangle_at(slot);
     let a = tri.v0 - ray.origin;
     let b = tri.v1 - ray.origin;
     let c = tri.v2 - ray.origin;
@@ -91,11 +92,11 @@ fn byte_of(pair: vec2<u32>, i: u32) -> u32 {
 // Tests a node's eight children; returns obvhs's hit mask: internal children in the top byte
 // (ordered by octant), leaf primitives in the low 24 bits.
 fn node_hits(index: u32, ray: Ray, inv_dir: vec3<f32>, oct_inv: u32, tmax: f32) -> u32 {
-    let n0 = bvh_nodes[5u * index];
-    let n1 = bvh_nodes[5u * index + 1u];
-    let n2 = bvh_nodes[5u * index + 2u];
-    let n3 = bvh_nodes[5u * index + 3u];
-    let n4 = bvh_nodes[5u * index + 4u];
+    let n0 = node_word(index, 0u);
+    let n1 = node_word(index, 1u);
+    let n2 = node_word(index, 2u);
+    let n3 = node_word(index, 3u);
+    let n4 = node_word(index, 4u);
     let p = bitcast<vec3<f32>>(n0.xyz);
     let e = vec3<f32>(
         bitcast<f32>((n0.w & 0xffu) << 23u),
@@ -181,8 +182,8 @@ fn walk_next(w: ptr<function, Walk>, ray: Ray, inv_dir: vec3<f32>, oct_inv: u32,
         let slot = (bit - 24u) ^ oct_inv;
         let index = (*w).nodes.x + countOneBits(hits_imask & ~(0xffffffffu << slot));
         let mask = node_hits(index, ray, inv_dir, oct_inv, tmax);
-        let header = bvh_nodes[5u * index + 1u];
-        (*w).nodes = vec2<u32>(header.x, (mask & 0xff000000u) | (bvh_nodes[5u * index].w >> 24u));
+        let header = node_word(index, 1u);
+        (*w).nodes = vec2<u32>(header.x, (mask & 0xff000000u) | (node_word(index, 0u).w >> 24u));
         (*w).leaves = vec2<u32>(header.y, mask & 0x00ffffffu);
         if (*w).leaves.y != 0u {
             found = true;

@@ -1,7 +1,8 @@
 // Traversal by hardware ray queries (wgpu's EXPERIMENTAL_RAY_QUERY), in place of `bvh.wgsl`'s
 // software traversal: the same `bvh_trace`. The acceleration structure is built over the very
-// triangle buffer the software traversal reads (its corners as vertices, three per BVH slot,
-// no index buffer), so a hit's primitive index is its slot.
+// triangle buffers the software traversal reads (its corners as vertices, three per BVH slot,
+// no index buffer; a geometry per chunk), so a hit's geometry and primitive indices give its
+// slot.
 enable wgpu_ray_query;
 #import triangles
 
@@ -22,5 +23,6 @@ fn bvh_trace(ray: Ray, any_hit: bool) -> Hit {
     if hit.kind != RAY_QUERY_INTERSECTION_TRIANGLE {
         return Hit(0.0, 0.0, 0.0, NO_HIT, 0u);
     }
-    return Hit(hit.t, hit.barycentrics.x, hit.barycentrics.y, hit.primitive_index, 0u);
+    let slot = (hit.geometry_index << TRIANGLE_CHUNK_SHIFT) | hit.primitive_index;
+    return Hit(hit.t, hit.barycentrics.x, hit.barycentrics.y, slot, 0u);
 }

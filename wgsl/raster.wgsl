@@ -51,7 +51,7 @@ struct Varyings {
 
 // Vertex `vertex` of a draw of the whole scene: corner `vertex % 3` of BVH slot `vertex / 3`.
 fn corner(vertex: u32) -> vec3<f32> {
-    let tri = bvh_triangles[vertex / 3u];
+    let tri = triangle_at(vertex / 3u);
     switch vertex % 3u {
         case 0u: {
             return tri.v0;

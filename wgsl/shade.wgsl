@@ -44,7 +44,7 @@ fn shadow_transmittance(origin: vec3<f32>, to_light: vec3<f32>, distance: f32) -
         if hit.slot == NO_HIT {
             return transmittance;
         }
-        let tri = bvh_triangles[hit.slot];
+        let tri = triangle_at(hit.slot);
         let m = materials[tri.material];
         transmittance *= 1.0 - m.opacity;
         if m.surface != SURFACE_DIFFUSE || transmittance < MIN_WEIGHT || layer == MAX_SHADOW_LAYERS {

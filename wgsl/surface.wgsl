@@ -44,8 +44,8 @@ struct Shading {
 @group(1) @binding(2) var<storage, read> materials: array<Material>;
 @group(1) @binding(3) var<storage, read> lights: array<Light>;
 // Per scene triangle: three vertex normals (xyz) when SMOOTH_NORMALS, then three UV pairs
-// packed in two vec4 when TEXTURES; see `fisheye_rt::trace::shading_vertices`.
-@group(1) @binding(4) var<storage, read> vertex_data: array<vec4<f32>>;
+// packed in two vec4 when TEXTURES; see `fisheye_rt::trace::shading_vertices`. `vertex_at`
+// reads them from `vertex_data` (group 1, binding 4) and its further chunks, if any.
 // Per texture: first texel, width, height, unused.
 @group(1) @binding(5) var<storage, read> texture_info: array<vec4<u32>>;
 // RGBA8 sRGB texels of every texture.
@@ -107,7 +107,7 @@ fn vertex_normal(hit: Hit, n: vec3<f32>) -> vec3<f32> {
 }
 
 fn surface_at(ray: Ray, hit: Hit) -> Surface {
-    let tri = bvh_triangles[hit.slot];
+    let tri = triangle_at(hit.slot);
     var material = materials[tri.material];
     let w = 1.0 - hit.u - hit.v;
     let position = hit_position(hit);
@@ -127,9 +127,9 @@ fn surface_at(ray: Ray, hit: Hit) -> Surface {
     let base = tri.triangle * stride;
     if SMOOTH_NORMALS {
         // Each vertex normal in the world before interpolation, as a flattened copy has it.
-        let n = normalize(w * vertex_normal(hit, vertex_data[base].xyz)
-            + hit.u * vertex_normal(hit, vertex_data[base + 1u].xyz)
-            + hit.v * vertex_normal(hit, vertex_data[base + 2u].xyz));
+        let n = normalize(w * vertex_normal(hit, vertex_at(base).xyz)
+            + hit.u * vertex_normal(hit, vertex_at(base + 1u).xyz)
+            + hit.v * vertex_normal(hit, vertex_at(base + 2u).xyz));
         // Keep the interpolated normal on the side the ray came from.
         normal = select(-n, n, dot(n, geometric) >= 0.0);
     }
@@ -138,8 +138,8 @@ fn surface_at(ray: Ray, hit: Hit) -> Surface {
         if SMOOTH_NORMALS {
             uv_base += 3u;
         }
-        let a = vertex_data[uv_base];
-        let b = vertex_data[uv_base + 1u];
+        let a = vertex_at(uv_base);
+        let b = vertex_at(uv_base + 1u);
         let uv = w * a.xy + hit.u * a.zw + hit.v * b.xy;
         material.diffuse *= sample_texture(material.texture, uv);
     }

@@ -12,7 +12,9 @@ struct BvhTriangle {
     pad: u32,
 }
 
-@group(1) @binding(1) var<storage, read> bvh_triangles: array<BvhTriangle>;
+// `triangle_at(slot)` reads them from `bvh_triangles` (group 1, binding 1) and, in a scene
+// too large for one binding, its further chunks (see `fisheye_rt::split`).
+#import scene_arrays
 
 // Mirrors `fisheye_rt::bvh::GpuInstance` (144 bytes): a mesh placed in the world.
 struct Instance {
@@ -56,7 +58,7 @@ struct Hit {
     // Barycentric weights of v1 and v2 (v0's is 1 - u - v).
     u: f32,
     v: f32,
-    // Index into bvh_triangles, NO_HIT if none.
+    // Index into the triangles (`triangle_at`), NO_HIT if none.
     slot: u32,
     // Index into instances (instanced scenes only).
     instance: u32,
@@ -64,7 +66,7 @@ struct Hit {
 
 // The scene triangle a BVH slot is in a given instance (as ids name it).
 fn scene_triangle(slot: u32, instance: u32) -> u32 {
-    let stored = bvh_triangles[slot].triangle;
+    let stored = triangle_at(slot).triangle;
     if INSTANCED {
         let i = instances[instance];
         return i.id_base + stored - i.first;
@@ -84,14 +86,14 @@ fn world_normal(hit: Hit, n: vec3<f32>) -> vec3<f32> {
 // The geometric normal of the hit's triangle in the world, its corners' winding on the same
 // side as a flattened copy's (not normalized).
 fn hit_face_normal(hit: Hit) -> vec3<f32> {
-    let tri = bvh_triangles[hit.slot];
+    let tri = triangle_at(hit.slot);
     return world_normal(hit, cross(tri.v1 - tri.v0, tri.v2 - tri.v0));
 }
 
 // The point of `hit` on its triangle, camera-relative, from the barycentrics (on the triangle
 // to within its rounding, unlike o + t·d).
 fn hit_position(hit: Hit) -> vec3<f32> {
-    let tri = bvh_triangles[hit.slot];
+    let tri = triangle_at(hit.slot);
     let p = (1.0 - hit.u - hit.v) * tri.v0 + hit.u * tri.v1 + hit.v * tri.v2;
     if INSTANCED {
         return affine(instances[hit.instance].to_world, p);

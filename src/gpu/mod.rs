@@ -403,8 +403,9 @@ impl GpuContext {
             out.push_str(&format!("  {name:<28} {mark}\n"));
         }
         out.push_str(&format!(
-            "limits:\n  max storage binding          {} MiB\n  max buffer size              {} MiB\n  max 2D texture side          {}\n",
+            "limits:\n  max storage binding          {} MiB\n  storage buffers a stage      {}\n  max buffer size              {} MiB\n  max 2D texture side          {}\n",
             limits.max_storage_buffer_binding_size >> 20,
+            limits.max_storage_buffers_per_shader_stage,
             limits.max_buffer_size >> 20,
             limits.max_texture_dimension_2d,
         ));

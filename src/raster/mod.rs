@@ -98,13 +98,14 @@ fn depth_attachment(view: &wgpu::TextureView) -> wgpu::RenderPassDepthStencilAtt
 /// `fragment` is the entry point and colour format, `None` for depth only.
 fn raster_pipeline(
     device: &wgpu::Device,
+    arrays: &crate::split::SceneArrays,
     constants: &[(&str, f64)],
     layouts: &[&wgpu::BindGroupLayout],
     file: &str,
     (vertex, multiview_mask): (&str, Option<NonZeroU32>),
     fragment: Option<(&str, wgpu::TextureFormat)>,
 ) -> wgpu::RenderPipeline {
-    let module = shader::module(device, file);
+    let module = shader::module(device, file, arrays);
     let options = wgpu::PipelineCompilationOptions {
         constants,
         ..Default::default()
@@ -310,9 +311,10 @@ impl RasterFaces {
                         wgpu::BindingResource::TextureView(&write),
                     ],
                 );
-                let pipeline = shader::compute_pipeline(
+                let pipeline = shader::scene_pipeline(
                     device,
                     "raster",
+                    &scene.arrays,
                     "deferred_lighting",
                     &constants,
                     &[&layout, &scene.layout, &shadows.lookup_layout],
@@ -329,6 +331,7 @@ impl RasterFaces {
             };
             let draw = raster_pipeline(
                 device,
+                &scene.arrays,
                 &constants,
                 layouts,
                 file,

@@ -188,6 +188,7 @@ impl ShadowMaps {
             });
             let pipeline = raster_pipeline(
                 device,
+                &scene.arrays,
                 &surface_constants(scene.features),
                 &[&empty, &scene.layout, &render_layout],
                 "raster",

@@ -6,7 +6,7 @@ use super::mesh::checker;
 use super::{Camera, Light, Material, MeshBuilder, Scene};
 
 /// The names `builtin:NAME` accepts, with what each shows.
-pub const SCENES: [(&str, &str); 6] = [
+pub const SCENES: [(&str, &str); 7] = [
     (
         "default",
         "a room with checker floor and grid walls, a mirror and a glass sphere, shadows and many small objects",
@@ -31,6 +31,10 @@ pub const SCENES: [(&str, &str); 6] = [
         "instances-few",
         "the first 20 of those instances (2M triangles), small enough to flatten for comparison",
     ),
+    (
+        "terrain",
+        "10M triangles of rolling hills seen from a drone (a 2,237 x 2,237 heightfield): a scene beyond one storage binding",
+    ),
 ];
 
 /// The built-in scene called `name`, or `None`.
@@ -42,6 +46,7 @@ pub fn scene(name: &str) -> Option<Scene> {
         "few-detailed" => Some(few_detailed()),
         "instances" => Some(instances(1000)),
         "instances-few" => Some(instances(20)),
+        "terrain" => Some(terrain(TERRAIN_SIDE)),
         _ => None,
     }
 }
@@ -399,6 +404,72 @@ fn few_detailed() -> Scene {
     scene
 }
 
+/// Quads a side of the built-in terrain: 2 × 2237² = 10,008,338 triangles.
+const TERRAIN_SIDE: usize = 2237;
+
+/// The terrain's height at `(x, z)`: seven waves of falling amplitude, each along its own
+/// direction with its own phase, from the hash (rolling hills up to about 35 m).
+fn terrain_height(x: f64, z: f64) -> f64 {
+    (0..7u64)
+        .map(|k| {
+            let angle = std::f64::consts::TAU * unit(k, 11);
+            let wavelength = 400.0 / 1.9f64.powi(k as i32);
+            let along = x * angle.cos() + z * angle.sin();
+            let phase = std::f64::consts::TAU * unit(k, 12);
+            wavelength / 25.0 * (std::f64::consts::TAU * along / wavelength + phase).sin()
+        })
+        .sum()
+}
+
+/// A heightfield of `side` × `side` quads over a square kilometre, two triangles each, in
+/// three materials by height (meadow, rock, snow), with a drone camera 80 m above the middle
+/// looking ahead and down.
+fn terrain(side: usize) -> Scene {
+    let mut b = MeshBuilder::new();
+    let bands = [
+        (
+            -1e9,
+            b.material(Material::diffuse("meadow", Vec3::new(0.1, 0.2, 0.05))),
+        ),
+        (
+            8.0,
+            b.material(Material::diffuse("rock", Vec3::new(0.22, 0.19, 0.16))),
+        ),
+        (
+            20.0,
+            b.material(Material::diffuse("snow", Vec3::splat(0.8))),
+        ),
+    ];
+    let step = 1000.0 / side as f64;
+    let at = |i: usize, j: usize| {
+        let (x, z) = (i as f64 * step - 500.0, j as f64 * step - 500.0);
+        DVec3::new(x, terrain_height(x, z), z)
+    };
+    let mut row: Vec<DVec3> = (0..=side).map(|i| at(i, 0)).collect();
+    for j in 0..side {
+        let next: Vec<DVec3> = (0..=side).map(|i| at(i, j + 1)).collect();
+        for i in 0..side {
+            let [a, b1, c, d] = [row[i], row[i + 1], next[i], next[i + 1]];
+            let height = (a.y + b1.y + c.y + d.y) / 4.0;
+            let material = bands
+                .iter()
+                .rev()
+                .find(|(h, _)| height >= *h)
+                .expect("a band")
+                .1;
+            b.triangle([a, c, b1], None, None, material);
+            b.triangle([b1, c, d], None, None, material);
+        }
+        row = next;
+    }
+    let ground = terrain_height(0.0, 0.0);
+    outdoors(
+        b,
+        DVec3::new(0.0, ground + 80.0, 0.0),
+        DVec3::new(0.0, ground, -100.0),
+    )
+}
+
 /// `count` instances of one 100,000-triangle torus standing on a plane, in rows of 40 across
 /// a field 80 m wide, each turned, scaled and coloured by its own hash (the mesh has one
 /// material, so colour comes from the scale's spread under the sun).
@@ -454,8 +525,13 @@ mod tests {
 
     #[test]
     fn every_builtin_scene_builds_and_is_sized_as_documented() {
+        // The terrain at full size takes seconds and a gigabyte to build: here at a tenth.
+        let small_terrain = || terrain(TERRAIN_SIDE / 10);
         for (name, _) in SCENES {
-            let s = scene(name).unwrap();
+            let s = match name {
+                "terrain" => small_terrain(),
+                _ => scene(name).unwrap(),
+            };
             assert!(!s.is_empty(), "{name}");
             assert_eq!(s.material_of.len(), s.triangles.len());
             assert!(
@@ -475,6 +551,8 @@ mod tests {
             (100_000_002, 100_002)
         );
         assert_eq!(scene("instances-few").unwrap().len(), 2_000_002);
+        assert_eq!(small_terrain().len(), 2 * (TERRAIN_SIDE / 10).pow(2));
+        assert!(2 * TERRAIN_SIDE.pow(2) >= 10_000_000);
         let room = scene("default").unwrap().features();
         assert!(room.mirrors && room.glass && room.textures && room.smooth_normals);
         assert!(scene("no-such").is_none());

@@ -72,9 +72,10 @@ impl RayCast {
                     ],
                 });
             Self {
-                pipeline: shader::compute_pipeline(
+                pipeline: shader::scene_pipeline(
                     &ctx.device,
                     "cast",
+                    &scene.arrays,
                     "main",
                     &constants,
                     &[&layout, &scene.layout],

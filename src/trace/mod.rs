@@ -34,6 +34,8 @@ use crate::lens::LensCamera;
 use crate::lens::gpu::{DirectionSource, LensRays, lens_constants, params_buffer};
 use crate::scene::{Camera, Features, Scene, Surface};
 use crate::shader;
+use crate::shared::TRACE_STORAGE_BUFFERS;
+use crate::split::{SceneArrays, Split};
 
 /// Bytes between the frame uniforms of a [`TracePass`]'s views: wgpu's default (and largest)
 /// `min_uniform_buffer_offset_alignment`.
@@ -141,32 +143,11 @@ fn shading_vectors_per_triangle(f: Features) -> usize {
     3 * usize::from(f.smooth_normals) + 2 * usize::from(f.textures)
 }
 
-/// Refuses a scene whose triangles, shading data or texels would not fit one storage binding
-/// of the adapter, with the numbers, before the BVH is built for nothing.
-fn check_scene_size(ctx: &GpuContext, scene: &Scene, features: Features) -> Result<()> {
+/// Refuses a scene whose textures would not fit one storage binding of the adapter, with the
+/// numbers, before the BVH is built for nothing. (Triangles, nodes and shading data are split
+/// across as many bindings as they need: [`check_bindings`].)
+fn check_textures(ctx: &GpuContext, scene: &Scene, features: Features) -> Result<()> {
     let limit = ctx.device.limits().max_storage_buffer_binding_size;
-    // Instances share their mesh's triangles: what is stored counts.
-    let triangles = scene.triangles.len() as u64;
-    let mib = |bytes: u64| bytes as f64 / f64::from(1 << 20);
-    let per_triangle = [
-        ("triangle data", size_of::<crate::bvh::GpuTriangle>() as u64),
-        (
-            "shading data (vertex normals and UVs)",
-            16 * shading_vectors_per_triangle(features) as u64,
-        ),
-    ];
-    for (what, each) in per_triangle {
-        if each * triangles > limit {
-            return Err(Error::Limit(format!(
-                "{triangles} triangles are too many for this adapter: their {what} takes \
-                 {:.1} MiB ({each} bytes a triangle), above its limit of {:.0} MiB per storage \
-                 binding; at most {} triangles fit",
-                mib(each * triangles),
-                mib(limit),
-                limit / each
-            )));
-        }
-    }
     let texels: u64 = scene
         .textures
         .iter()
@@ -183,6 +164,50 @@ fn check_scene_size(ctx: &GpuContext, scene: &Scene, features: Features) -> Resu
         )));
     }
     Ok(())
+}
+
+fn mib(bytes: u64) -> f64 {
+    bytes as f64 / f64::from(1 << 20)
+}
+
+/// Refuses a scene whose arrays, split as `arrays` says, need more storage bindings than a
+/// kernel of the device may have (those of the trace kernel's other group counted), with the
+/// numbers. `triangles` counts the scene's stored triangles, for the message.
+fn check_bindings(ctx: &GpuContext, arrays: &SceneArrays, triangles: u64) -> Result<()> {
+    let limits = ctx.device.limits();
+    let needed = TRACE_STORAGE_BUFFERS + arrays.extra_bindings();
+    let has = limits.max_storage_buffers_per_shader_stage;
+    if needed > has {
+        return Err(Error::Limit(format!(
+            "{triangles} triangles are too many for this device: split into storage bindings of \
+             at most {:.2} MiB, their nodes, triangles and shading data take {}, {} and {} \
+             bindings, and the trace kernel would bind {needed} storage buffers, above the \
+             device's limit of {has} per shader stage (a device with more storage buffers or \
+             larger bindings takes the scene)",
+            mib(limits.max_storage_buffer_binding_size),
+            arrays.nodes.chunks,
+            arrays.triangles.chunks,
+            arrays.vertices.chunks,
+        )));
+    }
+    Ok(())
+}
+
+/// Storage buffers holding `data` in the chunks `split` says, or one zero element where
+/// `data` is empty (bindings may not be empty), each checked against the binding limit.
+fn chunked_storage<T: Pod>(
+    ctx: &GpuContext,
+    label: &str,
+    data: &[T],
+    split: &Split,
+    extra: wgpu::BufferUsages,
+) -> Result<Vec<wgpu::Buffer>> {
+    split
+        .ranges(data.len())
+        .into_iter()
+        .enumerate()
+        .map(|(c, range)| storage_for(ctx, &format!("{label}.{c}"), &data[range], extra))
+        .collect()
 }
 
 /// The overrides of `wgsl/surface.wgsl` for a scene's features: code for what the scene does
@@ -262,6 +287,9 @@ fn storage_for<T: Pod>(
 pub struct GpuScene {
     pub(crate) layout: wgpu::BindGroupLayout,
     pub(crate) bind_group: wgpu::BindGroup,
+    /// How the nodes, triangles and shading data are split across storage bindings; kernels
+    /// that read the scene are composed for it.
+    pub arrays: SceneArrays,
     /// What the scene uses; the trace kernel is specialised to it.
     pub features: Features,
     /// The world position the scene was made relative to (the camera's).
@@ -336,9 +364,19 @@ impl GpuScene {
             scene
         };
         let features = scene.features();
-        check_scene_size(ctx, scene, features)?;
+        check_textures(ctx, scene, features)?;
+        let binding_limit = ctx.device.limits().max_storage_buffer_binding_size;
+        let stored = scene.triangles.len() as u64;
+        let vertex_vectors = stored * shading_vectors_per_triangle(features) as u64;
+        // Before the build, with the triangles as they are stored (nodes and pre-splits not
+        // yet known); after it, exactly.
+        let plan =
+            |nodes, triangles| SceneArrays::plan(binding_limit, nodes, triangles, vertex_vectors);
+        check_bindings(ctx, &plan(0, stored), stored)?;
         let origin = scene.camera.position;
         let bvh = SceneBvh::build(scene, origin, options.bvh)?;
+        let arrays = plan(bvh.nodes.len() as u64, bvh.triangles.len() as u64);
+        check_bindings(ctx, &arrays, stored)?;
         let materials: Vec<GpuMaterial> = scene
             .materials
             .iter()
@@ -372,29 +410,38 @@ impl GpuScene {
         };
         let frame = frame_for(origin, &scene.camera);
 
-        let buffers = [
-            storage(ctx, "fisheye.scene.bvh_nodes", &bvh.nodes)?,
-            storage_for(
-                ctx,
-                "fisheye.scene.triangles",
-                &bvh.triangles,
-                if options.traversal == Traversal::RayQuery {
-                    wgpu::BufferUsages::BLAS_INPUT
-                } else {
-                    wgpu::BufferUsages::empty()
-                },
-            )?,
-            storage(ctx, "fisheye.scene.materials", &materials)?,
-            storage(ctx, "fisheye.scene.lights", &lights)?,
-            storage(
-                ctx,
-                "fisheye.scene.vertex_data",
-                &shading_vertices(scene, features),
-            )?,
-            storage(ctx, "fisheye.scene.texture_info", &texture_info)?,
-            storage(ctx, "fisheye.scene.texels", &texels)?,
-            storage(ctx, "fisheye.scene.instances", &bvh.instances)?,
-        ];
+        let rq_input = if options.traversal == Traversal::RayQuery {
+            wgpu::BufferUsages::BLAS_INPUT
+        } else {
+            wgpu::BufferUsages::empty()
+        };
+        let none = wgpu::BufferUsages::empty();
+        let nodes = chunked_storage(
+            ctx,
+            "fisheye.scene.bvh_nodes",
+            &bvh.nodes,
+            &arrays.nodes,
+            none,
+        )?;
+        let triangles = chunked_storage(
+            ctx,
+            "fisheye.scene.triangles",
+            &bvh.triangles,
+            &arrays.triangles,
+            rq_input,
+        )?;
+        let vertices = chunked_storage(
+            ctx,
+            "fisheye.scene.vertex_data",
+            &shading_vertices(scene, features),
+            &arrays.vertices,
+            none,
+        )?;
+        let materials = storage(ctx, "fisheye.scene.materials", &materials)?;
+        let lights_buffer = storage(ctx, "fisheye.scene.lights", &lights)?;
+        let texture_info = storage(ctx, "fisheye.scene.texture_info", &texture_info)?;
+        let texels = storage(ctx, "fisheye.scene.texels", &texels)?;
+        let instances = storage(ctx, "fisheye.scene.instances", &bvh.instances)?;
         let scene = ctx.checked("uploading the scene", || {
             let device = &ctx.device;
             let uniform = crate::gpu::buffer_init(
@@ -403,11 +450,30 @@ impl GpuScene {
                 bytemuck::bytes_of(&shading),
                 wgpu::BufferUsages::UNIFORM,
             );
-            // Binding order = @binding(n) order in wgsl/bvh.wgsl, wgsl/triangles.wgsl and
-            // wgsl/surface.wgsl; the rasterizer reads them in its vertex and fragment stages.
-            let mut entries: Vec<_> = (0..7).map(|b| storage_entry(b, true)).collect();
-            entries.push(uniform_entry(7));
-            entries.push(storage_entry(8, true));
+            // Binding order = @binding(n) order in wgsl/triangles.wgsl, wgsl/surface.wgsl and
+            // the generated scene_arrays (`split::SceneArrays::bindings`: each array's first
+            // chunk at 0, 1 and 4, the others from 9 on); the rasterizer reads them in its
+            // vertex and fragment stages.
+            let resources: Vec<&wgpu::Buffer> = [
+                &nodes[0],
+                &triangles[0],
+                &materials,
+                &lights_buffer,
+                &vertices[0],
+                &texture_info,
+                &texels,
+                &uniform,
+                &instances,
+            ]
+            .into_iter()
+            .chain(nodes[1..].iter())
+            .chain(triangles[1..].iter())
+            .chain(vertices[1..].iter())
+            .collect();
+            let mut entries: Vec<_> = (0..resources.len() as u32)
+                .map(|b| storage_entry(b, true))
+                .collect();
+            entries[7] = uniform_entry(7);
             for entry in &mut entries {
                 entry.visibility = crate::gpu::ALL_STAGES;
             }
@@ -415,22 +481,24 @@ impl GpuScene {
                 label: Some("fisheye.scene"),
                 entries: &entries,
             });
-            let mut resources: Vec<&wgpu::Buffer> = buffers[..7].iter().collect();
-            resources.extend([&uniform, &buffers[7]]);
             let bind_group = bind_buffers(device, "fisheye.scene", &layout, &resources);
-            let ray_query = (options.traversal == Traversal::RayQuery)
-                .then(|| RayQueryScene::new(ctx, &buffers[1], scene.len() as u32));
-            let size = |k: usize| buffers[k].size();
+            let ray_query = (options.traversal == Traversal::RayQuery).then(|| {
+                RayQueryScene::new(ctx, &triangles, &arrays.triangles, bvh.triangles.len())
+            });
+            let size =
+                |buffers: &[wgpu::Buffer]| buffers.iter().map(wgpu::Buffer::size).sum::<u64>();
             let bytes = SceneBytes {
                 // The instances' buffer holds one unused element in a flat scene.
-                bvh: size(0) + (size_of::<crate::bvh::GpuInstance>() * bvh.instances.len()) as u64,
-                geometry: size(1),
-                shading: size(2) + size(3) + size(4),
-                textures: size(5) + size(6),
+                bvh: size(&nodes)
+                    + (size_of::<crate::bvh::GpuInstance>() * bvh.instances.len()) as u64,
+                geometry: size(&triangles),
+                shading: materials.size() + lights_buffer.size() + size(&vertices),
+                textures: texture_info.size() + texels.size(),
             };
             Self {
                 layout,
                 bind_group,
+                arrays,
                 features,
                 triangles: scene.triangles.len() as u32,
                 scene_triangles: scene.len() as u64,
@@ -547,7 +615,8 @@ impl TracePass {
                 }
                 None => "trace",
             };
-            let pipeline = shader::compute_pipeline(device, file, "main", &constants, &layouts);
+            let pipeline =
+                shader::scene_pipeline(device, file, &scene.arrays, "main", &constants, &layouts);
             let output = |label: &str, bytes: u64, usage: wgpu::BufferUsages| {
                 device.create_buffer(&wgpu::BufferDescriptor {
                     label: Some(label),

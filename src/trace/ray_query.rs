@@ -1,6 +1,7 @@
 //! The scene as a hardware acceleration structure, for [`Traversal::RayQuery`]: one bottom
-//! level over the BVH's own triangle buffer (its corners are the vertices, three per slot, so a
-//! hit's primitive index is its slot) and a top level with that one instance.
+//! level over the BVH's own triangle buffers (its corners are the vertices, three per slot;
+//! one geometry per chunk of the triangles, so a hit's geometry and primitive indices give
+//! its slot) and a top level with that one instance.
 //!
 //! [`Traversal::RayQuery`]: super::Traversal::RayQuery
 
@@ -8,6 +9,7 @@ use std::time::{Duration, Instant};
 
 use crate::error::{Error, Result};
 use crate::gpu::{GpuContext, bind_group};
+use crate::split::Split;
 
 /// A scene's acceleration structure and the bind group (`@group(2)` of `wgsl/bvh_rq.wgsl`)
 /// that exposes it.
@@ -39,17 +41,26 @@ impl RayQueryScene {
         Ok(())
     }
 
-    /// Builds the structures over `triangles` (the scene's triangle buffer, with
-    /// `BLAS_INPUT`, holding `count` triangles) and waits for the build.
-    pub(crate) fn new(ctx: &GpuContext, triangles: &wgpu::Buffer, count: u32) -> Self {
+    /// Builds the structures over `triangles` (the scene's triangle buffers, with
+    /// `BLAS_INPUT`, holding `count` triangles split as `split` says) and waits for the build.
+    pub(crate) fn new(
+        ctx: &GpuContext,
+        triangles: &[wgpu::Buffer],
+        split: &Split,
+        count: usize,
+    ) -> Self {
         let device = &ctx.device;
-        let size = wgpu::BlasTriangleGeometrySizeDescriptor {
-            vertex_format: wgpu::VertexFormat::Float32x3,
-            vertex_count: 3 * count,
-            index_format: None,
-            index_count: None,
-            flags: wgpu::AccelerationStructureGeometryFlags::OPAQUE,
-        };
+        let sizes: Vec<wgpu::BlasTriangleGeometrySizeDescriptor> = split
+            .ranges(count)
+            .into_iter()
+            .map(|range| wgpu::BlasTriangleGeometrySizeDescriptor {
+                vertex_format: wgpu::VertexFormat::Float32x3,
+                vertex_count: 3 * range.len() as u32,
+                index_format: None,
+                index_count: None,
+                flags: wgpu::AccelerationStructureGeometryFlags::OPAQUE,
+            })
+            .collect();
         let flags = wgpu::AccelerationStructureFlags::PREFER_FAST_TRACE;
         let mut tlas = device.create_tlas(&wgpu::CreateTlasDescriptor {
             label: Some("fisheye.scene.tlas"),
@@ -66,7 +77,7 @@ impl RayQueryScene {
                     update_mode: wgpu::AccelerationStructureUpdateMode::Build,
                 },
                 wgpu::BlasGeometrySizeDescriptors::Triangles {
-                    descriptors: vec![size.clone()],
+                    descriptors: sizes.clone(),
                 },
             )
         });
@@ -80,19 +91,23 @@ impl RayQueryScene {
             .iter()
             .map(|blas| wgpu::BlasBuildEntry {
                 blas,
-                geometry: wgpu::BlasGeometries::TriangleGeometries(vec![
-                    wgpu::BlasTriangleGeometry {
-                        size: &size,
-                        vertex_buffer: triangles,
-                        first_vertex: 0,
-                        // `GpuTriangle` is three vec4s whose xyz are the corners.
-                        vertex_stride: 16,
-                        index_buffer: None,
-                        first_index: None,
-                        transform_buffer: None,
-                        transform_buffer_offset: None,
-                    },
-                ]),
+                geometry: wgpu::BlasGeometries::TriangleGeometries(
+                    sizes
+                        .iter()
+                        .zip(triangles)
+                        .map(|(size, buffer)| wgpu::BlasTriangleGeometry {
+                            size,
+                            vertex_buffer: buffer,
+                            first_vertex: 0,
+                            // `GpuTriangle` is three vec4s whose xyz are the corners.
+                            vertex_stride: 16,
+                            index_buffer: None,
+                            first_index: None,
+                            transform_buffer: None,
+                            transform_buffer_offset: None,
+                        })
+                        .collect(),
+                ),
             })
             .collect();
         encoder.build_acceleration_structures(&entries, [&tlas]);

@@ -59,8 +59,9 @@ pub(crate) enum Command {
     /// List the built-in scenes.
     Scenes,
     /// Show the GPU adapter, its optional features and limits, and measure the precision of
-    /// WGSL's trigonometric builtins against this project's replacements on it.
-    Info,
+    /// WGSL's trigonometric builtins against this project's replacements on it; with
+    /// --scene, what a scene takes on the device.
+    Info(info::InfoArgs),
     /// Lens models: list them, map pixels and directions, draw what they do.
     Lens {
         #[command(subcommand)]
@@ -88,7 +89,7 @@ pub(crate) fn run(cli: Cli) -> Result<()> {
             }
             Ok(())
         }
-        Command::Info => info::info(),
+        Command::Info(args) => info::info(&args),
         Command::Lens { command } => match command {
             LensCommand::List => {
                 list();

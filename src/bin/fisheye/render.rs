@@ -5,14 +5,15 @@ use std::time::Instant;
 
 use anyhow::{Result, bail};
 use fisheye_rt::bench::{Renderer, SceneSet, Setup};
+use fisheye_rt::bvh::BvhQuality;
 use fisheye_rt::cube::{CubeMap, FACES, bordered};
 use fisheye_rt::gpu::GpuContext;
 use fisheye_rt::lens::ImageSize;
 use fisheye_rt::lens::gpu::DirectionSource;
-use fisheye_rt::scene::FRAME_FILL;
+use fisheye_rt::scene::{FRAME_FILL, Scene};
 use fisheye_rt::trace::{
-    Channel, ColourFile, Display, RenderOptions, Tone, refuse_non_regular, world_directions,
-    write_colour,
+    Channel, ColourFile, Display, GpuScene, RenderOptions, Tone, refuse_non_regular,
+    world_directions, write_colour,
 };
 
 use crate::args::{
@@ -165,35 +166,9 @@ pub(crate) fn render(args: &RenderArgs) -> Result<()> {
     println!("adapter: {}", ctx.adapter_name());
     let scenes = SceneSet::new(&ctx, &scene, &options, &[setup])?;
     let gpu_scene = scenes.for_method(setup.method);
-    let stored = if scene.is_instanced() {
-        format!(
-            " ({} stored, {} instances)",
-            scene.triangles.len(),
-            scene.instances.len()
-        )
-    } else {
-        String::new()
-    };
-    println!(
-        "scene: {scene_spec}, {} triangles{stored}; BVH ({}) {} nodes, depth {}, built in \
-         {:.1} ms",
-        scene.len(),
-        options.bvh.name(),
-        gpu_scene.bvh_nodes,
-        gpu_scene.bvh_depth,
-        gpu_scene.bvh_build_time.as_secs_f64() * 1e3
-    );
-    let bytes = gpu_scene.bytes;
-    let per = |b: u64| b as f64 / f64::from(gpu_scene.triangles.max(1));
-    println!(
-        "on the device: {:.1} MiB, {:.0} bytes a stored triangle (geometry {:.0}, BVH {:.1}, \
-         shading {:.1}), textures {:.1} MiB",
-        (bytes.geometry + bytes.bvh + bytes.shading) as f64 / f64::from(1 << 20),
-        bytes.per_triangle(gpu_scene.triangles),
-        per(bytes.geometry),
-        per(bytes.bvh),
-        per(bytes.shading),
-        bytes.textures as f64 / f64::from(1 << 20)
+    print!(
+        "{}",
+        scene_report(scene_spec, &scene, gpu_scene, options.bvh)
     );
     if let Some(rq) = &gpu_scene.ray_query {
         println!(
@@ -298,4 +273,48 @@ fn describe_cube(cube: &CubeMap, setup: Setup, lights: usize) {
             maps.size(),
         );
     }
+}
+
+/// What `render` and `info --scene` say of a scene on the device: its triangles, BVH and
+/// bytes, by what they hold and per stored triangle, and the storage bindings it is split
+/// across where one each does not hold it.
+pub(crate) fn scene_report(spec: &str, scene: &Scene, gpu: &GpuScene, bvh: BvhQuality) -> String {
+    let stored = if scene.is_instanced() {
+        format!(
+            " ({} stored, {} instances)",
+            scene.triangles.len(),
+            scene.instances.len()
+        )
+    } else {
+        String::new()
+    };
+    let mut out = format!(
+        "scene: {spec}, {} triangles{stored}; BVH ({}) {} nodes, depth {}, built in {:.1} ms\n",
+        scene.len(),
+        bvh.name(),
+        gpu.bvh_nodes,
+        gpu.bvh_depth,
+        gpu.bvh_build_time.as_secs_f64() * 1e3
+    );
+    let bytes = gpu.bytes;
+    let per = |b: u64| b as f64 / f64::from(gpu.triangles.max(1));
+    let mib = |b: u64| b as f64 / f64::from(1 << 20);
+    out += &format!(
+        "on the device: {:.1} MiB, {:.0} bytes a stored triangle (geometry {:.0}, BVH {:.1}, \
+         shading {:.1}), textures {:.1} MiB\n",
+        mib(bytes.geometry + bytes.bvh + bytes.shading),
+        bytes.per_triangle(gpu.triangles),
+        per(bytes.geometry),
+        per(bytes.bvh),
+        per(bytes.shading),
+        mib(bytes.textures)
+    );
+    let arrays = gpu.arrays;
+    if arrays.is_split() {
+        out += &format!(
+            "split across storage bindings: nodes {}, triangles {}, shading data {}\n",
+            arrays.nodes.chunks, arrays.triangles.chunks, arrays.vertices.chunks
+        );
+    }
+    out
 }
