@@ -138,6 +138,20 @@ fn main() {
                 build * 1e3,
                 gpu_scene.bvh_build_time.as_secs_f64() * 1e3
             );
+            // Memory: ours as uploaded, Embree's as its build grew this process.
+            let per = |bytes: u64| bytes as f64 / scene.len().max(1) as f64;
+            let ours = gpu_scene.bytes;
+            eprintln!(
+                "{spec}: bytes a triangle: ours {:.1} (geometry {:.1}, BVH {:.1}); Embree's \
+                 build grew resident memory by {} (its vertex and index buffers, 60 more, \
+                 not counted)",
+                per(ours.geometry + ours.bvh),
+                per(ours.geometry),
+                per(ours.bvh),
+                embree
+                    .build_resident
+                    .map_or("an unknown amount".into(), |b| format!("{:.1}", per(b)))
+            );
             let work = Workload::new(
                 embree,
                 &directions,

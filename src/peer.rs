@@ -21,6 +21,18 @@ pub struct Embree<'a> {
     handle: Handle,
     /// Each scene triangle's corners, camera-relative, as Embree has them.
     corners: Vec<[Vec3; 3]>,
+    /// How much the process's resident memory grew while Embree built its BVH (the commit;
+    /// the vertex and index buffers were filled before), where Linux's `/proc` tells.
+    pub build_resident: Option<u64>,
+}
+
+/// This process's resident memory in bytes (`VmRSS` of `/proc/self/status`), where there is
+/// one.
+fn resident() -> Option<u64> {
+    let status = std::fs::read_to_string("/proc/self/status").ok()?;
+    let line = status.lines().find(|l| l.starts_with("VmRSS:"))?;
+    let kib: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    Some(kib * 1024)
 }
 
 /// A committed scene's handle. Embree documents queries on a committed scene as safe from any
@@ -69,12 +81,17 @@ pub fn with_embree<R>(scene: &Scene, work: impl FnOnce(&Embree, f64) -> R) -> Re
     built.attach_geometry(geometry);
     // SAFETY: the handle is only read, while `built` lives.
     let handle = Handle(unsafe { built.handle() });
+    let before = resident();
     let committed = built.commit();
     let seconds = started.elapsed().as_secs_f64();
+    let build_resident = before
+        .zip(resident())
+        .map(|(before, after)| after.saturating_sub(before));
     let embree = Embree {
         scene: committed,
         handle,
         corners,
+        build_resident,
     };
     Ok(work(&embree, seconds))
 }

@@ -58,10 +58,12 @@ fn peak_memory_grows_with_triangles_at_the_stated_rate() {
     std::fs::remove_dir_all(dir).unwrap();
 }
 
-/// The README's figures ("Memory"): measured 489 bytes a triangle, and 155 MiB for the
-/// default room on lavapipe (whose "device" memory is the process's).
+/// The README's figures ("Memory"): measured 489 bytes a triangle, and for the default room
+/// on lavapipe (whose "device" memory is the process's) 203 MiB with Mesa's shader cache
+/// warm and 271 MiB when the kernels compile in the process (LLVM's working memory), so the
+/// bound on the fixed part holds either way.
 const BYTES_PER_TRIANGLE: f64 = 490.0;
-const FIXED_MIB: f64 = 200.0;
+const FIXED_MIB: f64 = 300.0;
 
 /// Four renders at once on one adapter (on lavapipe they share the CPU) all succeed and
 /// write, byte for byte, the image one render alone writes.
