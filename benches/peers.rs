@@ -64,7 +64,38 @@ impl Bench<'_> {
         (median(&samples), cast.read(self.ctx, &batch).unwrap())
     }
 
+    /// What our traversal did for `rays`, from a counting pass (untimed): node groups and
+    /// triangles a ray, and how busy the lanes of 8 consecutive rays were (the work of the
+    /// eight over eight times the busiest one's: lavapipe runs 8 invocations to a SIMD
+    /// register).
+    fn work(&self, spec: &str, what: &str, rays: &[CastRay], any_hit: bool) {
+        let cast = RayCast::counting(self.ctx, self.gpu_scene, any_hit).unwrap();
+        let batch = cast.upload(self.ctx, rays).unwrap();
+        let mut encoder = self.ctx.device.create_command_encoder(&Default::default());
+        cast.encode(&mut encoder, self.gpu_scene, &batch, None);
+        self.ctx.queue.submit([encoder.finish()]);
+        let work = cast.read_work(self.ctx, &batch).unwrap();
+        let steps: Vec<f64> = work
+            .iter()
+            .map(|w| f64::from(w.nodes + w.triangles))
+            .collect();
+        let busiest: f64 = steps
+            .chunks(8)
+            .map(|g| 8.0 * g.iter().copied().fold(0.0, f64::max))
+            .sum();
+        let mean = |f: fn(&fisheye_rt::trace::cast::CastWork) -> u32| {
+            work.iter().map(|w| f64::from(f(w))).sum::<f64>() / work.len().max(1) as f64
+        };
+        eprintln!(
+            "{spec} {what}: {:.1} node groups and {:.1} triangles a ray; lanes of 8 {:.0}% busy",
+            mean(|w| w.nodes),
+            mean(|w| w.triangles),
+            100.0 * steps.iter().sum::<f64>() / busiest.max(1.0)
+        );
+    }
+
     fn row(&self, spec: &str, what: &str, rays: &[CastRay], shadow: bool) {
+        self.work(spec, what, rays, shadow);
         let (ours_ms, ours) = self.ours(rays, shadow);
         let rate = |ms: f64| rays.len() as f64 / ms * 1e-3;
         let (single_ms, packet_ms, agreement) = if shadow {

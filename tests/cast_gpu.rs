@@ -114,3 +114,100 @@ fn empty_and_oversized_casts() {
         .to_string();
     assert!(message.contains("one dispatch takes at most"), "{message}");
 }
+
+/// Casts `rays` through a counting pass: its hits and each ray's work.
+fn counted(
+    scene: &GpuScene,
+    rays: &[CastRay],
+) -> (
+    Vec<fisheye_rt::trace::cast::CastHit>,
+    Vec<fisheye_rt::trace::cast::CastWork>,
+) {
+    let pass = RayCast::counting(ctx(), scene, false).unwrap();
+    let batch = pass.upload(ctx(), rays).unwrap();
+    let mut encoder = ctx().device.create_command_encoder(&Default::default());
+    pass.encode(&mut encoder, scene, &batch, None);
+    ctx().queue.submit([encoder.finish()]);
+    (
+        pass.read(ctx(), &batch).unwrap(),
+        pass.read_work(ctx(), &batch).unwrap(),
+    )
+}
+
+/// A counting pass finds the very hits of the plain one and counts what a ray can do: at least
+/// the root's node group and at most every node group once; at most every stored triangle
+/// once. Exactly: a ray that leaves a one-triangle scene behind it expands the root and tests
+/// nothing, one that hits it expands the root and tests its triangle. A plain pass refuses
+/// to read work.
+#[test]
+fn a_counting_pass_counts_nodes_and_triangles() {
+    use fisheye_rt::scene::{Camera, Material, MeshBuilder};
+    let room = builtin::scene("default").unwrap();
+    let gpu_room = GpuScene::new(ctx(), &room, &RenderOptions::default()).unwrap();
+    let rotation = room.camera.rotation();
+    let rays: Vec<CastRay> = camera("samyang-7.5mm", 64, 48)
+        .directions()
+        .into_iter()
+        .flatten()
+        .map(|d| CastRay {
+            origin: [0.0; 3],
+            tmin: 0.0,
+            dir: (rotation * d).as_vec3().to_array(),
+            tmax: f32::MAX,
+        })
+        .collect();
+    let plain = RayCast::new(ctx(), &gpu_room, false).unwrap();
+    let (hits, work) = counted(&gpu_room, &rays);
+    assert!(hits == plain.cast(ctx(), &gpu_room, &rays).unwrap());
+    let (nodes, triangles) = (gpu_room.bvh_nodes as u32, gpu_room.triangles);
+    for w in &work {
+        assert!((1..=nodes).contains(&w.nodes), "{w:?} of {nodes} nodes");
+        assert!(w.triangles <= triangles, "{w:?} of {triangles} triangles");
+    }
+    let mean = |f: fn(&fisheye_rt::trace::cast::CastWork) -> u32| {
+        work.iter().map(f).sum::<u32>() as f64 / work.len() as f64
+    };
+    eprintln!(
+        "default room: {:.1} node groups and {:.1} triangles a ray",
+        mean(|w| w.nodes),
+        mean(|w| w.triangles)
+    );
+    assert!(mean(|w| w.triangles) >= 1.0, "the closed room is hit");
+
+    let mut b = MeshBuilder::new();
+    let grey = b.material(Material::diffuse("grey", glam::Vec3::splat(0.8)));
+    b.triangle(
+        [
+            DVec3::new(-1.0, -1.0, -2.0),
+            DVec3::new(1.0, -1.0, -2.0),
+            DVec3::new(0.0, 1.0, -2.0),
+        ],
+        None,
+        None,
+        grey,
+    );
+    let camera_at = Camera {
+        position: DVec3::ZERO,
+        look_at: -DVec3::Z,
+        up: DVec3::Y,
+    };
+    let one = b.finish(Vec::new(), glam::Vec3::ONE, glam::Vec3::ZERO, camera_at);
+    let gpu_one = GpuScene::new(ctx(), &one, &RenderOptions::default()).unwrap();
+    let ray = |z: f32| CastRay {
+        origin: [0.0; 3],
+        tmin: 0.0,
+        dir: [0.0, 0.0, z],
+        tmax: f32::MAX,
+    };
+    let (hits, work) = counted(&gpu_one, &[ray(-1.0), ray(1.0)]);
+    assert_eq!(hits[0].triangle, 0);
+    assert_eq!(hits[1].triangle, NO_HIT);
+    let w = |nodes, triangles| fisheye_rt::trace::cast::CastWork { nodes, triangles };
+    assert_eq!(work, [w(1, 1), w(1, 0)]);
+    let batch = plain.upload(ctx(), &rays).unwrap();
+    let message = plain
+        .read_work(ctx(), &batch)
+        .expect_err("refused")
+        .to_string();
+    assert!(message.contains("RayCast::counting"), "{message}");
+}

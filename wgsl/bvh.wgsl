@@ -20,6 +20,12 @@ const BOX_PAD: f32 = 4.0 * 1.1920929e-7;
 // on a shared edge is inside both triangles even where the driver fuses multiply-adds.
 const EDGE_BAND: f32 = 2.0 * 1.1920929e-7;
 
+// Whether the traversal counts its work (the ray-cast kernel's counting pass): node groups
+// expanded (`node_hits` calls) and triangles tested, per invocation.
+override COUNT_WORK: bool = false;
+var<private> work_nodes: u32;
+var<private> work_triangles: u32;
+
 // Woop et al.'s per-ray shear: kz is the dominant axis, (kx, ky) keep the winding.
 struct Shear {
     k: vec3<u32>,
@@ -181,6 +187,9 @@ fn walk_next(w: ptr<function, Walk>, ray: Ray, inv_dir: vec3<f32>, oct_inv: u32,
         }
         let slot = (bit - 24u) ^ oct_inv;
         let index = (*w).nodes.x + countOneBits(hits_imask & ~(0xffffffffu << slot));
+        if COUNT_WORK {
+            work_nodes += 1u;
+        }
         let mask = node_hits(index, ray, inv_dir, oct_inv, tmax);
         let header = node_word(index, 1u);
         (*w).nodes = vec2<u32>(header.x, (mask & 0xff000000u) | (node_word(index, 0u).w >> 24u));
@@ -206,6 +215,9 @@ fn mesh_trace(root: u32, ray: Ray, any_hit: bool, best: Hit, instance: u32) -> H
             let bit = firstTrailingBit(w.leaves.y);
             w.leaves.y &= w.leaves.y - 1u;
             let slot = w.leaves.x + bit;
+            if COUNT_WORK {
+                work_triangles += 1u;
+            }
             let h = triangle_hit(slot, Ray(ray.origin, ray.dir, ray.tmin, hit.t), sh);
             // Exact ties (duplicated or coplanar overlapping triangles) go to the lower scene
             // triangle, so the result does not depend on the BVH; the reference does the same.

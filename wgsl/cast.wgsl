@@ -17,6 +17,8 @@ struct CastRay {
 @group(0) @binding(0) var<storage, read> rays: array<CastRay>;
 // Per ray: t, the scene triangle (as bits; NO_HIT on a miss), and the barycentrics u, v.
 @group(0) @binding(1) var<storage, read_write> hits: array<vec4<f32>>;
+// Per ray, with COUNT_WORK: the node groups expanded and the triangles tested.
+@group(0) @binding(2) var<storage, read_write> work: array<vec2<u32>>;
 
 @compute @workgroup_size(WORKGROUP_1D)
 fn main(@builtin(global_invocation_id) id: vec3<u32>) {
@@ -30,4 +32,7 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
         triangle = scene_triangle(hit.slot, hit.instance);
     }
     hits[id.x] = vec4<f32>(hit.t, bitcast<f32>(triangle), hit.u, hit.v);
+    if COUNT_WORK {
+        work[id.x] = vec2<u32>(work_nodes, work_triangles);
+    }
 }

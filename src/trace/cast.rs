@@ -41,15 +41,28 @@ pub struct CastHit {
     pub uv: [f32; 2],
 }
 
+/// The work one cast ray took, from a counting pass ([`RayCast::counting`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct CastWork {
+    /// Node groups the traversal expanded (each one node of obvhs's CWBVH, its eight
+    /// children's boxes tested), the root's included: at least one a ray.
+    pub nodes: u32,
+    /// Triangles tested.
+    pub triangles: u32,
+}
+
 /// The cast kernel for one scene: closest hits, or any hit (shadow rays).
 pub struct RayCast {
     pipeline: wgpu::ComputePipeline,
+    /// Whether it also counts each ray's work (`COUNT_WORK` in `wgsl/bvh.wgsl`).
+    counts: bool,
 }
 
-/// Rays uploaded for [`RayCast::encode`], and where their hits go.
+/// Rays uploaded for [`RayCast::encode`], and where their hits (and work) go.
 pub struct CastBatch {
     bind_group: wgpu::BindGroup,
     hits: wgpu::Buffer,
+    work: wgpu::Buffer,
     count: u32,
 }
 
@@ -57,10 +70,22 @@ impl RayCast {
     /// The kernel for `scene` (specialised to its instancing), finding the closest hit or,
     /// with `any_hit`, any hit.
     pub fn new(ctx: &GpuContext, scene: &GpuScene, any_hit: bool) -> Result<Self> {
+        Self::build(ctx, scene, any_hit, false)
+    }
+
+    /// As [`RayCast::new`], counting each ray's work too ([`RayCast::read_work`]): the same
+    /// hits, from a kernel that does a little more than the one [`RayCast::new`] makes, so
+    /// time that one.
+    pub fn counting(ctx: &GpuContext, scene: &GpuScene, any_hit: bool) -> Result<Self> {
+        Self::build(ctx, scene, any_hit, true)
+    }
+
+    fn build(ctx: &GpuContext, scene: &GpuScene, any_hit: bool, counts: bool) -> Result<Self> {
         ctx.checked("creating the ray-cast pass", || {
             let constants = [
                 ("ANY_HIT", f64::from(u8::from(any_hit))),
                 ("INSTANCED", f64::from(u8::from(scene.features.instanced))),
+                ("COUNT_WORK", f64::from(u8::from(counts))),
             ];
             let layout = ctx
                 .device
@@ -69,6 +94,7 @@ impl RayCast {
                     entries: &[
                         crate::gpu::storage_entry(0, true),
                         crate::gpu::storage_entry(1, false),
+                        crate::gpu::storage_entry(2, false),
                     ],
                 });
             Self {
@@ -80,6 +106,7 @@ impl RayCast {
                     &constants,
                     &[&layout, &scene.layout],
                 ),
+                counts,
             }
         })
     }
@@ -112,15 +139,23 @@ impl RayCast {
                 usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
                 mapped_at_creation: false,
             });
+            // 8 bytes a ray, written only by a counting pass.
+            let work = device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("fisheye.cast.work"),
+                size: input.size() / 4,
+                usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
+                mapped_at_creation: false,
+            });
             let bind_group = crate::gpu::bind_buffers(
                 device,
                 "fisheye.cast",
                 &self.pipeline.get_bind_group_layout(0),
-                &[&input, &hits],
+                &[&input, &hits, &work],
             );
             CastBatch {
                 bind_group,
                 hits,
+                work,
                 count: rays.len() as u32,
             }
         })
@@ -155,6 +190,22 @@ impl RayCast {
                 triangle: h[1].to_bits(),
                 uv: [h[2], h[3]],
             })
+            .collect())
+    }
+
+    /// The work each ray of `batch` took, once its cast has been submitted; an error for a
+    /// pass that does not count ([`RayCast::new`]'s).
+    pub fn read_work(&self, ctx: &GpuContext, batch: &CastBatch) -> Result<Vec<CastWork>> {
+        if !self.counts {
+            return Err(crate::error::Error::Option(
+                "this ray-cast pass does not count its work; make it with RayCast::counting".into(),
+            ));
+        }
+        let raw: Vec<[u32; 2]> = ctx.read_buffer(&batch.work)?;
+        Ok(raw
+            .into_iter()
+            .take(batch.count as usize)
+            .map(|[nodes, triangles]| CastWork { nodes, triangles })
             .collect())
     }
 
