@@ -70,11 +70,7 @@ impl Bench<'_> {
     /// register).
     fn work(&self, spec: &str, what: &str, rays: &[CastRay], any_hit: bool) {
         let cast = RayCast::counting(self.ctx, self.gpu_scene, any_hit).unwrap();
-        let batch = cast.upload(self.ctx, rays).unwrap();
-        let mut encoder = self.ctx.device.create_command_encoder(&Default::default());
-        cast.encode(&mut encoder, self.gpu_scene, &batch, None);
-        self.ctx.queue.submit([encoder.finish()]);
-        let work = cast.read_work(self.ctx, &batch).unwrap();
+        let (_, work) = cast.cast_counting(self.ctx, self.gpu_scene, rays).unwrap();
         let steps: Vec<f64> = work
             .iter()
             .map(|w| f64::from(w.nodes + w.triangles))

@@ -73,7 +73,10 @@ impl BvhQuality {
     }
 }
 
-const _: () = assert!(std::mem::size_of::<CwBvhNode>() == 80);
+// The element sizes the scene's arrays are split by (`split`, which reads nothing of the crate)
+// are these structs'.
+const _: () = assert!(std::mem::size_of::<CwBvhNode>() as u64 == crate::split::NODE_BYTES);
+const _: () = assert!(std::mem::size_of::<GpuTriangle>() as u64 == crate::split::TRIANGLE_BYTES);
 
 /// A built BVH with its triangles in leaf order, ready to upload.
 ///

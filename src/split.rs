@@ -33,14 +33,17 @@ pub struct Split {
 }
 
 impl Split {
+    /// The whole array in one binding.
+    pub const WHOLE: Split = Split {
+        shift: 31,
+        chunks: 1,
+    };
+
     /// The split of `len` elements of `bytes` each into bindings of at most `limit` bytes:
     /// one chunk if it fits, else chunks of the largest power of two of elements that fits.
     pub fn of(len: u64, bytes: u64, limit: u64) -> Self {
         if len * bytes <= limit {
-            return Self {
-                shift: 31,
-                chunks: 1,
-            };
+            return Self::WHOLE;
         }
         let per_chunk = (limit / bytes).max(1);
         let shift = per_chunk.ilog2();
@@ -76,14 +79,10 @@ pub struct SceneArrays {
 impl Default for SceneArrays {
     /// One binding each.
     fn default() -> Self {
-        let one = Split {
-            shift: 31,
-            chunks: 1,
-        };
         Self {
-            nodes: one,
-            triangles: one,
-            vertices: one,
+            nodes: Split::WHOLE,
+            triangles: Split::WHOLE,
+            vertices: Split::WHOLE,
         }
     }
 }

@@ -115,25 +115,6 @@ fn empty_and_oversized_casts() {
     assert!(message.contains("one dispatch takes at most"), "{message}");
 }
 
-/// Casts `rays` through a counting pass: its hits and each ray's work.
-fn counted(
-    scene: &GpuScene,
-    rays: &[CastRay],
-) -> (
-    Vec<fisheye_rt::trace::cast::CastHit>,
-    Vec<fisheye_rt::trace::cast::CastWork>,
-) {
-    let pass = RayCast::counting(ctx(), scene, false).unwrap();
-    let batch = pass.upload(ctx(), rays).unwrap();
-    let mut encoder = ctx().device.create_command_encoder(&Default::default());
-    pass.encode(&mut encoder, scene, &batch, None);
-    ctx().queue.submit([encoder.finish()]);
-    (
-        pass.read(ctx(), &batch).unwrap(),
-        pass.read_work(ctx(), &batch).unwrap(),
-    )
-}
-
 /// A counting pass finds the very hits of the plain one and counts what a ray can do: at least
 /// the root's node group and at most every node group once; at most every stored triangle
 /// once. Exactly: a ray that leaves a one-triangle scene behind it expands the root and tests
@@ -157,7 +138,10 @@ fn a_counting_pass_counts_nodes_and_triangles() {
         })
         .collect();
     let plain = RayCast::new(ctx(), &gpu_room, false).unwrap();
-    let (hits, work) = counted(&gpu_room, &rays);
+    let (hits, work) = RayCast::counting(ctx(), &gpu_room, false)
+        .unwrap()
+        .cast_counting(ctx(), &gpu_room, &rays)
+        .unwrap();
     assert!(hits == plain.cast(ctx(), &gpu_room, &rays).unwrap());
     let (nodes, triangles) = (gpu_room.bvh_nodes as u32, gpu_room.triangles);
     for w in &work {
@@ -199,7 +183,10 @@ fn a_counting_pass_counts_nodes_and_triangles() {
         dir: [0.0, 0.0, z],
         tmax: f32::MAX,
     };
-    let (hits, work) = counted(&gpu_one, &[ray(-1.0), ray(1.0)]);
+    let (hits, work) = RayCast::counting(ctx(), &gpu_one, false)
+        .unwrap()
+        .cast_counting(ctx(), &gpu_one, &[ray(-1.0), ray(1.0)])
+        .unwrap();
     assert_eq!(hits[0].triangle, 0);
     assert_eq!(hits[1].triangle, NO_HIT);
     let w = |nodes, triangles| fisheye_rt::trace::cast::CastWork { nodes, triangles };

@@ -216,12 +216,29 @@ impl RayCast {
         scene: &GpuScene,
         rays: &[CastRay],
     ) -> Result<Vec<CastHit>> {
+        let batch = self.submit(ctx, scene, rays)?;
+        self.read(ctx, &batch)
+    }
+
+    /// As [`RayCast::cast`], with each ray's work, for a counting pass.
+    pub fn cast_counting(
+        &self,
+        ctx: &GpuContext,
+        scene: &GpuScene,
+        rays: &[CastRay],
+    ) -> Result<(Vec<CastHit>, Vec<CastWork>)> {
+        let batch = self.submit(ctx, scene, rays)?;
+        Ok((self.read(ctx, &batch)?, self.read_work(ctx, &batch)?))
+    }
+
+    /// Uploads `rays` and submits their cast.
+    fn submit(&self, ctx: &GpuContext, scene: &GpuScene, rays: &[CastRay]) -> Result<CastBatch> {
         let batch = self.upload(ctx, rays)?;
         ctx.checked("casting rays", || {
             let mut encoder = ctx.device.create_command_encoder(&Default::default());
             self.encode(&mut encoder, scene, &batch, None);
             ctx.queue.submit([encoder.finish()]);
         })?;
-        self.read(ctx, &batch)
+        Ok(batch)
     }
 }
