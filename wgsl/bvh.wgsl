@@ -91,48 +91,71 @@ fn triangle_hit(slot: u32, ray: Ray, sh: Shear) -> vec4<f32> {
     return vec4<f32>(t, v * inv, w * inv, 1.0);
 }
 
-fn byte_of(pair: vec2<u32>, i: u32) -> u32 {
-    return (pair[i >> 2u] >> ((i & 3u) * 8u)) & 0xffu;
+// A node's child boxes as seen by one ray: slab distances are `q * scale + near` for the
+// near planes and `q * scale + far` for the far ones, q a child's quantized plane (0..=255);
+// `near` and `far` hold the rounding pad, so each box is tested conservatively.
+struct NodeSlabs {
+    scale: vec3<f32>,
+    near: vec3<f32>,
+    far: vec3<f32>,
+    tmin: f32,
+    tmax: f32,
+}
+
+// Whether the child in byte `shift / 8` of the near and far plane words is hit. Called with a
+// constant shift, so the byte unpacking folds to one or two instructions a plane.
+fn child_hit(near_q: vec3<u32>, far_q: vec3<u32>, shift: u32, s: NodeSlabs) -> bool {
+    let lo = vec3<f32>(vec3<i32>((near_q >> vec3<u32>(shift)) & vec3<u32>(0xffu)));
+    let hi = vec3<f32>(vec3<i32>((far_q >> vec3<u32>(shift)) & vec3<u32>(0xffu)));
+    let near = lo * s.scale + s.near;
+    let far = hi * s.scale + s.far;
+    return max(max(near.x, near.y), max(near.z, s.tmin)) <= min(min(far.x, far.y), min(far.z, s.tmax));
+}
+
+// The hit bits of the child in byte `shift / 8` of a meta word, decoded four at a time.
+fn child_bits(counts: u32, bit_index: u32, shift: u32) -> u32 {
+    return ((counts >> shift) & 0xffu) << ((bit_index >> shift) & 0xffu);
+}
+
+// The hit mask of the four children of one meta word (children 4j..4j+3 for j = `half`):
+// obvhs's child meta bytes decoded four at a time (after Ylitie et al.'s listing): an
+// internal child sets bit 24 + its slot ^ oct_inv, a leaf its primitive bits. The near and
+// far planes are picked per axis from the direction's sign once for the four.
+fn quad_hits(n: array<vec4<u32>, 5>, half: u32, negative: vec3<bool>, oct_inv: u32, s: NodeSlabs) -> u32 {
+    let child_meta = n[1][2u + half];
+    let inner = child_meta & (child_meta << 1u) & 0x10101010u;
+    let bit_index = (child_meta ^ ((inner >> 4u) * oct_inv)) & 0x1f1f1f1fu;
+    let counts = (child_meta >> 5u) & 0x07070707u;
+    let lo = vec3<u32>(n[2][half], n[3][half], n[4][half]);
+    let hi = vec3<u32>(n[2][2u + half], n[3][2u + half], n[4][2u + half]);
+    let near_q = select(lo, hi, negative);
+    let far_q = select(hi, lo, negative);
+    return select(0u, child_bits(counts, bit_index, 0u), child_hit(near_q, far_q, 0u, s))
+        | select(0u, child_bits(counts, bit_index, 8u), child_hit(near_q, far_q, 8u, s))
+        | select(0u, child_bits(counts, bit_index, 16u), child_hit(near_q, far_q, 16u, s))
+        | select(0u, child_bits(counts, bit_index, 24u), child_hit(near_q, far_q, 24u, s));
 }
 
 // Tests a node's eight children; returns obvhs's hit mask: internal children in the top byte
 // (ordered by octant), leaf primitives in the low 24 bits.
 fn node_hits(index: u32, ray: Ray, inv_dir: vec3<f32>, oct_inv: u32, tmax: f32) -> u32 {
-    let n0 = node_word(index, 0u);
-    let n1 = node_word(index, 1u);
-    let n2 = node_word(index, 2u);
-    let n3 = node_word(index, 3u);
-    let n4 = node_word(index, 4u);
-    let p = bitcast<vec3<f32>>(n0.xyz);
-    let e = vec3<f32>(
-        bitcast<f32>((n0.w & 0xffu) << 23u),
-        bitcast<f32>(((n0.w >> 8u) & 0xffu) << 23u),
-        bitcast<f32>(((n0.w >> 16u) & 0xffu) << 23u),
+    let n = array<vec4<u32>, 5>(
+        node_word(index, 0u),
+        node_word(index, 1u),
+        node_word(index, 2u),
+        node_word(index, 3u),
+        node_word(index, 4u),
     );
-    let scale = e * inv_dir;
-    let offset = (p - ray.origin) * inv_dir;
+    let p = bitcast<vec3<f32>>(n[0].xyz);
+    let e = bitcast<vec3<f32>>(((vec3<u32>(n[0].w) >> vec3<u32>(0u, 8u, 16u)) & vec3<u32>(0xffu))
+        << vec3<u32>(23u));
+    let rel = p - ray.origin;
+    let offset = rel * inv_dir;
     // A bound on the absolute rounding error of every slab distance of this node.
-    let pad = BOX_PAD * (abs(p - ray.origin) + 256.0 * e) * abs(inv_dir);
+    let pad = BOX_PAD * (abs(rel) + 256.0 * e) * abs(inv_dir);
+    let s = NodeSlabs(e * inv_dir, offset - pad, offset + pad, ray.tmin, tmax);
     let negative = inv_dir < vec3<f32>(0.0);
-    var mask = 0u;
-    for (var i = 0u; i < 8u; i++) {
-        let child_meta = byte_of(n1.zw, i);
-        if child_meta == 0u {
-            continue;
-        }
-        let lo = vec3<f32>(f32(byte_of(n2.xy, i)), f32(byte_of(n3.xy, i)), f32(byte_of(n4.xy, i)));
-        let hi = vec3<f32>(f32(byte_of(n2.zw, i)), f32(byte_of(n3.zw, i)), f32(byte_of(n4.zw, i)));
-        let near = select(lo, hi, negative) * scale + offset - pad;
-        let far = select(hi, lo, negative) * scale + offset + pad;
-        let t0 = max(max(near.x, near.y), max(near.z, ray.tmin));
-        let t1 = min(min(far.x, far.y), min(far.z, tmax));
-        if t0 <= t1 {
-            let inner = (child_meta & (child_meta << 1u) & 0x10u) != 0u;
-            let bit = select(child_meta & 0x1fu, (child_meta ^ oct_inv) & 0x1fu, inner);
-            mask |= (child_meta >> 5u) << bit;
-        }
-    }
-    return mask;
+    return quad_hits(n, 0u, negative, oct_inv, s) | quad_hits(n, 1u, negative, oct_inv, s);
 }
 
 // 1/d with zero components replaced by a tiny value of the same sign, so slab distances stay
