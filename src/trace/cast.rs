@@ -139,10 +139,11 @@ impl RayCast {
                 usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
                 mapped_at_creation: false,
             });
-            // 8 bytes a ray, written only by a counting pass.
+            // 8 bytes a ray, written only by a counting pass (one ray's worth for a plain
+            // pass, which binds it but never writes it).
             let work = device.create_buffer(&wgpu::BufferDescriptor {
                 label: Some("fisheye.cast.work"),
-                size: input.size() / 4,
+                size: if self.counts { input.size() / 4 } else { 8 },
                 usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
                 mapped_at_creation: false,
             });
