@@ -113,9 +113,9 @@ pub struct TradeOff {
     pub pareto: bool,
 }
 
-/// A colour per method name (the order of [`crate::bench::Method::ALL`]).
+/// A colour per method name (the order of [`crate::renderer::Method::ALL`]).
 fn method_colour(method: &str) -> RGBColor {
-    let index = crate::bench::Method::ALL
+    let index = crate::renderer::Method::ALL
         .iter()
         .position(|m| m.name() == method)
         .unwrap_or(0);

@@ -5,8 +5,9 @@
 mod common;
 
 use common::{camera, ctx};
-use fisheye_rt::bench::{Method, PathKind, Renderer, SceneSet, Setup};
+use fisheye_rt::bench::PathKind;
 use fisheye_rt::compare::{image_error, supersampled};
+use fisheye_rt::renderer::{Method, Offscreen, SceneSet, Setup};
 use fisheye_rt::report::{self, LensRun, Study};
 use fisheye_rt::scene::builtin;
 use fisheye_rt::trace::{RenderOptions, render};
@@ -23,7 +24,7 @@ fn every_method_times_each_of_its_passes_and_renders_what_render_does() {
     let all = setups(&Method::ALL, &[24]);
     let scenes = SceneSet::new(ctx(), &scene, &RenderOptions::default(), &all).unwrap();
     for setup in all {
-        let renderer = Renderer::new(ctx(), &cam, &scenes, setup, 256).unwrap();
+        let renderer = Offscreen::new(ctx(), &cam, &scenes, setup, 256).unwrap();
         // The warm-up compiles the kernels; the frame after it is the one compared below.
         assert!(renderer.warm_up(ctx(), &scenes, &scene.camera).unwrap() > 0.0);
         let time = renderer.frame(ctx(), &scenes, &scene.camera).unwrap();
@@ -89,7 +90,7 @@ fn compare_measures_both_families_against_the_many_ray_reference() {
     let all = Setup::all(&[Method::Rt, traced], &[16, 64], &[1, 4, 16]);
     let scenes = SceneSet::new(ctx(), &scene, &RenderOptions::default(), &all).unwrap();
     let colour = |setup: Setup| {
-        let renderer = Renderer::new(ctx(), &lenses[0].camera, &scenes, setup, 512).unwrap();
+        let renderer = Offscreen::new(ctx(), &lenses[0].camera, &scenes, setup, 512).unwrap();
         renderer.frame(ctx(), &scenes, &scene.camera).unwrap();
         renderer.colour(ctx()).unwrap()
     };
@@ -273,7 +274,7 @@ fn banded_frames_are_timed_whole() {
     };
     let frames = |ctx: &fisheye_rt::gpu::GpuContext| {
         let scenes = SceneSet::new(ctx, &scene, &options, &[setup]).unwrap();
-        let renderer = Renderer::new(ctx, &cam, &scenes, setup, 256).unwrap();
+        let renderer = Offscreen::new(ctx, &cam, &scenes, setup, 256).unwrap();
         let time = renderer.frame(ctx, &scenes, &pose).unwrap();
         assert!(time.gpu_ms().unwrap() > 0.0);
         renderer.output(ctx).unwrap()

@@ -1,8 +1,10 @@
-//! The library's modules depend on each other in one direction: read from the sources, the
-//! graph of which file names which (`crate::a::b`, `super::x`, and a `mod.rs` re-exporting its
-//! children) has no cycle, `shared` and `split` read nothing of the crate, and `shader`
-//! reads only them. Comments, the `#[cfg(test)] mod tests` at a file's end and test files (`tests.rs`)
-//! are left out: tests may reach anywhere.
+//! The house rules, read from the sources. The library's modules depend on each other in one
+//! direction: the graph of which file names which (`crate::a::b`, `super::x`, and a `mod.rs`
+//! re-exporting its children) has no cycle, no module reads one of a higher layer ([`LAYERS`],
+//! the order `src/lib.rs` describes), `shared` and `split` read nothing of the crate, and
+//! `shader` reads only them. Comments, the `#[cfg(test)] mod tests` at a file's end and test
+//! files (`tests.rs`, `tests/`) are left out: tests may reach anywhere. And no source file of
+//! the repository is longer than [`MAX_LINES`].
 
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::Path;
@@ -24,7 +26,7 @@ fn modules() -> BTreeMap<String, String> {
                 if matches!(parts.last().map(String::as_str), Some("mod" | "lib")) {
                     parts.pop();
                 }
-                if parts == ["main"] || parts.last().is_some_and(|p| p == "tests") {
+                if parts == ["main"] || parts.iter().any(|p| p == "tests") {
                     continue; // the binary, and test modules kept in files of their own
                 }
                 out.insert(
@@ -251,7 +253,7 @@ fn modules_depend_one_way() {
     let edges = graph();
     // The reading sees what it should: the tracer reads the shader assembly and the BVH, and
     // names re-exported by `lens` lead to the files that define them.
-    assert!(edges["trace"].contains("shader") && edges["trace"].contains("bvh"));
+    assert!(edges["trace::pass"].contains("shader") && edges["trace::gpu_scene"].contains("bvh"));
     assert!(
         edges["lens::gpu"].contains("lens::camera"),
         "{:?}",
@@ -278,4 +280,121 @@ fn a_cycle_is_found() {
     edges.get_mut("shared").unwrap().insert("trace".into());
     let c = cycle(&edges).expect("shared -> trace -> ... -> shared");
     assert!(c.contains(&"shared".to_string()) && c.contains(&"trace".to_string()));
+}
+
+/// The layers, lowest first: a module may read its own layer's and lower ones. A module's
+/// layer is that of its top-level folder (`lens::gpu` is `lens`'s).
+const LAYERS: [&[&str]; 8] = [
+    // What the GPU and Rust share, read by everything.
+    &["shared", "split"],
+    // Shader assembly, errors, bounded input, rigid transforms.
+    &["shader", "error", "input", "pose"],
+    // Lens models, the device, and its trigonometry measured.
+    &["lens", "gpu", "precision"],
+    // Scenes and their BVH.
+    &["scene", "bvh"],
+    // The passes: the tracer, the cube map, the rasterizer.
+    &["trace", "cube", "raster"],
+    // What renders frames and datasets from the passes.
+    &["renderer", "dataset"],
+    // The tool box of the `fisheye` command (feature `cli`) and the peer (`peer-embree`).
+    &[
+        "bench", "compare", "report", "plot", "demo", "validate", "peer",
+    ],
+    // The `fisheye` command (`src/bin/fisheye/`).
+    &["bin"],
+];
+
+/// The layer of module `name`.
+fn layer(name: &str) -> usize {
+    let top = name.split("::").next().unwrap();
+    LAYERS
+        .iter()
+        .position(|l| l.contains(&top))
+        .unwrap_or_else(|| panic!("module {name} is in no layer of LAYERS: add it"))
+}
+
+/// The edges that go up a layer.
+fn upward(edges: &BTreeMap<String, BTreeSet<String>>) -> Vec<String> {
+    edges
+        .iter()
+        .filter(|(name, _)| !name.is_empty())
+        .flat_map(|(name, to)| {
+            to.iter()
+                .filter(|t| !t.is_empty() && layer(t) > layer(name))
+                .map(move |t| {
+                    format!(
+                        "{name} (layer {}) reads {t} (layer {})",
+                        layer(name),
+                        layer(t)
+                    )
+                })
+        })
+        .collect()
+}
+
+#[test]
+fn no_module_reads_a_higher_layer() {
+    let edges = graph();
+    let up = upward(&edges);
+    assert!(
+        up.is_empty(),
+        "lower layers read higher ones:\n{}",
+        up.join("\n")
+    );
+    // The check finds such an edge where there is one.
+    let mut bad = edges.clone();
+    bad.get_mut("lens").unwrap().insert("renderer".into());
+    assert_eq!(upward(&bad), ["lens (layer 2) reads renderer (layer 5)"]);
+}
+
+/// Files stay small enough to read in one sitting.
+const MAX_LINES: usize = 700;
+
+/// The files under `dir` (not `target/`, `.git/` or other hidden folders) whose names end in
+/// one of `extensions`, with their line counts.
+fn line_counts(dir: &Path, extensions: &[&str], out: &mut Vec<(String, usize)>) {
+    for entry in std::fs::read_dir(dir).unwrap() {
+        let path = entry.unwrap().path();
+        let name = path.file_name().unwrap().to_string_lossy().into_owned();
+        if path.is_dir() {
+            if !(name.starts_with('.') || name == "target" || name == "node_modules") {
+                line_counts(&path, extensions, out);
+            }
+        } else if extensions.iter().any(|e| name.ends_with(e)) {
+            let text = std::fs::read_to_string(&path).unwrap();
+            out.push((path.display().to_string(), text.lines().count()));
+        }
+    }
+}
+
+#[test]
+fn no_source_file_is_over_700_lines() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let mut counts = Vec::new();
+    let sources = [
+        ".rs", ".wgsl", ".py", ".sh", ".js", ".html", ".css", ".toml",
+    ];
+    line_counts(root, &sources, &mut counts);
+    for script in [".ci/run", ".ci/test", ".ci/install-lavapipe"] {
+        let text = std::fs::read_to_string(root.join(script)).unwrap();
+        counts.push((script.to_string(), text.lines().count()));
+    }
+    // The walk sees the sources: the tracer's kernel and this file among them.
+    assert!(counts.iter().any(|(p, _)| p.ends_with("wgsl/trace.wgsl")));
+    assert!(
+        counts
+            .iter()
+            .any(|(p, _)| p.ends_with("tests/module_graph.rs"))
+    );
+    let long: Vec<String> = counts
+        .iter()
+        .filter(|(_, n)| *n > MAX_LINES)
+        .map(|(p, n)| format!("{p}: {n} lines"))
+        .collect();
+    assert!(
+        long.is_empty(),
+        "over {MAX_LINES} lines, split along what each part does:\n{}",
+        long.join("\n")
+    );
 }

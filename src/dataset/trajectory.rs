@@ -123,12 +123,30 @@ pub fn parse(text: &str, format: TrajectoryFormat, fps: f64) -> Result<Vec<Pose>
     if format == TrajectoryFormat::Kitti && !(fps.is_finite() && fps > 0.0) {
         return Err(format!("the frame rate {fps} is not a positive number"));
     }
-    data_lines(text)
-        .enumerate()
-        .map(|(index, (line, content))| {
-            pose(content, format, index, fps).map_err(|e| format!("line {line}: {e}"))
-        })
-        .collect()
+    let mut poses: Vec<Pose> = Vec::new();
+    let mut previous_line = 0;
+    for (index, (line, content)) in data_lines(text).enumerate() {
+        let pose = pose(content, format, index, fps).map_err(|e| format!("line {line}: {e}"))?;
+        // Frames are named by their stamps and rendered in order: a repeated stamp would
+        // overwrite a frame, an earlier one reorder the sequence.
+        if let Some(last) = poses.last()
+            && pose.seconds <= last.seconds
+        {
+            let how = if pose.seconds == last.seconds {
+                "repeats"
+            } else {
+                "comes before"
+            };
+            return Err(format!(
+                "line {line}: the time stamp {} {how} line {previous_line}'s {}; a \
+                 trajectory's stamps must increase",
+                pose.stamp, last.stamp
+            ));
+        }
+        poses.push(pose);
+        previous_line = line;
+    }
+    Ok(poses)
 }
 
 /// One data line's pose.
@@ -276,6 +294,17 @@ mod tests {
                 "1,0,0\n",
                 TrajectoryFormat::Euroc,
                 "3 fields; a euroc pose has 8 or more",
+            ),
+            (
+                "# stamps\n1.5 0 0 0 0 0 0 1\n\n1.50 0 0 0 0 0 0 1\n",
+                TrajectoryFormat::Tum,
+                "line 4: the time stamp 1.50 repeats line 2's 1.5; a trajectory's stamps must \
+                 increase",
+            ),
+            (
+                "20,0,0,0,1,0,0,0\n30,0,0,0,1,0,0,0\n25,0,0,0,1,0,0,0\n",
+                TrajectoryFormat::Euroc,
+                "line 3: the time stamp 25 comes before line 2's 30",
             ),
         ];
         for (text, format, wanted) in cases {

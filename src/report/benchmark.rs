@@ -7,10 +7,11 @@ use std::path::Path;
 use serde::Serialize;
 
 use super::{Progress, Run, Study, file_stem, is_pinhole, machine_lines, sig, write_report};
-use crate::bench::{FrameStats, FrameTime, Memory, Pass, PathKind, camera_path};
+use crate::bench::{FrameStats, Memory, PathKind, camera_path};
 use crate::error::{Error, Result};
 use crate::gpu::median;
 use crate::plot;
+use crate::renderer::{FrameTime, Pass};
 
 /// One setup's frames along the path.
 #[derive(Serialize)]

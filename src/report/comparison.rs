@@ -9,12 +9,12 @@ use std::path::Path;
 use serde::Serialize;
 
 use super::{Progress, Run, Study, file_stem, machine_lines, sig, speed_ratio, write_report};
-use crate::bench::{FrameTime, Setup};
 use crate::compare::{Envelope, ImageError, error_map, flip_error, image_error, pareto_front};
 use crate::error::Result;
 use crate::gpu::median;
 use crate::plot;
 use crate::renderer::Method;
+use crate::renderer::{FrameTime, Setup};
 use crate::scene::Camera;
 use crate::trace::{colour_image, save_png};
 

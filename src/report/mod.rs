@@ -12,12 +12,13 @@ use serde::Serialize;
 pub use benchmark::{BenchEntry, BenchReport, bench};
 pub use comparison::{CompareEntry, CompareReport, Verdict, compare};
 
+use crate::bench::Machine;
 pub use crate::bench::PathKind;
-use crate::bench::{Machine, Renderer, SceneSet, Setup};
 use crate::error::Result;
 use crate::gpu::GpuContext;
 use crate::lens::LensCamera;
 use crate::plot;
+use crate::renderer::{Offscreen, SceneSet, Setup};
 use crate::scene::Scene;
 
 /// A lens to measure, with the name reports give it.
@@ -87,8 +88,8 @@ impl Study<'_> {
         }
     }
 
-    fn renderer(&self, lens: &LensRun, setup: Setup) -> Result<Renderer> {
-        Renderer::new(self.ctx, &lens.camera, self.scenes, setup, self.shadow_size)
+    fn renderer(&self, lens: &LensRun, setup: Setup) -> Result<Offscreen> {
+        Offscreen::new(self.ctx, &lens.camera, self.scenes, setup, self.shadow_size)
     }
 }
 

@@ -79,6 +79,32 @@ impl Display {
     }
 }
 
+/// The middle grey that [`auto_exposure`] maps an image's log-average luminance to: the
+/// "key" of a normal-key scene in Reinhard et al. 2002, §3.1.
+pub const KEY: f64 = 0.18;
+
+/// The exposure in stops that maps the log-average luminance of the pixels the lens covers
+/// (`w > 0`) to [`KEY`]: Reinhard, Stark, Shirley and Ferwerda, "Photographic Tone Reproduction
+/// for Digital Images" (SIGGRAPH 2002), eq. 1 and 2: `L̄ = exp(mean(ln(δ + L)))`, scale
+/// `a / L̄`, here `log2(a / L̄)`. Luminance is Rec. 709's `0.2126 R + 0.7152 G + 0.0722 B`
+/// and δ = 10⁻⁴ keeps black pixels finite. Computed in f64; 0 where no pixel is covered.
+pub fn auto_exposure(colour: &[[f32; 4]]) -> f32 {
+    const DELTA: f64 = 1e-4;
+    let (sum, n) = colour
+        .iter()
+        .filter(|c| c[3] > 0.0)
+        .map(|c| {
+            let [r, g, b] = [c[0], c[1], c[2]].map(|v| f64::from(v).max(0.0));
+            (DELTA + 0.2126 * r + 0.7152 * g + 0.0722 * b).ln()
+        })
+        .fold((0.0, 0usize), |(s, n), l| (s + l, n + 1));
+    if n == 0 {
+        return 0.0;
+    }
+    let log_average = (sum / n as f64).exp();
+    (KEY / log_average).log2() as f32
+}
+
 /// The files colour images are written as, chosen by the path's extension and a bit depth.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum ColourFile {
@@ -264,6 +290,42 @@ pub fn write_file(path: &Path, contents: &[u8]) -> Result<()> {
     })
 }
 
+/// Refuses, before any work, an output file that could not be written: a `path` that exists
+/// and is not a regular file ([`refuse_non_regular`]), a folder for it that cannot be made, or
+/// one that takes no new file (read-only, sysfs, another user's). It makes the folder (as
+/// [`write_atomically`] would) and creates and removes a probe file there.
+pub fn check_writable(path: &Path) -> Result<()> {
+    refuse_non_regular(path)?;
+    let parent = path.parent().filter(|p| !p.as_os_str().is_empty());
+    probe_folder(parent.unwrap_or(Path::new(".")), path)
+}
+
+/// As [`check_writable`], for an output folder: `dir` is made if missing and must take new
+/// files.
+pub fn check_writable_folder(dir: &Path) -> Result<()> {
+    probe_folder(dir, dir)
+}
+
+/// Makes `dir` and creates and removes a file in it; errors name `output`, what is to be
+/// written.
+fn probe_folder(dir: &Path, output: &Path) -> Result<()> {
+    let fail = |reason: std::io::Error| Error::Io {
+        path: output.to_path_buf(),
+        reason: std::io::Error::new(
+            reason.kind(),
+            format!("cannot be written ({reason}); nothing was rendered"),
+        ),
+    };
+    std::fs::create_dir_all(dir).map_err(fail)?;
+    let probe = dir.join(format!(".fisheye-probe.{}.tmp", std::process::id()));
+    std::fs::OpenOptions::new()
+        .write(true)
+        .create_new(true)
+        .open(&probe)
+        .map_err(fail)?;
+    std::fs::remove_file(&probe).map_err(fail)
+}
+
 /// Refuses a `path` that exists and is not a regular file (a folder, a device such as
 /// `/dev/full`, a named pipe, a symbolic link), naming what it is; a missing path is fine. Tools
 /// call it before work whose result goes there.
@@ -283,6 +345,35 @@ pub fn refuse_non_regular(path: &Path) -> Result<()> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Auto exposure against Reinhard et al.'s formula: a grey image of luminance L gets
+    /// log2(0.18 / (δ + L)); scaling the radiance by 2^k lowers it by k stops (up to δ);
+    /// uncovered pixels do not count; no covered pixel gives 0.
+    #[test]
+    fn auto_exposure_maps_the_log_average_to_the_key() {
+        for l in [0.01f32, 0.18, 1.0, 37.5] {
+            let ev = auto_exposure(&[[l, l, l, 1.0]; 12]);
+            let wanted = (0.18 / (1e-4 + f64::from(l))).log2() as f32;
+            assert!((ev - wanted).abs() < 1e-5, "{l}: {ev} vs {wanted}");
+        }
+        // Half the pixels at 4, half at 1/4 (luminance weights sum to 1): log-average 1.
+        let mixed: Vec<[f32; 4]> = (0..10)
+            .map(|i| {
+                if i % 2 == 0 {
+                    [4.0; 4]
+                } else {
+                    [0.25, 0.25, 0.25, 1.0]
+                }
+            })
+            .collect();
+        assert!((auto_exposure(&mixed) - 0.18f32.log2()).abs() < 1e-3);
+        let brighter: Vec<[f32; 4]> = mixed.iter().map(|c| c.map(|v| v * 8.0)).collect();
+        assert!((auto_exposure(&mixed) - auto_exposure(&brighter) - 3.0).abs() < 1e-3);
+        let mut masked = mixed.clone();
+        masked.push([1e6, 1e6, 1e6, 0.0]);
+        assert_eq!(auto_exposure(&masked), auto_exposure(&mixed));
+        assert_eq!(auto_exposure(&[[5.0, 5.0, 5.0, 0.0]]), 0.0);
+    }
 
     /// The curves against their formulas, and exposure in stops.
     #[test]

@@ -5,13 +5,13 @@ use std::path::PathBuf;
 
 use anyhow::{Context, Result, bail};
 use clap::ValueEnum;
-use fisheye_rt::bench;
 use fisheye_rt::bvh::BvhQuality;
 use fisheye_rt::cube::CubeMethod;
 use fisheye_rt::lens::calib::{self, CalibFormat};
 use fisheye_rt::lens::gpu::DirectionSource;
 use fisheye_rt::lens::{DirectionFormula, ImageSize, LensCamera, parse_spec};
 use fisheye_rt::raster::RasterMethod;
+use fisheye_rt::renderer;
 use fisheye_rt::scene::Scene;
 use fisheye_rt::trace::{Channel, Tone};
 use glam::DVec3;
@@ -93,15 +93,37 @@ pub(crate) enum Method {
 
 impl Method {
     /// The library's method.
-    pub(crate) fn method(self) -> bench::Method {
-        let raster = |m| bench::Method::Cube(CubeMethod::Raster(m));
+    pub(crate) fn method(self) -> renderer::Method {
+        let raster = |m| renderer::Method::Cube(CubeMethod::Raster(m));
         match self {
-            Self::Rt => bench::Method::Rt,
-            Self::Rq => bench::Method::Rq,
-            Self::CubeRt => bench::Method::Cube(CubeMethod::Traced),
+            Self::Rt => renderer::Method::Rt,
+            Self::Rq => renderer::Method::Rq,
+            Self::CubeRt => renderer::Method::Cube(CubeMethod::Traced),
             Self::CubeForward => raster(RasterMethod::Forward),
             Self::CubeDeferred => raster(RasterMethod::Deferred),
             Self::CubeSingle => raster(RasterMethod::SinglePass),
+        }
+    }
+}
+
+/// `render --exposure`: stops, or `auto` (Reinhard et al.'s log-average luminance mapped to
+/// middle grey).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) enum Exposure {
+    Stops(f32),
+    Auto,
+}
+
+impl std::str::FromStr for Exposure {
+    type Err = String;
+
+    fn from_str(text: &str) -> std::result::Result<Self, String> {
+        if text == "auto" {
+            return Ok(Exposure::Auto);
+        }
+        match text.parse::<f32>() {
+            Ok(stops) if stops.is_finite() => Ok(Exposure::Stops(stops)),
+            _ => Err(format!("{text:?}: give `auto` or a finite number of stops")),
         }
     }
 }

@@ -154,6 +154,7 @@ fn render(args: &RenderArgs) -> Result<()> {
             args.out.display()
         );
     }
+    fisheye_rt::trace::check_writable_folder(&args.out)?;
     let probe = match args.colour {
         ColourArg::Png => "frame.png",
         ColourArg::Exr => "frame.exr",

@@ -257,6 +257,7 @@ pub(crate) fn demo(lenses: Vec<String>, size: ImageSize, out: PathBuf) -> Result
         .iter()
         .map(|spec| Ok((spec, LensCamera::new(parse_spec(spec)?, size))))
         .collect::<Result<Vec<_>>>()?;
+    fisheye_rt::trace::check_writable_folder(&out)?;
     let ctx = GpuContext::new()?;
     println!("adapter: {}", ctx.adapter_name());
     let queries = Queries::new(&ctx, 1);

@@ -4,21 +4,21 @@ use std::path::PathBuf;
 use std::time::Instant;
 
 use anyhow::{Result, bail};
-use fisheye_rt::bench::{Renderer, SceneSet, Setup};
 use fisheye_rt::bvh::BvhQuality;
 use fisheye_rt::cube::{CubeMap, FACES, bordered};
 use fisheye_rt::gpu::GpuContext;
 use fisheye_rt::lens::ImageSize;
 use fisheye_rt::lens::gpu::DirectionSource;
+use fisheye_rt::renderer::{Offscreen, SceneSet, Setup};
 use fisheye_rt::scene::{FRAME_FILL, Scene};
 use fisheye_rt::trace::{
-    Channel, ColourFile, Display, GpuScene, RenderOptions, Tone, refuse_non_regular,
-    world_directions, write_colour,
+    Channel, ColourFile, Display, GpuScene, KEY, RenderOptions, Tone, auto_exposure,
+    check_writable, world_directions, write_colour,
 };
 
 use crate::args::{
-    ArrayFormat, CalibArgs, Directions, Method, Output, ShadingArgs, ToneArg, load_scene_with,
-    parse_camera,
+    ArrayFormat, CalibArgs, Directions, Exposure, Method, Output, ShadingArgs, ToneArg,
+    load_scene_with, parse_camera,
 };
 
 #[derive(clap::Args)]
@@ -78,9 +78,12 @@ pub(crate) struct RenderArgs {
     /// EXR's default) or 32 (float) for EXR.
     #[arg(long)]
     pub(crate) bits: Option<u32>,
-    /// Exposure in stops (EV): the radiance is scaled by 2^EXPOSURE before the tone curve.
-    #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
-    pub(crate) exposure: f32,
+    /// Exposure in stops (EV): the radiance is scaled by 2^EXPOSURE before the tone curve;
+    /// `auto` maps the image's log-average luminance to middle grey (Reinhard et al. 2002).
+    /// Default: `auto` for a PNG of a bare OBJ or glTF file lit by the headlight and sun this
+    /// tool adds (their brightness has no meaning in the file's units), else 0.
+    #[arg(long, allow_hyphen_values = true)]
+    pub(crate) exposure: Option<Exposure>,
     /// Tone curve from exposed radiance to the PNG's [0, 1]: `aces` (Narkowicz's 2015 fit of
     /// the ACES filmic curve: highlights roll off instead of clipping) or `clamp` (linear,
     /// clipped at 1: what `compare` and `validate` measure).
@@ -99,16 +102,6 @@ pub(crate) fn render(args: &RenderArgs) -> Result<()> {
     let started = Instant::now();
     // Everything about the files first: a refused name costs no rendering.
     let file = ColourFile::for_path(&args.out, args.bits)?;
-    if !args.exposure.is_finite() {
-        bail!(
-            "--exposure {}: give a finite number of stops",
-            args.exposure
-        );
-    }
-    let display = Display {
-        exposure: args.exposure,
-        tone: args.tone.into(),
-    };
     let array_path = |channel: Channel| {
         let extension = match args.format {
             ArrayFormat::Npy => "npy",
@@ -118,9 +111,9 @@ pub(crate) fn render(args: &RenderArgs) -> Result<()> {
             .with_extension(format!("{}.{extension}", channel.name()))
     };
     let channels: Vec<Channel> = args.outputs.iter().map(|&o| Channel::from(o)).collect();
-    refuse_non_regular(&args.out)?;
+    check_writable(&args.out)?;
     for &channel in &channels {
-        refuse_non_regular(&array_path(channel))?;
+        check_writable(&array_path(channel))?;
     }
     let method = args.method.method();
     // A cube map's resampler takes one bilinear sample a pixel; --spp is direct tracing's.
@@ -180,7 +173,7 @@ pub(crate) fn render(args: &RenderArgs) -> Result<()> {
         "lens: {} at {}; compiling the kernels...",
         camera.lens, camera.size
     );
-    let renderer = Renderer::with_directions(
+    let renderer = Offscreen::with_directions(
         &ctx,
         &camera,
         &scenes,
@@ -209,6 +202,19 @@ pub(crate) fn render(args: &RenderArgs) -> Result<()> {
         ),
         None => println!("{what}; no GPU timestamps on this adapter"),
     }
+    // Bare meshes are lit by lights this tool made up: expose what they show (PNG only; an
+    // EXR keeps the radiance unless asked).
+    let png = matches!(file, ColourFile::Png8 | ColourFile::Png16);
+    let exposure = match args.exposure {
+        Some(Exposure::Stops(stops)) => stops,
+        Some(Exposure::Auto) => auto(&output.colour),
+        None if png && scene.headlight.is_some() => auto(&output.colour),
+        None => 0.0,
+    };
+    let display = Display {
+        exposure,
+        tone: args.tone.into(),
+    };
     write_colour(out, output.size, &output.colour, &display, file)?;
     if !channels.is_empty() {
         let directions = world_directions(&camera, &scene.camera);
@@ -230,9 +236,18 @@ pub(crate) fn render(args: &RenderArgs) -> Result<()> {
     Ok(())
 }
 
+/// The exposure that maps `colour`'s log-average luminance to middle grey, said.
+fn auto(colour: &[[f32; 4]]) -> f32 {
+    let stops = auto_exposure(colour);
+    println!(
+        "exposure: auto, {stops:+.2} EV (log-average luminance to {KEY}, Reinhard et al. 2002)"
+    );
+    stops
+}
+
 /// The colour file's format and how it shows radiance, in words.
 fn describe_file(file: ColourFile, display: &Display) -> String {
-    let exposure = format!("exposure {:+} EV", display.exposure);
+    let exposure = format!("exposure {:+.2} EV", display.exposure);
     match file {
         ColourFile::Png8 | ColourFile::Png16 => {
             let bits = if file == ColourFile::Png8 { 8 } else { 16 };

@@ -3,9 +3,10 @@
 use std::path::PathBuf;
 
 use anyhow::{Context, Result, bail};
-use fisheye_rt::bench::{self, PathKind, SceneSet, Setup};
+use fisheye_rt::bench::PathKind;
 use fisheye_rt::gpu::GpuContext;
 use fisheye_rt::lens::{LensCamera, parse_spec};
+use fisheye_rt::renderer::{self, SceneSet, Setup};
 use fisheye_rt::report::{self, LensRun, Study};
 use fisheye_rt::scene::Scene;
 use fisheye_rt::trace::RenderOptions;
@@ -97,8 +98,8 @@ pub(crate) fn prepare(args: &StudyArgs, command: &str) -> Result<Prepared> {
     if let Some(&bad) = args.cube_size.iter().find(|&&s| s == 0) {
         bail!("--cube-size {bad}: face sizes must be at least 1");
     }
-    let methods: Vec<bench::Method> = if args.method.is_empty() {
-        bench::Method::ALL.to_vec()
+    let methods: Vec<renderer::Method> = if args.method.is_empty() {
+        renderer::Method::ALL.to_vec()
     } else {
         args.method.iter().map(|m| m.method()).collect()
     };
@@ -147,7 +148,7 @@ pub(crate) fn out_folder(out: Option<&std::path::Path>, command: &str) -> Result
             .find(|p| !p.exists())
             .expect("a free folder name"),
     };
-    std::fs::create_dir_all(&out).with_context(|| format!("creating {}", out.display()))?;
+    fisheye_rt::trace::check_writable_folder(&out)?;
     Ok(out)
 }
 

@@ -33,6 +33,10 @@
 //! # Ok(()) }
 //! ```
 
+mod offscreen;
+
+pub use offscreen::{FrameTime, Offscreen, Pass, SceneSet, Setup};
+
 use crate::cube::{CubeMap, CubeMethod, CubeSettings, CubeSpans};
 use crate::error::{Error, Result};
 use crate::gpu::{GpuContext, bind_group, dispatch_over_image, storage_entry};

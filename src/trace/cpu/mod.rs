@@ -7,11 +7,16 @@
 //! instances that place meshes, whose rays it maps into the mesh's space with the f32 maps the
 //! GPU gets. Rays come from the f64 lens reference.
 
+mod surface;
+mod tree;
+
 use glam::{DMat3, DVec2, DVec3, Vec3};
+use surface::*;
+use tree::*;
 
 use super::{MAX_DEPTH_LIMIT, MAX_SHADOW_LAYERS, NO_HIT, RenderOutput};
 use crate::lens::LensCamera;
-use crate::scene::{Features, Scene, Surface, Texture};
+use crate::scene::{Features, Scene, Surface};
 
 /// Rays whose weight falls below this are not traced (as on the GPU).
 const MIN_WEIGHT: f64 = crate::shared::MIN_WEIGHT as f64;
@@ -31,156 +36,6 @@ pub struct Hit {
     pub stored: u32,
     /// The instance it was hit in (index into `Scene::instances`), if any.
     pub instance: Option<u32>,
-}
-
-enum Node {
-    Leaf {
-        lo: DVec3,
-        hi: DVec3,
-        first: u32,
-        count: u32,
-    },
-    Inner {
-        lo: DVec3,
-        hi: DVec3,
-        left: u32,
-        right: u32,
-    },
-}
-
-/// A binary BVH (median splits) over boxes named by ids.
-struct Tree {
-    nodes: Vec<Node>,
-    order: Vec<u32>,
-}
-
-impl Tree {
-    /// The tree over `ids`, whose boxes `bounds` gives.
-    fn new(ids: Vec<u32>, bounds: &dyn Fn(u32) -> (DVec3, DVec3)) -> Self {
-        let mut tree = Self {
-            nodes: Vec::new(),
-            order: ids,
-        };
-        if !tree.order.is_empty() {
-            tree.build(0, tree.order.len(), bounds);
-        }
-        tree
-    }
-
-    /// Builds the subtree over `order[first..first + count]`, returns its node index.
-    fn build(&mut self, first: usize, count: usize, bounds: &dyn Fn(u32) -> (DVec3, DVec3)) -> u32 {
-        let (lo, hi) = self.order[first..first + count]
-            .iter()
-            .map(|&i| bounds(i))
-            .fold(
-                (DVec3::INFINITY, DVec3::NEG_INFINITY),
-                |(lo, hi), (a, b)| (lo.min(a), hi.max(b)),
-            );
-        let index = self.nodes.len() as u32;
-        if count <= 4 {
-            self.nodes.push(Node::Leaf {
-                lo,
-                hi,
-                first: first as u32,
-                count: count as u32,
-            });
-            return index;
-        }
-        let axis = (hi - lo).max_position();
-        let centroid = |i: &u32| {
-            let (a, b) = bounds(*i);
-            (a + b)[axis]
-        };
-        self.order[first..first + count].sort_by(|a, b| centroid(a).total_cmp(&centroid(b)));
-        self.nodes.push(Node::Leaf {
-            lo,
-            hi,
-            first: 0,
-            count: 0,
-        });
-        let half = count / 2;
-        let left = self.build(first, half, bounds);
-        let right = self.build(first + half, count - half, bounds);
-        self.nodes[index as usize] = Node::Inner {
-            lo,
-            hi,
-            left,
-            right,
-        };
-        index
-    }
-
-    /// Calls `visit` with each id whose leaf box the ray reaches before `limit()`, until it
-    /// returns true.
-    fn walk(
-        &self,
-        origin: DVec3,
-        dir: DVec3,
-        tmin: f64,
-        limit: &dyn Fn() -> f64,
-        visit: &mut dyn FnMut(u32) -> bool,
-    ) {
-        if self.nodes.is_empty() {
-            return;
-        }
-        let inv = DVec3::ONE / dir;
-        let mut stack = vec![0u32];
-        while let Some(index) = stack.pop() {
-            match self.nodes[index as usize] {
-                Node::Leaf {
-                    lo,
-                    hi,
-                    first,
-                    count,
-                } => {
-                    if !box_hit(lo, hi, origin, inv, tmin, limit()) {
-                        continue;
-                    }
-                    for &id in &self.order[first as usize..(first + count) as usize] {
-                        if visit(id) {
-                            return;
-                        }
-                    }
-                }
-                Node::Inner {
-                    lo,
-                    hi,
-                    left,
-                    right,
-                } => {
-                    if box_hit(lo, hi, origin, inv, tmin, limit()) {
-                        stack.extend([left, right]);
-                    }
-                }
-            }
-        }
-    }
-}
-
-fn box_hit(lo: DVec3, hi: DVec3, origin: DVec3, inv: DVec3, tmin: f64, tmax: f64) -> bool {
-    let a = (lo - origin) * inv;
-    let b = (hi - origin) * inv;
-    let near = a.min(b).max_element().max(tmin);
-    let far = a.max(b).min_element().min(tmax);
-    // f64 rounding is ~1e-16 relative: a relative pad of 1e-12 is conservative.
-    near <= far * (1.0 + 1e-12) + 1e-300
-}
-
-/// An affine map read from the rows the GPU gets.
-#[derive(Clone, Copy)]
-struct Affine {
-    m: DMat3,
-    t: DVec3,
-}
-
-impl Affine {
-    fn from_rows(rows: [[f32; 4]; 3]) -> Self {
-        let row = |r: [f32; 4]| DVec3::new(r[0].into(), r[1].into(), r[2].into());
-        Self {
-            m: DMat3::from_cols(row(rows[0]), row(rows[1]), row(rows[2])).transpose(),
-            t: DVec3::new(rows[0][3].into(), rows[1][3].into(), rows[2][3].into()),
-        }
-    }
 }
 
 /// An instance as the reference uses it: the f32 maps the GPU gets, promoted.
@@ -691,16 +546,6 @@ impl Reference<'_> {
     }
 }
 
-struct SurfacePoint {
-    position: DVec3,
-    geometric: DVec3,
-    normal: DVec3,
-    front: bool,
-    diffuse: DVec3,
-    specular: DVec3,
-    shininess: f64,
-}
-
 /// Whether `hit` beats `best` (or, without one, lies before `tmax`): nearer, or as near and of
 /// a lower scene triangle, as `bvh_trace` in `wgsl/bvh.wgsl` decides exact ties.
 fn closer(hit: &Hit, best: Option<&Hit>, tmax: f64) -> bool {
@@ -708,54 +553,4 @@ fn closer(hit: &Hit, best: Option<&Hit>, tmax: f64) -> bool {
         None => hit.t < tmax,
         Some(b) => hit.t < b.t || (hit.t == b.t && hit.triangle < b.triangle),
     }
-}
-
-fn reflect(d: DVec3, n: DVec3) -> DVec3 {
-    d - 2.0 * d.dot(n) * n
-}
-
-/// As `keep_side` in `wgsl/shade.wgsl`: `dir` kept on the `side` of the geometric surface
-/// (1: where the ray came from; -1: beyond), at least `GRAZING_COSINE` off it.
-fn keep_side(dir: DVec3, geometric: DVec3, side: f64) -> DVec3 {
-    let graze = f64::from(crate::shared::GRAZING_COSINE);
-    let c = side * dir.dot(geometric);
-    if c >= graze {
-        return dir;
-    }
-    (dir + side * (graze - c) * geometric).normalize()
-}
-
-fn fresnel(cos_i: f64, cos_t: f64, eta: f64) -> f64 {
-    let rs = (eta * cos_i - cos_t) / (eta * cos_i + cos_t);
-    let rp = (cos_i - eta * cos_t) / (cos_i + eta * cos_t);
-    0.5 * (rs * rs + rp * rp)
-}
-
-fn srgb_to_linear(c: f64) -> f64 {
-    if c <= 0.04045 {
-        c / 12.92
-    } else {
-        ((c + 0.055) / 1.055).powf(2.4)
-    }
-}
-
-/// Bilinear, repeat-wrapped, in linear space; v = 0 at the bottom (as `wgsl/shade.wgsl`).
-fn sample(t: &Texture, uv: DVec2) -> DVec3 {
-    let (w, h) = (i64::from(t.width), i64::from(t.height));
-    let texel = |x: i64, y: i64| {
-        let (x, y) = (x.rem_euclid(w) as usize, y.rem_euclid(h) as usize);
-        let i = 4 * (y * t.width as usize + x);
-        DVec3::new(
-            srgb_to_linear(f64::from(t.rgba[i]) / 255.0),
-            srgb_to_linear(f64::from(t.rgba[i + 1]) / 255.0),
-            srgb_to_linear(f64::from(t.rgba[i + 2]) / 255.0),
-        )
-    };
-    let st = DVec2::new(uv.x * w as f64 - 0.5, (1.0 - uv.y) * h as f64 - 0.5);
-    let base = st.floor();
-    let f = st - base;
-    let (x, y) = (base.x as i64, base.y as i64);
-    let top = texel(x, y).lerp(texel(x + 1, y), f.x);
-    let bottom = texel(x, y + 1).lerp(texel(x + 1, y + 1), f.x);
-    top.lerp(bottom, f.y)
 }

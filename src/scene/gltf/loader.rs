@@ -1,3 +1,6 @@
+//! The walk over a glTF scene's nodes: transforms composed, meshes flattened or instanced,
+//! materials, textures, lights and cameras mapped to this project's scene.
+
 //! glTF 2.0 scenes (`.gltf` with external or embedded buffers, `.glb`) through the `gltf`
 //! crate's document model and validation. Buffers and images are read here, through the
 //! loader's `read` (so within the input budgets). A mesh that one node uses is placed in world
@@ -21,34 +24,14 @@
 //! - camera nodes: their poses (looking down the node's -z, up its +y), for `--camera gltf:N`;
 //! - anything else (animations, skins, morph targets, other textures, other extensions, sampler
 //!   modes other than repeat and linear) is left out with one warning per feature.
-
-use std::collections::{BTreeSet, HashMap};
-use std::path::Path;
-
-use base64::Engine;
-use glam::{DAffine3, DMat4, DQuat, DVec3, Vec2, Vec3};
-
-use super::obj::{Dropped, Loaded};
-use super::{Camera, Light, Material, MeshBuilder, MeshId, ReadFile, Surface, Texture};
-use crate::error::{Error, Result};
-use crate::input::InputKind;
-
-/// Extensions whose content is used (others are warned about).
-const USED_EXTENSIONS: [&str; 4] = [
-    "KHR_lights_punctual",
-    "KHR_materials_transmission",
-    "KHR_materials_ior",
-    "KHR_materials_emissive_strength",
-];
-
 /// Nodes nested deeper than this are refused (glTF's hierarchy is a tree; no stack overflow on
 /// hostile input).
-const MAX_DEPTH: usize = 256;
+pub(super) const MAX_DEPTH: usize = 256;
 
 /// Node visits (a node as often as the hierarchy reaches it) beyond which a file is refused:
 /// the spec makes the hierarchy a tree, but a file may share children between parents and
 /// reach the same nodes exponentially often.
-const MAX_NODE_VISITS: usize = 1 << 20;
+pub(super) const MAX_NODE_VISITS: usize = 1 << 20;
 
 /// What a glTF file gives beyond its triangles and materials.
 pub struct Content {
@@ -58,316 +41,67 @@ pub struct Content {
     pub cameras: Vec<Camera>,
 }
 
-/// Loads the glTF file at `path` (and the files it names, through `read`) into `b`: the scene
-/// `scene` (else the document's default, else its first). Warnings name what was left out.
-pub fn load_into(
-    path: &Path,
-    read: ReadFile,
-    scene: Option<usize>,
-    b: &mut MeshBuilder,
-    warnings: &mut Vec<String>,
-) -> Result<Content> {
-    let fail = |message: String| Error::Gltf {
-        path: path.to_path_buf(),
-        message,
-    };
-    let bytes =
-        read(path, InputKind::Gltf).map_err(|e| fail(format!("cannot read the file: {e}")))?;
-    // The gltf crate subtracts the 12-byte header from the GLB's declared length unchecked
-    // (an overflow where overflow checks are on; found by fuzzing).
-    if let Some(length) = bytes
-        .strip_prefix(b"glTF")
-        .and_then(|rest| rest.get(4..8))
-        .map(|l| u32::from_le_bytes([l[0], l[1], l[2], l[3]]))
-        .filter(|&l| l < 12)
-    {
-        return Err(fail(format!(
-            "not valid glTF: the GLB header declares {length} bytes, less than the header itself"
-        )));
-    }
-    let unchecked = gltf::Gltf::from_slice_without_validation(&bytes)
-        .map_err(|e| fail(format!("not valid glTF: {e}")))?;
-    let blob = unchecked.blob;
-    let json = unchecked.document.into_json();
-    // gltf-json's validation reads a primitive's POSITION accessor before it checks that the
-    // index exists (and panics if not; found by fuzzing): check attribute indices first.
-    for (m, mesh) in json.meshes.iter().enumerate() {
-        for (p, primitive) in mesh.primitives.iter().enumerate() {
-            if let Some(index) = primitive
-                .attributes
-                .values()
-                .find(|i| i.value() >= json.accessors.len())
-            {
-                return Err(fail(format!(
-                    "not valid glTF: meshes[{m}].primitives[{p}] names accessors[{}], and \
-                     there are {}",
-                    index.value(),
-                    json.accessors.len()
-                )));
-            }
-        }
-    }
-    // Its image accessor unwraps an image's mimeType (with a bufferView) or uri (without).
-    for (i, image) in json.images.iter().enumerate() {
-        let complete = match image.buffer_view {
-            Some(_) => image.mime_type.is_some(),
-            None => image.uri.is_some(),
-        };
-        if !complete {
-            return Err(fail(format!(
-                "not valid glTF: images[{i}] needs a uri, or a bufferView with a mimeType"
-            )));
-        }
-    }
-    let document =
-        &gltf::Document::from_json(json).map_err(|e| fail(format!("not valid glTF: {e}")))?;
-    let dir = path.parent().unwrap_or(Path::new(""));
-    let buffers: Vec<Vec<u8>> = document
-        .buffers()
-        .map(|buffer| {
-            let what = format!("buffers[{}]", buffer.index());
-            let data = match buffer.source() {
-                gltf::buffer::Source::Bin => blob
-                    .clone()
-                    .ok_or_else(|| fail(format!("{what}: no binary chunk in the file")))?,
-                gltf::buffer::Source::Uri(uri) => {
-                    uri_data(uri, dir, read).map_err(|e| fail(format!("{what}: {}", e.text())))?
-                }
-            };
-            if data.len() < buffer.length() {
-                return Err(fail(format!(
-                    "{what} holds {} bytes, not the {} it declares",
-                    data.len(),
-                    buffer.length()
-                )));
-            }
-            Ok(data)
-        })
-        .collect::<Result<_>>()?;
-    let mut ignored = BTreeSet::new();
-    if document.animations().next().is_some() {
-        ignored.insert("animations".to_string());
-    }
-    if document.skins().next().is_some() {
-        ignored.insert("skins".to_string());
-    }
-    for extension in document.extensions_used() {
-        if !USED_EXTENSIONS.contains(&extension) {
-            ignored.insert(format!("the extension {extension}"));
-        }
-    }
-    let chosen = match scene {
-        Some(n) => document.scenes().nth(n).ok_or_else(|| {
-            fail(format!(
-                "no scene {n}: the file has {}",
-                document.scenes().count()
-            ))
-        })?,
-        None => document
-            .default_scene()
-            .or_else(|| document.scenes().next())
-            .ok_or_else(|| fail("no scene to render".into()))?,
-    };
-    // Meshes that several nodes use are stored once and placed by instances.
-    let mut uses = HashMap::new();
-    let mut visits = 0;
-    for node in chosen.nodes() {
-        count_uses(&node, 0, &mut visits, &mut uses);
-    }
-    let mut loader = Loader {
-        path,
-        dir,
-        read,
-        buffers: &buffers,
-        uses,
-        meshes: HashMap::new(),
-        visits: 0,
-        materials: HashMap::new(),
-        textures: HashMap::new(),
-        content: Content {
-            lights: Vec::new(),
-            cameras: Vec::new(),
-        },
-        ignored,
-        warnings,
-    };
-    for node in chosen.nodes() {
-        loader.node(&node, DMat4::IDENTITY, 0, b)?;
-    }
-    let Loader {
-        ignored,
-        warnings,
-        content,
-        ..
-    } = loader;
-    for what in ignored {
-        warnings.push(format!("{}: {what} not rendered", path.display()));
-    }
-    Ok(content)
-}
+use super::uri::{Missing, uri_data};
+use crate::error::{Error, Result};
+use crate::scene::obj::Dropped;
+use crate::scene::{Camera, Light, Material, MeshBuilder, MeshId, ReadFile, Surface, Texture};
+use glam::{DAffine3, DMat4, DQuat, DVec3, Vec2, Vec3};
+use std::collections::{BTreeSet, HashMap};
+use std::path::Path;
 
-/// Counts the nodes under `node` (itself included) that use each mesh, up to [`MAX_DEPTH`]
-/// levels and [`MAX_NODE_VISITS`] nodes (where loading stops with an error anyway).
-fn count_uses(
-    node: &gltf::Node,
-    depth: usize,
-    visits: &mut usize,
-    uses: &mut HashMap<usize, usize>,
-) {
-    *visits += 1;
-    if depth > MAX_DEPTH || *visits > MAX_NODE_VISITS {
-        return;
-    }
-    if let Some(mesh) = node.mesh() {
-        *uses.entry(mesh.index()).or_default() += 1;
-    }
-    for child in node.children() {
-        count_uses(&child, depth + 1, visits, uses);
-    }
-}
-
-/// A glTF file as a scene: its lights (else a headlight and a sun), its first camera (else a
-/// view framing its bounds), and its cameras for `--camera gltf:N`.
-pub fn load_gltf(path: &Path, scene: Option<usize>) -> Result<Loaded> {
-    load_gltf_from(path, &super::disk, scene)
-}
-
-/// As [`load_gltf`], reading the files through `read`.
-pub fn load_gltf_from(path: &Path, read: ReadFile, scene: Option<usize>) -> Result<Loaded> {
-    let mut b = MeshBuilder::new();
-    let mut warnings = Vec::new();
-    let content = load_into(path, read, scene, &mut b, &mut warnings)?;
-    if b.is_empty() {
-        return Err(Error::Gltf {
-            path: path.to_path_buf(),
-            message: format!("no triangles to render{}", super::obj::because(&warnings)),
-        });
-    }
-    let (lo, hi) = b.bounds().unwrap_or((DVec3::ZERO, DVec3::ZERO));
-    let given = content.cameras.first().copied();
-    let camera = given.unwrap_or_else(|| super::obj::framing(lo, hi, super::obj::DEFAULT_DISTANCE));
-    let lit = !content.lights.is_empty();
-    let lights = if lit {
-        content.lights
-    } else {
-        super::obj::headlight_and_sun(&camera)
-    };
-    let mut scene = b.finish(
-        lights,
-        super::obj::DEFAULT_SKY,
-        super::obj::DEFAULT_AMBIENT,
-        camera,
-    );
-    scene.cameras = content.cameras;
-    if !lit {
-        scene.headlight = Some(0);
-    }
-    if given.is_none() {
-        scene.framed = Some((lo, hi));
-    }
-    Ok(Loaded { scene, warnings })
-}
-
-/// Why a URI's bytes could not be had.
-enum Missing {
-    /// The file does not exist (a missing image is a warning).
-    NotFound(String),
-    /// Anything else: a bad URI, a special or oversized file (always an error).
-    Bad(String),
-}
-
-impl Missing {
-    fn text(self) -> String {
-        match self {
-            Missing::NotFound(t) | Missing::Bad(t) => t,
-        }
-    }
-}
-
-/// The bytes of a URI: a `data:` URI's base64, or a file relative to the glTF's folder.
-fn uri_data(uri: &str, dir: &Path, read: ReadFile) -> Result<Vec<u8>, Missing> {
-    if let Some(data) = uri.strip_prefix("data:") {
-        let (header, payload) = data
-            .split_once(',')
-            .ok_or_else(|| Missing::Bad("a data URI without a comma".into()))?;
-        if !header.ends_with(";base64") {
-            return Err(Missing::Bad("a data URI that is not base64".into()));
-        }
-        return base64::engine::general_purpose::STANDARD
-            .decode(payload)
-            .map_err(|e| Missing::Bad(format!("its data URI is not valid base64: {e}")));
-    }
-    let name = percent_decoded(uri).map_err(Missing::Bad)?;
-    let file = dir.join(&name);
-    read(&file, InputKind::Gltf).map_err(|e| {
-        let text = format!("{}: {e}", file.display());
-        if e.kind() == std::io::ErrorKind::NotFound {
-            Missing::NotFound(text)
-        } else {
-            Missing::Bad(text)
-        }
-    })
-}
-
-/// A relative URI's path with its `%XX` escapes decoded.
-fn percent_decoded(uri: &str) -> Result<String, String> {
-    let bytes = uri.as_bytes();
-    let mut out = Vec::with_capacity(bytes.len());
-    let mut i = 0;
-    while i < bytes.len() {
-        if bytes[i] == b'%' {
-            let hex = uri
-                .get(i + 1..i + 3)
-                .and_then(|h| u8::from_str_radix(h, 16).ok())
-                .ok_or_else(|| format!("the URI {uri:?} has a bad % escape"))?;
-            out.push(hex);
-            i += 3;
-        } else {
-            out.push(bytes[i]);
-            i += 1;
-        }
-    }
-    String::from_utf8(out).map_err(|_| format!("the URI {uri:?} is not UTF-8"))
-}
-
-struct Loader<'a> {
-    path: &'a Path,
-    dir: &'a Path,
-    read: ReadFile<'a>,
-    buffers: &'a [Vec<u8>],
+pub(super) struct Loader<'a> {
+    pub(super) path: &'a Path,
+    pub(super) dir: &'a Path,
+    pub(super) read: ReadFile<'a>,
+    pub(super) buffers: &'a [Vec<u8>],
     /// Our material of each glTF material (`None`: the default material).
-    materials: HashMap<Option<usize>, u32>,
+    pub(super) materials: HashMap<Option<usize>, u32>,
     /// Our texture of each glTF texture (`None`: it could not be loaded).
-    textures: HashMap<usize, Option<u32>>,
+    pub(super) textures: HashMap<usize, Option<u32>>,
     /// How many nodes use each glTF mesh: those used more than once are instanced.
-    uses: HashMap<usize, usize>,
+    pub(super) uses: HashMap<usize, usize>,
     /// The stored mesh of each instanced glTF mesh.
-    meshes: HashMap<usize, MeshId>,
+    pub(super) meshes: HashMap<usize, MeshId>,
     /// Nodes visited so far.
-    visits: usize,
-    content: Content,
+    pub(super) visits: usize,
+    pub(super) content: Content,
     /// Features left out, for one warning each.
-    ignored: BTreeSet<String>,
-    warnings: &'a mut Vec<String>,
+    pub(super) ignored: BTreeSet<String>,
+    pub(super) warnings: &'a mut Vec<String>,
 }
 
 impl Loader<'_> {
-    fn fail(&self, message: String) -> Error {
+    pub(super) fn fail(&self, message: String) -> Error {
         Error::Gltf {
             path: self.path.to_path_buf(),
             message,
         }
     }
 
-    /// Adds a node and its children under `parent`'s transform.
-    fn node(
+    /// Adds a node and its children under `parent`'s transform; `ancestors` are the indices
+    /// of the nodes above it, root first.
+    pub(super) fn node(
         &mut self,
         node: &gltf::Node,
         parent: DMat4,
-        depth: usize,
+        ancestors: &mut Vec<usize>,
         b: &mut MeshBuilder,
     ) -> Result<()> {
-        if depth > MAX_DEPTH {
+        if let Some(at) = ancestors.iter().position(|&a| a == node.index()) {
+            let chain: Vec<String> = ancestors[at..]
+                .iter()
+                .chain([&node.index()])
+                .map(|i| format!("nodes[{i}]"))
+                .collect();
+            return Err(self.fail(format!(
+                "nodes[{}] lists nodes[{}] as a child, which is its own ancestor: the hierarchy \
+                 has a cycle ({})",
+                ancestors.last().expect("a node's own ancestor is above it"),
+                node.index(),
+                chain.join(" -> ")
+            )));
+        }
+        if ancestors.len() > MAX_DEPTH {
             return Err(self.fail(format!(
                 "nodes[{}]: the hierarchy is deeper than {MAX_DEPTH} nodes",
                 node.index()
@@ -444,13 +178,15 @@ impl Loader<'_> {
                 });
             }
         }
+        ancestors.push(node.index());
         for child in node.children() {
-            self.node(&child, world, depth + 1, b)?;
+            self.node(&child, world, ancestors, b)?;
         }
+        ancestors.pop();
         Ok(())
     }
 
-    fn light(&mut self, light: &gltf::khr_lights_punctual::Light, at: DAffine3) {
+    pub(super) fn light(&mut self, light: &gltf::khr_lights_punctual::Light, at: DAffine3) {
         use gltf::khr_lights_punctual::Kind;
         let colour = Vec3::from(light.color()) * light.intensity() / 683.0;
         match light.kind() {
@@ -479,7 +215,12 @@ impl Loader<'_> {
         }
     }
 
-    fn mesh(&mut self, mesh: &gltf::Mesh, at: DAffine3, b: &mut MeshBuilder) -> Result<()> {
+    pub(super) fn mesh(
+        &mut self,
+        mesh: &gltf::Mesh,
+        at: DAffine3,
+        b: &mut MeshBuilder,
+    ) -> Result<()> {
         for primitive in mesh.primitives() {
             let what = format!("meshes[{}].primitives[{}]", mesh.index(), primitive.index());
             if primitive.morph_targets().next().is_some() {
@@ -592,7 +333,7 @@ impl Loader<'_> {
     /// Refuses accessors of a type the spec does not allow where they are used (the gltf
     /// crate's validation does not check them, and its readers assume them: found by
     /// fuzzing).
-    fn check_types(&self, primitive: &gltf::Primitive, what: &str) -> Result<()> {
+    pub(super) fn check_types(&self, primitive: &gltf::Primitive, what: &str) -> Result<()> {
         use gltf::accessor::{DataType as D, Dimensions as N};
         let allowed: [(Option<gltf::Accessor>, &str, &[D], N); 4] = [
             (
@@ -636,7 +377,7 @@ impl Loader<'_> {
     }
 
     /// Our material for a glTF material (made at its first use).
-    fn material(&mut self, m: &gltf::Material, b: &mut MeshBuilder) -> Result<u32> {
+    pub(super) fn material(&mut self, m: &gltf::Material, b: &mut MeshBuilder) -> Result<u32> {
         if let Some(&id) = self.materials.get(&m.index()) {
             return Ok(id);
         }
@@ -708,7 +449,11 @@ impl Loader<'_> {
 
     /// Our texture for a glTF texture, or `None` (warned) where its image is missing or cannot
     /// be decoded; an error for a special or oversized file or a bad URI.
-    fn texture(&mut self, texture: &gltf::Texture, b: &mut MeshBuilder) -> Result<Option<u32>> {
+    pub(super) fn texture(
+        &mut self,
+        texture: &gltf::Texture,
+        b: &mut MeshBuilder,
+    ) -> Result<Option<u32>> {
         if let Some(&id) = self.textures.get(&texture.index()) {
             return Ok(id);
         }
