@@ -13,7 +13,9 @@
 //!   split across as many storage bindings as they need.
 //! - [`scene`], [`bvh`], [`trace`]: scenes (built-in, OBJ, glTF and scene files), the CWBVH,
 //!   and the GPU tracer with its f64 reference.
-//! - [`renderer`]: rendering on the caller's device into the caller's texture and encoder.
+//! - [`renderer`]: a [`renderer::Renderer`] renders on the caller's device into the caller's
+//!   texture and encoder; a [`renderer::Offscreen`] renders frames in submissions of its own,
+//!   times them and reads them back (what the `fisheye` tool's commands are built on).
 //! - [`pose`], [`dataset`]: rigid transforms, trajectories (TUM, KITTI, EuRoC) and synthetic
 //!   datasets of a camera rig along them, in shards.
 //! - `peer` (feature `peer-embree`): Embree 3 casting the same rays, for the peer benchmark.
@@ -41,6 +43,8 @@
 //! assert!(frame.ids.iter().all(|&id| id != NO_HIT)); // the room is closed
 //! # Ok(()) }
 //! ```
+
+#![warn(missing_docs)]
 
 pub mod bvh;
 pub mod cube;
@@ -79,7 +83,13 @@ pub mod peer;
 
 pub use error::{Error, LensError, Result};
 
-/// The README's Rust examples, compiled as doctests so they stay true.
+/// The README's Rust examples, compiled and run as doctests so they stay true.
 #[doc = include_str!("../README.md")]
 #[cfg(doctest)]
 pub struct ReadmeDoctests;
+
+/// The book's Rust examples ("Embedding in Rust"), compiled and run as doctests; `tests/docs.rs`
+/// checks that every page with Rust in it is included here.
+#[doc = include_str!("../docs/src/embedding.md")]
+#[cfg(doctest)]
+pub struct EmbeddingDoctests;

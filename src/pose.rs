@@ -12,7 +12,7 @@ const QUATERNION_NORM_TOLERANCE: f64 = 1e-2;
 
 /// How far `RᵀR` may be from the identity, entry by entry, before a rotation matrix is refused:
 /// KITTI prints 6 significant digits (errors near 10⁻⁶).
-const ORTHONORMAL_TOLERANCE: f64 = 1e-3;
+pub const ORTHONORMAL_TOLERANCE: f64 = 1e-3;
 
 /// The rotation of a quaternion given as `(x, y, z, w)`, normalised; refused when it is not
 /// finite or not within 1% of unit length.

@@ -70,7 +70,9 @@ impl Split {
 /// How a scene's growing arrays are split across the bindings of group 1.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct SceneArrays {
+    /// The BVH's nodes (80 bytes each).
     pub nodes: Split,
+    /// The triangles (48 bytes each).
     pub triangles: Split,
     /// The `vec4<f32>`s of per-vertex shading data.
     pub vertices: Split,

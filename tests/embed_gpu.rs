@@ -79,8 +79,12 @@ fn frames_recorded_into_the_callers_encoder_and_texture_match_the_one_call_rende
         look_at: home.look_at + DVec3::new(-0.8, 0.3, 0.0),
         up: DVec3::Y,
     };
+    // The last target is the one the renderer offers.
     let targets: Vec<wgpu::Texture> = (0..3)
-        .map(|_| texture(&device, camera.size, format))
+        .map(|i| match i {
+            2 => renderer.target_texture(&device),
+            _ => texture(&device, camera.size, format),
+        })
         .collect();
     let mut encoder = device.create_command_encoder(&Default::default());
     for (pose, target) in [home, moved, home].iter().zip(&targets) {

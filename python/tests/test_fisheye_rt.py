@@ -276,13 +276,33 @@ def test_the_type_stubs_name_everything_the_module_has():
             assert members <= declared[name], (name, members - declared[name])
 
 
-def test_the_readmes_example_runs():
-    """The Python example in the README's "Python" section runs as written."""
-    readme = (ROOT / "README.md").read_text()
-    section = readme.split("\n## Python\n", 1)[1].split("\n## ", 1)[0]
-    code = section.split("```python\n", 1)[1].split("```", 1)[0]
+def python_blocks(path):
+    """The ```python blocks of a Markdown file, in order."""
+    text = path.read_text()
+    return [block.split("```", 1)[0] for block in text.split("```python\n")[1:]]
+
+
+def test_the_docs_python_examples_run_as_written():
+    """Every Python block of the README and the book runs as written: the README's
+    front-page example, then the Python page's, which checks its own results."""
+    blocks = python_blocks(ROOT / "README.md")
+    assert len(blocks) == 1
     scope = {}
-    exec(compile(code, "README.md (Python)", "exec"), scope)
+    exec(compile(blocks[0], "README.md (Python)", "exec"), scope)
+    assert scope["out"]["srgb"].shape == (480, 640, 4)
+    assert scope["out"]["range"].dtype == np.float32
+    pages = sorted((ROOT / "docs" / "src").glob("*.md"))
+    found = 0
+    for page in pages:
+        for k, code in enumerate(python_blocks(page)):
+            scope = {}
+            exec(compile(code, f"{page.name} (Python block {k})", "exec"), scope)
+            found += 1
+    assert found >= 1
+    # The Python page's example: a pixel outside the image has no ray.
+    python_page = python_blocks(ROOT / "docs" / "src" / "python.md")[0]
+    scope = {}
+    exec(compile(python_page, "python.md", "exec"), scope)
     assert scope["out"]["srgb"].shape == (768, 1024, 4)
     assert np.isnan(scope["dirs"][1]).all() and not np.isnan(scope["dirs"][0]).any()
 

@@ -330,6 +330,28 @@ impl Renderer {
         })
     }
 
+    /// A texture [`Renderer::encode`] can write: the camera's size, the renderer's format,
+    /// usable as a storage texture, sampled, and copied from.
+    pub fn target_texture(&self, device: &wgpu::Device) -> wgpu::Texture {
+        let size = self.camera.size;
+        device.create_texture(&wgpu::TextureDescriptor {
+            label: Some("fisheye.target"),
+            size: wgpu::Extent3d {
+                width: size.width,
+                height: size.height,
+                depth_or_array_layers: 1,
+            },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format: self.format,
+            usage: wgpu::TextureUsages::STORAGE_BINDING
+                | wgpu::TextureUsages::TEXTURE_BINDING
+                | wgpu::TextureUsages::COPY_SRC,
+            view_formats: &[],
+        })
+    }
+
     /// The scene as uploaded (its BVH statistics, bounds, features).
     pub fn scene(&self) -> &GpuScene {
         &self.scene

@@ -16,10 +16,10 @@ pub fn linear_to_srgb(x: f32) -> f32 {
     }
 }
 
-/// Masked pixels' colour in [`RenderOutput::to_image`] (sRGB).
+/// Masked pixels' colour in [`super::RenderOutput::to_image`] (sRGB).
 pub const MASKED_RGB: [u8; 3] = [0, 0, 0];
 
-/// The image of linear colours whose `w` is the lens's coverage (as [`RenderOutput::colour`]):
+/// The image of linear colours whose `w` is the lens's coverage (as [`super::RenderOutput::colour`]):
 /// sRGB-encoded and clamped, alpha the coverage (opaque where a pixel is covered, transparent
 /// where not, between at the edge of the image circle with several rays per pixel).
 pub fn colour_image(size: ImageSize, colour: &[[f32; 4]]) -> image::RgbaImage {

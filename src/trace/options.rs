@@ -27,7 +27,7 @@ pub struct RenderOptions {
     /// How rays find their hits.
     pub traversal: Traversal,
     /// Rays per pixel (a square: jittered stratified samples, box-filtered; see
-    /// [`sampling`]). Ground-truth outputs stay the one ray through the pixel's centre.
+    /// [`super::sampling`]). Ground-truth outputs stay the one ray through the pixel's centre.
     pub spp: u32,
 }
 

@@ -1,0 +1,43 @@
+#!/usr/bin/env bash
+# Re-makes the pictures of the README and the book (docs/src/images/): three renders and the
+# speed-against-error plot of results/lavapipe/, and the strip the README opens with. Run from
+# anywhere after `cargo build --release`; about a minute on lavapipe. Needs python3 with
+# Pillow (`.ci/install-lavapipe` installs it). Each picture is kept under 300 KB.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+fisheye=target/release/fisheye
+out=docs/src/images
+mkdir -p "$out"
+# The default room through the 180° Canon 8-15 mm at 8 mm (the first command of the README).
+"$fisheye" render --size 480x360 -o "$out/room.png"
+# Šibenik cathedral through the Samyang 7.5 mm's real mapping (a preset fitted to the lens).
+"$fisheye" render scenes/sibenik.toml --lens samyang-7.5mm --size 480x360 -o "$out/sibenik.png"
+# The Stanford bunny, a bare OBJ exposed automatically, as a dome master (equidistant 180°).
+"$fisheye" render scenes/scanned/stanford-bunny.obj --lens equidistant:f=0.6366 --size 360x360 \
+  -o "$out/dome.png"
+python3 - "$out" <<'PY'
+import sys
+from PIL import Image
+
+out = sys.argv[1]
+plot = Image.open("results/lavapipe/sibenik/compare/tradeoff-flip.samyang-7.5mm.png").convert("RGB")
+height = 360
+plot = plot.resize((round(plot.width * height / plot.height), height), Image.LANCZOS)
+plot.save(f"{out}/tradeoff.png", optimize=True)
+tiles = [Image.open(f"{out}/{n}.png").convert("RGB") for n in ("room", "sibenik", "dome")]
+tiles.append(plot)
+strip = Image.new("RGB", (sum(t.width for t in tiles) + 8 * (len(tiles) - 1), height), "white")
+x = 0
+for t in tiles:
+    strip.paste(t, (x, 0))
+    x += t.width + 8
+strip = strip.resize((strip.width * 2 // 3, height * 2 // 3), Image.LANCZOS)
+strip.quantize(colors=256, method=Image.Quantize.MEDIANCUT, dither=Image.Dither.FLOYDSTEINBERG).save(
+    f"{out}/strip.png", optimize=True
+)
+for name in ("room", "sibenik", "dome", "tradeoff", "strip"):
+    path = f"{out}/{name}.png"
+    image = Image.open(path)
+    image.quantize(colors=256, method=Image.Quantize.MEDIANCUT if image.mode == "RGB" else Image.Quantize.FASTOCTREE).save(path, optimize=True) if name != "strip" else None
+PY
+ls -l "$out"
