@@ -115,6 +115,17 @@ impl DirectionFormula {
 }
 
 /// A lens on an image of a given size: the camera's projection, without pose.
+///
+/// ```
+/// use fisheye_rt::lens::{parse_spec, ImageSize, LensCamera};
+/// let camera = LensCamera::new(parse_spec("equidistant:f=0.5")?, ImageSize::new(640, 480)?);
+/// // Pixel (320, 240)'s centre is the image's: straight ahead (x right, y down, z forward).
+/// let ahead = camera.pixel_direction(320, 240).expect("the centre has a ray");
+/// assert!(ahead.z > 0.99);
+/// // f = 0.5 half-widths a radian: 90° off axis at 0.785 half-widths, inside the image.
+/// assert!(camera.pixel_direction(320 + 250, 240).is_some_and(|d| d.z.abs() < 0.02));
+/// # Ok::<(), fisheye_rt::Error>(())
+/// ```
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct LensCamera {
     /// The lens mapping.

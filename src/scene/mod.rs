@@ -200,6 +200,14 @@ pub const MAX_FLATTENED: usize = 50_000_000;
 /// is a stored world triangle, numbered first, or a triangle of an instance: instance k's
 /// triangles follow those of instances before it, in mesh order, as [`Scene::flattened`]
 /// lays them out.
+///
+/// ```
+/// use fisheye_rt::scene::builtin;
+/// // Or from files: scene::obj::load_obj, scene::gltf::load_gltf, scene::file::load_scene_file.
+/// let scene = builtin::scene("default").expect("a built-in scene");
+/// assert!(scene.len() > 0 && !scene.lights.is_empty());
+/// assert!(!scene.is_instanced()); // every triangle in world space
+/// ```
 #[derive(Clone, Debug)]
 pub struct Scene {
     /// The corners of every stored triangle: world space, then mesh space.

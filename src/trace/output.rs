@@ -11,6 +11,19 @@ use super::NO_HIT;
 use super::display::{colour_image, write_atomically};
 
 /// One rendered frame, row-major.
+///
+/// ```
+/// use fisheye_rt::lens::{parse_spec, ImageSize, LensCamera};
+/// use fisheye_rt::trace::{render, RenderOptions, NO_HIT};
+/// use fisheye_rt::{gpu::GpuContext, scene::builtin};
+/// let scene = builtin::scene("default").expect("a built-in scene");
+/// let camera = LensCamera::new(parse_spec("samyang-7.5mm")?, ImageSize::new(32, 24)?);
+/// let out = render(&GpuContext::new()?, &scene, &camera, &RenderOptions::default())?;
+/// let (rays, hits) = out.counts(); // pixels with a ray at their centre; those that hit
+/// assert!(0 < hits && hits <= rays && rays <= 32 * 24);
+/// assert_eq!(out.ids.iter().filter(|&&id| id != NO_HIT).count(), hits);
+/// # Ok::<(), fisheye_rt::Error>(())
+/// ```
 #[derive(Clone, Debug)]
 pub struct RenderOutput {
     /// Image size.
