@@ -231,20 +231,7 @@ impl State {
             _ => Renderer::new(device, queue, &self.scene, &camera, &options, format),
         }
         .map_err(|e| e.to_string())?;
-        let target = device.create_texture(&wgpu::TextureDescriptor {
-            label: Some("viewer.image"),
-            size: wgpu::Extent3d {
-                width: size.width,
-                height: size.height,
-                depth_or_array_layers: 1,
-            },
-            mip_level_count: 1,
-            sample_count: 1,
-            dimension: wgpu::TextureDimension::D2,
-            format,
-            usage: wgpu::TextureUsages::STORAGE_BINDING | wgpu::TextureUsages::TEXTURE_BINDING,
-            view_formats: &[],
-        });
+        let target = renderer.target_texture(device);
         let view = target.create_view(&Default::default());
         let blit_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("viewer.blit"),

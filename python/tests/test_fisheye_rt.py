@@ -291,14 +291,12 @@ def test_the_docs_python_examples_run_as_written():
     exec(compile(blocks[0], "README.md (Python)", "exec"), scope)
     assert scope["out"]["srgb"].shape == (480, 640, 4)
     assert scope["out"]["range"].dtype == np.float32
-    pages = sorted((ROOT / "docs" / "src").glob("*.md"))
-    found = 0
+    # The Python page's example is run below, where its results are checked.
+    pages = sorted(p for p in (ROOT / "docs" / "src").glob("*.md") if p.name != "python.md")
     for page in pages:
         for k, code in enumerate(python_blocks(page)):
             scope = {}
             exec(compile(code, f"{page.name} (Python block {k})", "exec"), scope)
-            found += 1
-    assert found >= 1
     # The Python page's example: a pixel outside the image has no ray.
     python_page = python_blocks(ROOT / "docs" / "src" / "python.md")[0]
     scope = {}

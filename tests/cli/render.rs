@@ -172,45 +172,33 @@ fn render_exposes_tone_maps_and_writes_png_or_exr() {
     std::fs::remove_dir_all(dir).unwrap();
 }
 
-/// A colour file the tool cannot write is refused before anything is rendered, with one
-/// message and no file; a failure while writing leaves no file either.
+/// A colour file the tool cannot write is refused before anything is rendered (no device is
+/// made), with one message and no file.
 #[test]
 fn refused_outputs_cost_no_rendering_and_leave_no_file() {
     let dir = std::env::temp_dir().join(format!("fisheye-cli-refused-{}", std::process::id()));
     std::fs::create_dir_all(dir.join("folder.png")).unwrap();
     std::fs::write(dir.join("plain.txt"), "a file, not a folder").unwrap();
     std::os::unix::fs::symlink("/dev/full", dir.join("full.png")).unwrap();
-    type Case<'a> = (&'a str, &'a [&'a str], &'a str, bool);
+    type Case<'a> = (&'a str, &'a [&'a str], &'a str);
     let cases: [Case; 9] = [
-        ("x.jpg", &[], "use one of those extensions", false),
-        ("x", &[], "use one of those extensions", false),
-        ("x.exr", &["--bits", "8"], "8 bits a channel", false),
-        ("x.png", &["--bits", "32"], "32 bits a channel", false),
-        ("folder.png", &[], "a folder, not a regular file", false),
-        (
-            "full.png",
-            &[],
-            "a symbolic link, not a regular file",
-            false,
-        ),
+        ("x.jpg", &[], "use one of those extensions"),
+        ("x", &[], "use one of those extensions"),
+        ("x.exr", &["--bits", "8"], "8 bits a channel"),
+        ("x.png", &["--bits", "32"], "32 bits a channel"),
+        ("folder.png", &[], "a folder, not a regular file"),
+        ("full.png", &[], "a symbolic link, not a regular file"),
         (
             "x.png",
             &["--outputs", "range", "--format", "exr"],
             "x.range.exr: a folder",
-            false,
         ),
-        (
-            "x.png",
-            &["--exposure", "inf"],
-            "finite number of stops",
-            false,
-        ),
+        ("x.png", &["--exposure", "inf"], "finite number of stops"),
         // A folder that cannot be made (a file is in its way): refused before the device.
         (
             "plain.txt/x.png",
             &[],
             "x.png: cannot be written (File exists",
-            false,
         ),
     ];
     std::fs::create_dir_all(dir.join("x.range.exr")).unwrap();
@@ -218,7 +206,7 @@ fn refused_outputs_cost_no_rendering_and_leave_no_file() {
         .unwrap()
         .map(|e| e.unwrap().path())
         .collect();
-    for (name, extra, needle, renders) in cases {
+    for (name, extra, needle) in cases {
         let out = dir.join(name);
         let render = [
             "render",
@@ -237,7 +225,10 @@ fn refused_outputs_cost_no_rendering_and_leave_no_file() {
         let code = output.status.code();
         assert!(matches!(code, Some(1 | 2)), "{args:?}: {code:?} {stderr}");
         assert_eq!(stderr.matches(needle).count(), 1, "{args:?}: {stderr:?}");
-        assert_eq!(stdout.contains("adapter:"), renders, "{args:?}: {stdout}");
+        assert!(
+            !stdout.contains("adapter:"),
+            "{args:?} made a device: {stdout}"
+        );
         let after: Vec<_> = std::fs::read_dir(&dir)
             .unwrap()
             .map(|e| e.unwrap().path())
