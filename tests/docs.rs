@@ -194,7 +194,12 @@ fn the_readme_is_a_front_page_whose_commands_run() {
             block.info
         );
     }
-    // Pictures: present and at most 300 KB each.
+    // Pictures: present and at most 300 KB each, the book's too.
+    for entry in std::fs::read_dir(root().join("docs/src/images")).unwrap() {
+        let path = entry.unwrap().path();
+        let bytes = std::fs::metadata(&path).unwrap().len();
+        assert!(bytes <= 300 << 10, "{} is {bytes} bytes", path.display());
+    }
     for link in readme.split("](").skip(1) {
         let target = &link[..link.find(')').unwrap()];
         let target = target.split('#').next().unwrap();

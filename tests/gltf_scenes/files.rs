@@ -338,3 +338,22 @@ fn shared_meshes_are_instanced() {
     assert!(close(flat.triangles[1][1], DVec3::X));
     assert!(close(flat.triangles[2][1], DVec3::new(3.0, 0.0, 0.0)));
 }
+
+/// The repository's glTF example, written by another tool (trimesh, `scenes/gltf/make.py`):
+/// its two shared meshes are stored once and placed by the 20 nodes that use them (8 columns
+/// of a 24-sided cylinder, 12 tori of 32 × 12 quads), with the floor and the ball in world
+/// space; no warning, and no lights of its own (the headlight and the sun are added).
+#[test]
+fn the_example_gltf_file_is_instanced() {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/gltf/pavilion.glb");
+    let loaded = load_gltf(&path, None).unwrap();
+    assert!(loaded.warnings.is_empty(), "{:?}", loaded.warnings);
+    let scene = loaded.scene;
+    assert_eq!(scene.instances.len(), 20);
+    // A capped cylinder of 24 sections: 4 × 24 triangles; a torus: 2 × 32 × 12.
+    let (column, torus) = (4 * 24, 2 * 32 * 12);
+    let world = scene.world_triangles;
+    assert_eq!(scene.triangles.len() - world, column + torus);
+    assert_eq!(scene.len(), world + 8 * column + 12 * torus);
+    assert!(scene.headlight.is_some());
+}
