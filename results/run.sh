@@ -8,7 +8,7 @@
 #
 #   bash results/run.sh results/NAME
 #   # SIZE, CUBES, SPP, REFERENCE_SPP, BENCH_CUBES, BENCH_SPP, FRAMES, SCENES, SOAK, THESIS
-#   # override
+#   # override; FISHEYE=PATH runs a binary built elsewhere instead of building one
 #
 # The defaults suit a CPU (lavapipe): 256x192 images, and cube faces of 128, 256 and 480
 # texels (0.5, 1 and 2 texels per pixel at the 180° image's centre, as the 512, 1024
@@ -25,8 +25,8 @@ reference_spp=${REFERENCE_SPP:-256}
 bench_cubes=${BENCH_CUBES:-128,256}
 bench_spp=${BENCH_SPP:-1,16}
 frames=${FRAMES:-8}
-bin=target/release/fisheye
-cargo build --release --quiet
+bin=${FISHEYE:-target/release/fisheye}
+[ -n "${FISHEYE:-}" ] || cargo build --release --quiet
 lenses=(--lens canon-8-15mm@8mm --lens samyang-7.5mm)
 first=${FIRST:-1}
 scenes=${SCENES:-builtin:many-small builtin:few-detailed scenes/sibenik.toml \

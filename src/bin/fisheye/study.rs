@@ -98,7 +98,7 @@ pub(crate) fn prepare(args: &StudyArgs, command: &str) -> Result<Prepared> {
     if let Some(&bad) = args.cube_size.iter().find(|&&s| s == 0) {
         bail!("--cube-size {bad}: face sizes must be at least 1");
     }
-    let methods: Vec<renderer::Method> = if args.method.is_empty() {
+    let mut methods: Vec<renderer::Method> = if args.method.is_empty() {
         renderer::Method::ALL.to_vec()
     } else {
         args.method.iter().map(|m| m.method()).collect()
@@ -106,7 +106,6 @@ pub(crate) fn prepare(args: &StudyArgs, command: &str) -> Result<Prepared> {
     for &spp in &args.spp {
         samples_per_side(spp).with_context(|| format!("--spp {spp}"))?;
     }
-    let setups = Setup::all(&methods, &args.cube_size, &args.spp);
     let mut scene = load_scene_with(&args.scene, args.gltf_scene)?;
     if let Some(text) = &args.camera {
         let pose = parse_camera(text, &scene)?;
@@ -115,6 +114,17 @@ pub(crate) fn prepare(args: &StudyArgs, command: &str) -> Result<Prepared> {
     let out = out_folder(args.out.as_deref(), command)?;
     let ctx = GpuContext::new()?;
     println!("adapter: {}", ctx.adapter_name());
+    // Without --method, every method the adapter can run; a method named is an error there.
+    if args.method.is_empty() {
+        methods.retain(|m| match m.missing_feature(&ctx) {
+            Some(feature) => {
+                println!("left out: {} (the adapter has no {feature})", m.name());
+                false
+            }
+            None => true,
+        });
+    }
+    let setups = Setup::all(&methods, &args.cube_size, &args.spp);
     let options = RenderOptions {
         max_depth: args.shading.max_depth,
         bvh: args.shading.bvh.into(),
