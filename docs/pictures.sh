@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
-# Re-makes the pictures of the README and the book (docs/src/images/): three renders and the
-# speed-against-error plot of results/lavapipe/, and the strip the README opens with. Run from
+# Re-makes the pictures of the README and the book (docs/src/images/): three renders, an
+# adaptive render beside its spp map, the speed-against-error plot of results/lavapipe/, and
+# the strip the README opens with. Run from
 # anywhere after `cargo build --release`; about a minute on lavapipe. Needs python3 with
 # Pillow (`.ci/install-lavapipe` installs it). Each picture is kept under 300 KB.
 set -euo pipefail
@@ -16,6 +17,21 @@ mkdir -p "$out"
 # lights: the headlight and sun this tool adds, exposed automatically), from inside the ring.
 "$fisheye" render scenes/gltf/pavilion.glb --camera 1.2,1.8,4.2:0,0.6,0 --size 400x300 \
   -o "$out/gltf.png"
+# Adaptive sampling: the room with --spp auto and its spp map, side by side.
+"$fisheye" render --size 400x300 --spp auto --outputs spp -o "$out/adaptive-room.png"
+python3 - "$out" <<'PY'
+import sys
+from PIL import Image
+
+out = sys.argv[1]
+room = Image.open(f"{out}/adaptive-room.png").convert("RGBA")
+rays = Image.open(f"{out}/adaptive-room.spp.png").convert("RGBA")
+pair = Image.new("RGBA", (room.width * 2 + 8, room.height), (255, 255, 255, 255))
+pair.alpha_composite(room, (0, 0))
+pair.alpha_composite(rays, (room.width + 8, 0))
+pair.convert("RGB").save(f"{out}/adaptive.png", optimize=True)
+PY
+rm -f "$out/adaptive-room.png" "$out/adaptive-room.spp.png"
 python3 - "$out" <<'PY'
 import sys
 from PIL import Image

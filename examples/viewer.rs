@@ -9,7 +9,7 @@
 //! Keys: W A S D (or the arrows) move, Q and E go down and up, dragging with the left button
 //! looks around; L switches lens, M switches method (rt, rq, cube-rt, cube-forward,
 //! cube-deferred, cube-single: those the adapter has), P switches the rays per pixel of the
-//! traced methods (1, 4, 16), R goes back to the scene's camera, Esc quits. The title shows the lens, the method and the frame time. For tests:
+//! traced methods (1, 4, 16, then adaptive: auto:0.1:1 and auto), R goes back to the scene's camera, Esc quits. The title shows the lens, the method and the frame time. For tests:
 //! `--frames N --screenshot FILE` renders N frames from the scene's camera, saves the window's
 //! last frame as a PNG and exits.
 
@@ -23,7 +23,7 @@ use fisheye_rt::gpu::GpuContext;
 use fisheye_rt::lens::{ImageSize, LensCamera, parse_spec};
 use fisheye_rt::renderer::{Method, Renderer};
 use fisheye_rt::scene::{Camera, Scene};
-use fisheye_rt::trace::RenderOptions;
+use fisheye_rt::trace::{RenderOptions, Sampling};
 use glam::DVec3;
 use winit::application::ApplicationHandler;
 use winit::dpi::PhysicalSize;
@@ -42,7 +42,9 @@ const LENSES: [&str; 5] = [
 ];
 
 /// The rays per pixel P cycles through.
-const SPP: [u32; 3] = [1, 4, 16];
+/// The samplings P steps through: uniform rays per pixel, then adaptive sampling below one ray
+/// a pixel where the image is smooth (fast while moving) and up to 16 where it is not.
+const SPP: [&str; 5] = ["1", "4", "16", "auto:0.1:1", "auto"];
 
 struct Args {
     scene: String,
@@ -80,7 +82,7 @@ fn args() -> Result<Args, String> {
                 let text = value("--spp")?;
                 out.spp = SPP
                     .iter()
-                    .position(|s| s.to_string() == text)
+                    .position(|s| *s == text)
                     .ok_or(format!("--spp {text}: one of {SPP:?}"))?;
             }
             "--size" => {
@@ -217,9 +219,12 @@ impl State {
             wgpu::TextureFormat::Rgba8Unorm
         };
         let method = Method::ALL[self.method];
+        let sampling = Sampling::parse(SPP[self.spp]).map_err(|e| e.to_string())?;
+        let (spp, adaptive) = sampling.options(false);
         let options = RenderOptions {
             traversal: method.traversal(),
-            spp: SPP[self.spp],
+            spp,
+            adaptive,
             ..RenderOptions::default()
         };
         let (device, queue) = (&self.ctx.device, &self.ctx.queue);
@@ -372,7 +377,7 @@ impl State {
             Method::ALL[self.method].name(),
             match Method::ALL[self.method] {
                 Method::Cube(_) => String::new(),
-                _ => format!(" at {} rays a pixel", SPP[self.spp]),
+                _ => format!(" at --spp {}", SPP[self.spp]),
             },
             self.frame_ms
         ));

@@ -2,29 +2,32 @@
 # Reproduces a results folder: `fisheye compare` and `fisheye bench` on the issue's scenes
 # (the built-in many-small and few-detailed, and the shared Sibenik, Cornell box, bunny and
 # Buddha), through a 180° equidistant fisheye (canon-8-15mm@8mm) and the Samyang equisolid
-# preset (bench adds the pinhole baseline); direct RT over rays per pixel (SPP) against the
-# cube maps over face sizes (CUBES); then the thesis's face sizes (512, 1024, 1920) at
+# preset (bench adds the pinhole baseline); direct RT over rays per pixel (SPP: uniform
+# counts, and adaptive sampling at thresholds and most rays, auto:THRESHOLD[:MAX]) against
+# the cube maps over face sizes (CUBES); then the thesis's face sizes (512, 1024, 1920) at
 # 1024x768.
 #
 #   bash results/run.sh results/NAME
-#   # SIZE, CUBES, SPP, REFERENCE_SPP, BENCH_CUBES, BENCH_SPP, FRAMES, SCENES, SOAK, THESIS
-#   # override; FISHEYE=PATH runs a binary built elsewhere instead of building one
+#   # SIZE, CUBES, SPP, REFERENCE_SPP, BENCH_CUBES, BENCH_SPP, FRAMES, COMPARE_FRAMES, SCENES,
+#   # SOAK, THESIS, VALIDATE override; FISHEYE=PATH runs a binary built elsewhere instead of building one
 #
 # The defaults suit a CPU (lavapipe): 256x192 images, and cube faces of 128, 256 and 480
 # texels (0.5, 1 and 2 texels per pixel at the 180° image's centre, as the issue's 512, 1024
 # and 1920 are at 1024x768). On a GPU use SIZE=1024x768 CUBES=512,1024,1920
-# BENCH_CUBES=512,1024,1920 FRAMES=60. Error maps and reference images are kept for the first
+# BENCH_CUBES=512,1024,1920 FRAMES=60 COMPARE_FRAMES=15 (a GPU's clocks need more than three
+# frames for a steady median). Error maps and reference images are kept for the first
 # scene only (FIRST=0: for none), to keep the folder small.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 out=${1:?usage: bash results/run.sh OUT_DIR}
 size=${SIZE:-256x192}
 cubes=${CUBES:-128,256,480}
-spp=${SPP:-1,4,16}
+spp=${SPP:-1,4,16,auto:0.1:1,auto:0.1:4,auto:0.1,auto:0.02}
 reference_spp=${REFERENCE_SPP:-256}
 bench_cubes=${BENCH_CUBES:-128,256}
-bench_spp=${BENCH_SPP:-1,16}
+bench_spp=${BENCH_SPP:-1,16,auto:0.1:1,auto:0.1}
 frames=${FRAMES:-8}
+compare_frames=${COMPARE_FRAMES:-3}
 bin=${FISHEYE:-target/release/fisheye}
 [ -n "${FISHEYE:-}" ] || cargo build --release --quiet
 lenses=(--lens canon-8-15mm@8mm --lens samyang-7.5mm)
@@ -34,7 +37,8 @@ scenes/cornell-box.toml scenes/bunny.toml scenes/buddha.toml}
 for scene in $scenes; do
     name=$(basename "${scene#builtin:}" .toml)
     "$bin" compare "$scene" "${lenses[@]}" --no-pinhole --size "$size" --cube-size "$cubes" \
-        --spp "$spp" --reference-spp "$reference_spp" --frames 3 -o "$out/$name/compare"
+        --spp "$spp" --reference-spp "$reference_spp" --frames "$compare_frames" \
+        -o "$out/$name/compare"
     if [ "$first" = 0 ]; then
         rm -f "$out/$name/compare/"*.error.png "$out/$name/compare/"*.reference.png
     fi
@@ -43,11 +47,13 @@ for scene in $scenes; do
         --spp "$bench_spp" --frames "$frames" --warmup 2 -o "$out/$name/bench"
 done
 # Lens validation: every preset and calibrated example. Two overlays are kept, and no
-# per-corner lists, to keep the folder small.
-"$bin" validate -o "$out/validate"
-find "$out/validate" -name 'overlay.*' ! -name 'overlay.kb_*' ! -name 'overlay.canon-8-15mm@8mm.png' \
-    -delete
-rm -f "$out/validate/points."*.csv
+# per-corner lists, to keep the folder small (VALIDATE=0 leaves it out).
+if [ "${VALIDATE:-1}" = 1 ]; then
+    "$bin" validate -o "$out/validate"
+    find "$out/validate" -name 'overlay.*' ! -name 'overlay.kb_*' \
+        ! -name 'overlay.canon-8-15mm@8mm.png' -delete
+    rm -f "$out/validate/points."*.csv
+fi
 # Soak: 10,000 frames along the default room's walk, direct RT and a deferred cube map, with
 # resident and device memory before the first timed frame and after the last (SOAK=0 leaves
 # it out).

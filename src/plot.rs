@@ -274,7 +274,8 @@ fn place_labels(anchors: &[(i32, i32)], widths: &[i32], height: i32) -> Vec<(i32
 
 /// Time per frame (x, log) against error (y, log), a labelled point per setup coloured by
 /// method (filled where it is on the Pareto front), and each family's lower envelope as a
-/// line (`envelopes`: direct RT first, then the cube maps).
+/// line (`envelopes`: direct RT first, then the cube maps, then direct RT's uniform
+/// sampling alone).
 pub fn time_against_error(
     path: &Path,
     title: &str,
@@ -304,7 +305,11 @@ pub fn time_against_error(
             .x_label_formatter(&|v| tick(*v))
             .y_label_formatter(&|v| tick(*v))
             .draw()?;
-        let family_colours = [method_colour("rt"), RGBColor(90, 90, 90)];
+        let family_colours = [
+            method_colour("rt"),
+            RGBColor(90, 90, 90),
+            RGBColor(160, 190, 230),
+        ];
         for (series, &colour) in envelopes.iter().zip(&family_colours) {
             let line: Vec<(f64, f64)> = series
                 .points

@@ -15,7 +15,7 @@ use crate::split::SceneArrays;
 const SCENE_ARRAYS: &str = "scene_arrays";
 
 /// Every WGSL file of the project, by name (its file stem under `wgsl/`).
-pub const FILES: [(&str, &str); 24] = [
+pub const FILES: [(&str, &str); 29] = [
     ("math", include_str!("../wgsl/math.wgsl")),
     ("calibrated", include_str!("../wgsl/calibrated.wgsl")),
     ("triangles", include_str!("../wgsl/triangles.wgsl")),
@@ -25,6 +25,11 @@ pub const FILES: [(&str, &str); 24] = [
     ("shade", include_str!("../wgsl/shade.wgsl")),
     ("trace", include_str!("../wgsl/trace.wgsl")),
     ("trace_rq", include_str!("../wgsl/trace_rq.wgsl")),
+    ("pixel", include_str!("../wgsl/pixel.wgsl")),
+    ("colour", include_str!("../wgsl/colour.wgsl")),
+    ("adaptive", include_str!("../wgsl/adaptive.wgsl")),
+    ("adaptive_rq", include_str!("../wgsl/adaptive_rq.wgsl")),
+    ("adaptive_args", include_str!("../wgsl/adaptive_args.wgsl")),
     ("cast", include_str!("../wgsl/cast.wgsl")),
     ("lens", include_str!("../wgsl/lens.wgsl")),
     ("primary", include_str!("../wgsl/primary.wgsl")),
@@ -270,7 +275,15 @@ mod tests {
             .map(|(name, _)| *name)
             .filter(|name| reads_scene(name))
             .collect();
-        for kernel in ["trace", "trace_rq", "cast", "raster", "raster_multiview"] {
+        for kernel in [
+            "trace",
+            "trace_rq",
+            "adaptive",
+            "adaptive_rq",
+            "cast",
+            "raster",
+            "raster_multiview",
+        ] {
             assert!(readers.contains(&kernel), "{kernel} reads the scene");
         }
         let sources = FILES.iter().map(|(name, _)| (*name, compose(name))).chain(

@@ -21,6 +21,19 @@ pub const TRAVERSAL_STACK: u32 = 32;
 /// must ask for more (`renderer::required_limits`).
 pub const TRACE_STORAGE_BUFFERS: u32 = 12;
 
+/// Storage buffers the adaptive kernels bind beyond the trace kernel's: the per-pixel state
+/// and the work list (`trace::AdaptivePass`).
+pub const ADAPTIVE_STORAGE_BUFFERS: u32 = 2;
+
+/// Side of the blocks of pixels whose corners adaptive sampling traces first: one ray per
+/// `ADAPTIVE_BLOCK`² pixels where the image is smooth.
+pub const ADAPTIVE_BLOCK: u32 = 4;
+/// The `u32`s before the list in adaptive sampling's work buffer: the list's length
+/// (at `ADAPTIVE_COUNT`), three unused (a 16-byte header).
+pub const ADAPTIVE_HEADER: u32 = 4;
+/// Where the work buffer holds the list's length.
+pub const ADAPTIVE_COUNT: u32 = 0;
+
 /// The most samples per pixel side (`RenderOptions::spp` is a square of at most this).
 pub const MAX_SAMPLES_PER_SIDE: u32 = 16;
 
@@ -279,6 +292,9 @@ pub fn wgsl_constants() -> Vec<(String, u32)> {
         ("NO_TEXTURE", NO_TEXTURE),
         ("MAX_SHADOW_LAYERS", MAX_SHADOW_LAYERS),
         ("NO_HIT", NO_HIT),
+        ("ADAPTIVE_BLOCK", ADAPTIVE_BLOCK),
+        ("ADAPTIVE_HEADER", ADAPTIVE_HEADER),
+        ("ADAPTIVE_COUNT", ADAPTIVE_COUNT),
         ("SURFACE_DIFFUSE", SURFACE_DIFFUSE),
         ("SURFACE_MIRROR", SURFACE_MIRROR),
         ("SURFACE_GLASS", SURFACE_GLASS),
@@ -366,6 +382,24 @@ pub struct Frame {
     /// w: the first image row the outputs hold (a band of rows, when the whole image's
     /// outputs exceed one storage binding; 0 otherwise).
     pub offset: [u32; 4],
+}
+
+/// Adaptive sampling's settings as `wgsl/adaptive.wgsl` reads them (32 bytes).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, PartialEq, Pod, Zeroable)]
+pub struct AdaptiveParams {
+    /// Displayed-colour difference at which two samples disagree.
+    pub threshold: f32,
+    /// The least cosine between two corners' normals on one smooth surface.
+    pub normal_cosine: f32,
+    /// The farthest a corner's hit may lie from another's tangent plane, relative to range.
+    pub plane_distance: f32,
+    /// Padding.
+    pub _pad0: u32,
+    /// Lattice points across and down.
+    pub lattice: [u32; 2],
+    /// Blocks across and down.
+    pub blocks: [u32; 2],
 }
 
 /// One triangle as `wgsl/bvh.wgsl` reads it: 48 bytes, three `vec4<f32>` whose `w` carry the
@@ -581,6 +615,25 @@ mod tests {
                 ("forward", offset_of!(Frame, forward)),
                 ("eye", offset_of!(Frame, eye)),
                 ("offset", offset_of!(Frame, offset)),
+            ],
+        );
+    }
+
+    /// `AdaptiveParams` in Rust and WGSL have the same size and field offsets.
+    #[test]
+    fn adaptive_params_layout_matches_wgsl() {
+        assert_eq!(size_of::<AdaptiveParams>(), 32);
+        assert_wgsl_layout(
+            "adaptive",
+            "AdaptiveParams",
+            size_of::<AdaptiveParams>(),
+            &[
+                ("threshold", offset_of!(AdaptiveParams, threshold)),
+                ("normal_cosine", offset_of!(AdaptiveParams, normal_cosine)),
+                ("plane_distance", offset_of!(AdaptiveParams, plane_distance)),
+                ("_pad0", offset_of!(AdaptiveParams, _pad0)),
+                ("lattice", offset_of!(AdaptiveParams, lattice)),
+                ("blocks", offset_of!(AdaptiveParams, blocks)),
             ],
         );
     }

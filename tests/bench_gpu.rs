@@ -10,11 +10,11 @@ use fisheye_rt::compare::{image_error, supersampled};
 use fisheye_rt::renderer::{Method, Offscreen, SceneSet, Setup};
 use fisheye_rt::report::{self, LensRun, Study};
 use fisheye_rt::scene::builtin;
-use fisheye_rt::trace::{RenderOptions, render};
+use fisheye_rt::trace::{RenderOptions, Sampling, render};
 
 /// Direct methods at one ray per pixel, cube methods at `sizes`.
 fn setups(methods: &[Method], sizes: &[u32]) -> Vec<Setup> {
-    Setup::all(methods, sizes, &[1])
+    Setup::all(methods, sizes, &[Sampling::Uniform(1)])
 }
 
 #[test]
@@ -87,7 +87,11 @@ fn compare_measures_both_families_against_the_many_ray_reference() {
         camera: camera("rectilinear:f=1", 64, 48),
     }];
     let traced = Method::Cube(fisheye_rt::cube::CubeMethod::Traced);
-    let all = Setup::all(&[Method::Rt, traced], &[16, 64], &[1, 4, 16]);
+    let all = Setup::all(
+        &[Method::Rt, traced],
+        &[16, 64],
+        &[1, 4, 16].map(Sampling::Uniform),
+    );
     let scenes = SceneSet::new(ctx(), &scene, &RenderOptions::default(), &all).unwrap();
     let colour = |setup: Setup| {
         let renderer = Offscreen::new(ctx(), &lenses[0].camera, &scenes, setup, 512).unwrap();

@@ -10,7 +10,7 @@ use fisheye_rt::cube::{CubeMap, CubeMethod, CubeSettings};
 use fisheye_rt::gpu::GpuContext;
 use fisheye_rt::lens::{ImageSize, LensCamera, parse_spec};
 use fisheye_rt::scene::builtin;
-use fisheye_rt::trace::{GpuScene, RenderOptions, colour_image, render};
+use fisheye_rt::trace::{Adaptive, GpuScene, RenderOptions, colour_image, render};
 
 /// The viewer example's binary, beside this test's (`target/<profile>/examples/viewer`).
 fn viewer() -> PathBuf {
@@ -97,6 +97,19 @@ fn the_viewer_shows_the_scene_under_xvfb() {
     let traced = render(&ctx, &scene, &camera, &four).unwrap().to_image();
     let window = screenshot(&[&args[..], &["--spp", "4"]].concat());
     assert_shows("rt at 4 rays a pixel", &window, &traced);
+    // Adaptive sampling through the embedding `Renderer` the viewer draws with.
+    let adaptive = Adaptive {
+        threshold: Adaptive::DEFAULT_THRESHOLD,
+        ground_truth: false,
+    };
+    let auto = RenderOptions {
+        spp: 16,
+        adaptive: Some(adaptive),
+        ..options
+    };
+    let traced = render(&ctx, &scene, &camera, &auto).unwrap().to_image();
+    let window = screenshot(&[&args[..], &["--spp", "auto"]].concat());
+    assert_shows("rt, adaptive", &window, &traced);
 
     // Through a cube map of the size the viewer picks: half the image's longer side.
     let gpu_scene = GpuScene::new(&ctx, &scene, &options).unwrap();

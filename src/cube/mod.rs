@@ -93,8 +93,8 @@ impl CubeSettings {
 }
 
 enum Faces {
-    Traced(TracedFaces),
-    Raster(RasterFaces),
+    Traced(Box<TracedFaces>),
+    Raster(Box<RasterFaces>),
 }
 
 /// The tracer's half of the cube-map path: one bordered face at a time through the face
@@ -251,8 +251,10 @@ impl CubeMap {
             )
         })?;
         let faces = match settings.method {
-            CubeMethod::Traced => Faces::Traced(TracedFaces::new(ctx, scene, size, &cube)?),
-            CubeMethod::Raster(method) => Faces::Raster(RasterFaces::new(
+            CubeMethod::Traced => {
+                Faces::Traced(Box::new(TracedFaces::new(ctx, scene, size, &cube)?))
+            }
+            CubeMethod::Raster(method) => Faces::Raster(Box::new(RasterFaces::new(
                 ctx,
                 scene,
                 size,
@@ -260,7 +262,7 @@ impl CubeMap {
                 method,
                 settings.shadow_size,
                 &cube,
-            )?),
+            )?)),
         };
         ctx.checked("creating the cube-map sampler", || {
             let device = &ctx.device;

@@ -46,7 +46,10 @@ use crate::raster::RasterMethod;
 use crate::scene::{Camera, Scene};
 use crate::shader;
 use crate::shared::TRACE_STORAGE_BUFFERS;
-use crate::trace::{GpuScene, RenderOptions, RenderOutput, TracePass, Traversal};
+use crate::trace::{
+    Adaptive, AdaptivePass, AdaptiveSpans, GpuScene, RenderOptions, RenderOutput, TracePass,
+    Traversal,
+};
 
 /// The limits a device needs for the renderer: wgpu's downlevel defaults, with the storage
 /// buffers the trace kernel binds. Ask for these (or the adapter's own) when creating the
@@ -140,62 +143,90 @@ pub const TARGET_FORMATS: [(wgpu::TextureFormat, &str); 3] = [
 pub(crate) enum Path {
     /// Tracing the lens's rays (software traversal or ray queries, as the scene was built).
     Direct(Box<TracePass>),
+    /// Tracing them where the image needs them (adaptive sampling).
+    Adaptive(Box<AdaptivePass>),
     /// Through a cube map (faces traced or rasterized, then resampled).
     Cube(Box<CubeMap>),
 }
 
+/// How a frame's passes are timed: a traced frame's one pass, an adaptive frame's stages, a
+/// cube map's passes.
+#[derive(Default)]
+pub(crate) struct Spans<'a> {
+    pub(crate) trace: Option<wgpu::ComputePassTimestampWrites<'a>>,
+    pub(crate) adaptive: AdaptiveSpans<'a>,
+    pub(crate) cube: CubeSpans<'a>,
+}
+
 impl Path {
-    /// Direct tracing with `directions` and `spp` rays per pixel, or a cube map made as
-    /// `cube` says.
+    /// Direct tracing with `directions` and `spp` rays per pixel (adaptively where `adaptive`
+    /// says), or a cube map made as `cube` says.
     pub(crate) fn new(
         ctx: &GpuContext,
         camera: &LensCamera,
         scene: &GpuScene,
-        (directions, spp): (DirectionSource, u32),
+        (directions, spp, adaptive): (DirectionSource, u32, Option<Adaptive>),
         cube: Option<&CubeSettings>,
     ) -> Result<Self> {
-        Ok(match cube {
-            None => Path::Direct(Box::new(TracePass::supersampled(
+        Ok(match (cube, adaptive) {
+            (Some(settings), _) => {
+                Path::Cube(Box::new(CubeMap::new(ctx, camera, scene, settings)?))
+            }
+            (None, Some(adaptive)) => Path::Adaptive(Box::new(AdaptivePass::new(
+                ctx, camera, scene, directions, spp, adaptive,
+            )?)),
+            (None, None) => Path::Direct(Box::new(TracePass::supersampled(
                 ctx, camera, scene, directions, spp,
             )?)),
-            Some(settings) => Path::Cube(Box::new(CubeMap::new(ctx, camera, scene, settings)?)),
         })
     }
 
-    /// Records a frame from `pose`; a traced frame's pass is timed by `trace`, a cube map's
-    /// passes by `spans`.
+    /// Records a frame from `pose`, its passes timed by `spans`.
     pub(crate) fn encode(
         &self,
         ctx: &GpuContext,
         encoder: &mut wgpu::CommandEncoder,
         scene: &GpuScene,
         pose: &Camera,
-        trace: Option<wgpu::ComputePassTimestampWrites<'_>>,
-        spans: CubeSpans<'_>,
+        spans: Spans<'_>,
     ) {
         match self {
             Path::Direct(pass) => {
                 pass.encode_pose(&ctx.device, encoder, scene, pose);
-                pass.encode(encoder, scene, trace);
+                pass.encode(encoder, scene, spans.trace);
             }
-            Path::Cube(cube) => cube.encode(ctx, encoder, scene, pose, spans),
+            Path::Adaptive(pass) => {
+                pass.encode_pose(&ctx.device, encoder, scene, pose);
+                pass.encode(encoder, scene, spans.adaptive);
+            }
+            Path::Cube(cube) => cube.encode(ctx, encoder, scene, pose, spans.cube),
+        }
+    }
+
+    /// The trace pass whose buffers hold a traced frame's outputs.
+    fn trace_pass(&self) -> Option<&TracePass> {
+        match self {
+            Path::Direct(pass) => Some(pass),
+            Path::Adaptive(pass) => Some(pass.trace_pass()),
+            Path::Cube(_) => None,
         }
     }
 
     /// The lens image's colour output (linear RGB, w = the mask).
     pub(crate) fn colour_buffer(&self) -> &wgpu::Buffer {
-        match self {
-            Path::Direct(pass) => pass.colour_buffer(),
-            Path::Cube(cube) => cube.colour_buffer(),
+        match (self, self.trace_pass()) {
+            (_, Some(pass)) => pass.colour_buffer(),
+            (Path::Cube(cube), None) => cube.colour_buffer(),
+            _ => unreachable!("a traced frame has a trace pass"),
         }
     }
 
     /// The last frame's outputs, read back: every output of a traced frame, the colour alone
     /// (geometry zero, ids `NO_HIT`) through a cube map.
     pub(crate) fn read(&self, ctx: &GpuContext) -> Result<RenderOutput> {
-        match self {
-            Path::Direct(pass) => pass.read(ctx),
-            Path::Cube(cube) => {
+        match (self, self.trace_pass()) {
+            (_, Some(pass)) => pass.read(ctx),
+            (Path::Cube(cube), None) => {
                 let colour = cube.read(ctx)?;
                 let size = cube.camera().size;
                 Ok(RenderOutput {
@@ -205,6 +236,7 @@ impl Path {
                     colour,
                 })
             }
+            _ => unreachable!("a traced frame has a trace pass"),
         }
     }
 }
@@ -284,7 +316,7 @@ impl Renderer {
             scene
         };
         let gpu_scene = GpuScene::new(&ctx, scene, options)?;
-        let rays = (options.directions, options.spp);
+        let rays = (options.directions, options.spp, options.adaptive);
         let path = Path::new(&ctx, camera, &gpu_scene, rays, cube)?;
         let (present, present_layout) = ctx.checked("creating the present pass", || {
             let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
@@ -392,7 +424,7 @@ impl Renderer {
         self.ctx.checked("recording a frame", || {
             let (ctx, scene) = (&self.ctx, &self.scene);
             self.path
-                .encode(ctx, encoder, scene, pose, None, CubeSpans::default());
+                .encode(ctx, encoder, scene, pose, Spans::default());
             let colour = self.path.colour_buffer();
             let view = target.create_view(&Default::default());
             let group = bind_group(
@@ -420,10 +452,7 @@ impl Renderer {
     /// row-major, as [`crate::trace::RenderOutput`] reads them; for passes of the caller's own.
     /// `None` through a cube map, which makes colour alone.
     pub fn outputs(&self) -> Option<[&wgpu::Buffer; 3]> {
-        match &self.path {
-            Path::Direct(pass) => Some(pass.buffers()),
-            Path::Cube(_) => None,
-        }
+        self.path.trace_pass().map(TracePass::buffers)
     }
 
     /// The last submitted frame's outputs, read back to the CPU (waiting for the device): all

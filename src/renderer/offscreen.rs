@@ -7,7 +7,7 @@
 
 use serde::Serialize;
 
-use super::{Method, Path};
+use super::{Method, Path, Spans};
 use crate::cube::{CubeMap, CubeMethod, CubeSettings, CubeSpans};
 use crate::error::Result;
 use crate::gpu::{GpuContext, Queries};
@@ -15,7 +15,10 @@ use crate::lens::LensCamera;
 use crate::lens::gpu::DirectionSource;
 use crate::raster::RasterMethod;
 use crate::scene::{Camera, Scene};
-use crate::trace::{GpuScene, RenderOptions, RenderOutput, Traversal};
+use crate::trace::{
+    ALL_STAGES, Adaptive, AdaptiveSpans, GpuScene, RenderOptions, RenderOutput, Sampling, Stage,
+    Traversal, stages_for,
+};
 
 impl Method {
     /// The passes a frame of this method is timed in, in order.
@@ -31,33 +34,48 @@ impl Method {
 }
 
 /// One configuration measured: a method and, for cube maps, the face size; for direct
-/// methods, the rays per pixel.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+/// methods, how many rays a pixel takes.
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Setup {
     /// The method.
     pub method: Method,
     /// Face size in texels of a cube-map method; ignored by direct ray tracing.
     pub cube_size: u32,
-    /// Rays per pixel of a direct method (a square, see [`crate::trace::sampling`]); 1 for
+    /// Rays per pixel of a direct method, uniform or adaptive (see [`Sampling`]); one for
     /// cube maps, whose resampler takes one bilinear sample a pixel.
-    pub spp: u32,
+    pub sampling: Sampling,
 }
 
 impl Setup {
     /// A direct method at `spp` rays per pixel, or a cube method at face size `cube_size`.
     pub fn direct(method: Method, spp: u32) -> Setup {
+        Self::sampled(method, Sampling::Uniform(spp))
+    }
+
+    /// A direct method sampled as `sampling` says.
+    pub fn sampled(method: Method, sampling: Sampling) -> Setup {
         Setup {
             method,
             cube_size: 0,
-            spp,
+            sampling,
         }
     }
 
-    /// `rt@16spp`, `rq@1spp`, or the cube method and face size: `cube-forward@512`.
+    /// A cube method at face size `cube_size`.
+    pub fn cube(method: Method, cube_size: u32) -> Setup {
+        Setup {
+            method,
+            cube_size,
+            sampling: Sampling::Uniform(1),
+        }
+    }
+
+    /// `rt@16spp`, `rt@auto:0.02`, `rq@1spp`, or the cube method and face size:
+    /// `cube-forward@512`.
     pub fn label(&self) -> String {
         match self.method {
             Method::Cube(_) => format!("{}@{}", self.method.name(), self.cube_size),
-            _ => format!("{}@{}spp", self.method.name(), self.spp),
+            _ => format!("{}@{}", self.method.name(), self.sampling.label()),
         }
     }
 
@@ -66,26 +84,54 @@ impl Setup {
         self.method.cube().map(|_| self.cube_size)
     }
 
-    /// The rays per pixel of a direct setup.
+    /// The most rays per pixel of a direct setup.
     pub fn spp(&self) -> Option<u32> {
-        self.method.cube().is_none().then_some(self.spp)
+        self.method
+            .cube()
+            .is_none()
+            .then_some(self.sampling.max_spp())
     }
 
-    /// Every setup of `methods`: direct methods once per rays-per-pixel count of `spps`, cube
+    /// The threshold of an adaptive direct setup.
+    pub fn threshold(&self) -> Option<f32> {
+        self.method
+            .cube()
+            .is_none()
+            .then(|| self.sampling.threshold())
+            .flatten()
+    }
+
+    /// The passes a frame of this setup is timed in, in order (an adaptive frame's stages, as
+    /// [`crate::trace::stages_for`] lists them).
+    pub fn passes(&self, ground_truth: bool) -> Vec<Pass> {
+        let Some(threshold) = self.threshold() else {
+            return self.method.passes().to_vec();
+        };
+        let side = crate::trace::sampling::samples_per_side(self.sampling.max_spp()).unwrap_or(1);
+        let options = Adaptive {
+            threshold,
+            ground_truth,
+        };
+        stages_for(side, options)
+            .into_iter()
+            .map(Pass::of)
+            .collect()
+    }
+
+    /// Every setup of `methods`: direct methods once per sampling of `samplings`, cube
     /// methods once per face size.
-    pub fn all(methods: &[Method], cube_sizes: &[u32], spps: &[u32]) -> Vec<Setup> {
+    pub fn all(methods: &[Method], cube_sizes: &[u32], samplings: &[Sampling]) -> Vec<Setup> {
         methods
             .iter()
             .flat_map(|&method| match method {
                 Method::Cube(_) => cube_sizes
                     .iter()
-                    .map(|&cube_size| Setup {
-                        method,
-                        cube_size,
-                        spp: 1,
-                    })
+                    .map(|&size| Setup::cube(method, size))
                     .collect::<Vec<_>>(),
-                _ => spps.iter().map(|&spp| Setup::direct(method, spp)).collect(),
+                _ => samplings
+                    .iter()
+                    .map(|&sampling| Setup::sampled(method, sampling))
+                    .collect(),
             })
             .collect()
     }
@@ -103,9 +149,32 @@ pub enum Pass {
     Lighting,
     /// Resampling the cube into the lens image.
     Sampler,
+    /// Adaptive sampling's first rays, one per block corner.
+    Coarse,
+    /// Adaptive sampling's rays through the pixels of blocks whose corners disagree, and the
+    /// interpolation of the others.
+    Refine,
+    /// Adaptive sampling's 2 × 2 samples of pixels whose colour differs from a neighbour's,
+    /// and the error estimate that picks those which take every sample.
+    Estimate,
+    /// Adaptive sampling's supersampling of the pixels picked.
+    Supersample,
+    /// Adaptive sampling's first hits of interpolated pixels, for the ground truth.
+    Truth,
 }
 
 impl Pass {
+    /// The pass that times an adaptive stage.
+    pub fn of(stage: Stage) -> Pass {
+        match stage {
+            Stage::Coarse => Pass::Coarse,
+            Stage::Refine => Pass::Refine,
+            Stage::Estimate => Pass::Estimate,
+            Stage::Supersample => Pass::Supersample,
+            Stage::Truth => Pass::Truth,
+        }
+    }
+
     /// Lower-case name, as reports print it.
     pub fn name(&self) -> &'static str {
         match self {
@@ -113,6 +182,11 @@ impl Pass {
             Pass::Faces => "faces",
             Pass::Lighting => "lighting",
             Pass::Sampler => "sampler",
+            Pass::Coarse => "coarse",
+            Pass::Refine => "refine",
+            Pass::Estimate => "estimate",
+            Pass::Supersample => "supersample",
+            Pass::Truth => "truth",
         }
     }
 }
@@ -191,6 +265,7 @@ impl SceneSet {
 pub struct Offscreen {
     path: Path,
     setup: Setup,
+    passes: Vec<Pass>,
     queries: Option<Queries>,
 }
 
@@ -199,7 +274,7 @@ pub struct Offscreen {
 pub struct FrameTime {
     /// Milliseconds from setting the pose to the GPU finishing the frame, on the CPU's clock.
     pub wall_ms: f64,
-    /// GPU milliseconds per pass, in [`Method::passes`] order; `None` without timestamp
+    /// GPU milliseconds per pass, in [`Offscreen::passes`] order; `None` without timestamp
     /// queries.
     pub passes_ms: Option<Vec<f64>>,
 }
@@ -228,10 +303,13 @@ impl Offscreen {
             setup,
             shadow_size,
             DirectionSource::Computed,
+            false,
         )
     }
 
-    /// As [`Offscreen::new`], with direct tracing's primary rays from `directions`.
+    /// As [`Offscreen::new`], with direct tracing's primary rays from `directions`; with
+    /// `ground_truth`, adaptive sampling also traces the first hits of the pixels it
+    /// interpolates (see [`crate::trace::Adaptive::ground_truth`]).
     pub fn with_directions(
         ctx: &GpuContext,
         camera: &LensCamera,
@@ -239,8 +317,10 @@ impl Offscreen {
         setup: Setup,
         shadow_size: u32,
         directions: DirectionSource,
+        ground_truth: bool,
     ) -> Result<Self> {
-        let rays = (directions, setup.spp);
+        let (spp, adaptive) = setup.sampling.options(ground_truth);
+        let rays = (directions, spp, adaptive);
         let scene = scenes.for_method(setup.method);
         let cube = match setup.method {
             Method::Cube(method) => Some(CubeSettings {
@@ -250,10 +330,12 @@ impl Offscreen {
             _ => None,
         };
         let path = Path::new(ctx, camera, scene, rays, cube.as_ref())?;
-        let queries = Queries::new(ctx, setup.method.passes().len() as u32);
+        let passes = setup.passes(ground_truth);
+        let queries = Queries::new(ctx, passes.len() as u32);
         Ok(Self {
             path,
             setup,
+            passes,
             queries,
         })
     }
@@ -261,6 +343,21 @@ impl Offscreen {
     /// The setup.
     pub fn setup(&self) -> Setup {
         self.setup
+    }
+
+    /// The passes a frame is timed in, in [`FrameTime::passes_ms`] order.
+    pub fn passes(&self) -> &[Pass] {
+        &self.passes
+    }
+
+    /// The rays each pixel's colour took in the last frame, row-major: the spp map of adaptive
+    /// sampling (see [`crate::trace::AdaptivePass::read_rays`]); `None` for other setups,
+    /// whose pixels all take the setup's rays.
+    pub fn rays_per_pixel(&self, ctx: &GpuContext) -> Result<Option<Vec<u32>>> {
+        match &self.path {
+            Path::Adaptive(pass) => pass.read_rays(ctx).map(Some),
+            _ => Ok(None),
+        }
     }
 
     /// Renders one frame from `pose` in one submission, waits for the GPU to finish it, and
@@ -271,17 +368,21 @@ impl Offscreen {
         let started = std::time::Instant::now();
         ctx.checked("rendering a frame", || {
             let mut encoder = ctx.device.create_command_encoder(&Default::default());
-            let passes = self.setup.method.passes();
-            let index = |p: Pass| passes.iter().position(|&x| x == p).map(|i| i as u32);
+            let index = |p: Pass| self.passes.iter().position(|&x| x == p).map(|i| i as u32);
             let span = |p: Pass| index(p).and_then(|i| q.map(|q| q.span(i)));
-            let spans = CubeSpans {
-                faces: span(Pass::Faces),
-                lighting: span(Pass::Lighting),
-                sampler: span(Pass::Sampler),
+            let writes = |p: Pass| index(p).and_then(|i| q.map(|q| q.writes(i)));
+            let spans = Spans {
+                trace: writes(Pass::Trace),
+                adaptive: AdaptiveSpans {
+                    stages: ALL_STAGES.map(|stage| writes(Pass::of(stage))),
+                },
+                cube: CubeSpans {
+                    faces: span(Pass::Faces),
+                    lighting: span(Pass::Lighting),
+                    sampler: span(Pass::Sampler),
+                },
             };
-            let trace = index(Pass::Trace).and_then(|i| q.map(|q| q.writes(i)));
-            self.path
-                .encode(ctx, &mut encoder, scene, pose, trace, spans);
+            self.path.encode(ctx, &mut encoder, scene, pose, spans);
             if let Some(q) = q {
                 q.resolve(&mut encoder);
             }
@@ -314,7 +415,8 @@ impl Offscreen {
                 })?;
                 ctx.wait()?;
             }
-            Path::Cube(_) => {
+            // Each stage's kernels run only once its predecessors listed pixels.
+            Path::Adaptive(_) | Path::Cube(_) => {
                 self.frame(ctx, scenes, pose)?;
             }
         }
@@ -336,7 +438,7 @@ impl Offscreen {
     pub fn cube(&self) -> Option<&CubeMap> {
         match &self.path {
             Path::Cube(cube) => Some(cube),
-            Path::Direct(_) => None,
+            _ => None,
         }
     }
 }
@@ -350,13 +452,19 @@ mod tests {
         for m in Method::ALL {
             assert_eq!(Method::from_name(m.name()), Some(m));
         }
-        let setups = Setup::all(&[Method::Rt, Method::ALL[3]], &[512, 1024], &[1, 16]);
+        let samplings = [1, 16].map(Sampling::Uniform);
+        let mut setups = Setup::all(&[Method::Rt, Method::ALL[3]], &[512, 1024], &samplings);
+        setups.push(Setup::sampled(
+            Method::Rt,
+            Sampling::parse("auto:0.05").unwrap(),
+        ));
         let labels: Vec<String> = setups.iter().map(Setup::label).collect();
         let wanted = [
             "rt@1spp",
             "rt@16spp",
             "cube-forward@512",
             "cube-forward@1024",
+            "rt@auto:0.05",
         ];
         assert_eq!(labels, wanted);
     }

@@ -27,7 +27,7 @@ pub struct BenchEntry {
     /// Rays per pixel of a direct method, `None` for cube maps.
     pub spp: Option<u32>,
     /// The timed passes, in the order of each frame's `passes_ms`.
-    pub passes: &'static [Pass],
+    pub passes: Vec<Pass>,
     /// Statistics of the GPU time per frame (the sum of the passes), if timestamps exist.
     pub gpu: Option<FrameStats>,
     /// Statistics of the wall time per frame.
@@ -120,7 +120,7 @@ pub fn bench(
             let memory_start = memory_start.expect("at least one timed frame");
             let wall: Vec<f64> = timed.iter().map(|t| t.wall_ms).collect();
             let gpu: Option<Vec<f64>> = timed.iter().map(FrameTime::gpu_ms).collect();
-            let passes = setup.method.passes();
+            let passes = renderer.passes().to_vec();
             let pass_median_ms = timed
                 .iter()
                 .map(|t| t.passes_ms.clone())

@@ -29,8 +29,14 @@ pub struct CompareEntry {
     pub method: &'static str,
     /// Cube face size, `None` for direct methods.
     pub cube_size: Option<u32>,
-    /// Rays per pixel of a direct method, `None` for cube maps.
+    /// Rays per pixel of a direct method (the most, for adaptive sampling), `None` for cube
+    /// maps.
     pub spp: Option<u32>,
+    /// Adaptive sampling's threshold, `None` for uniform sampling and cube maps.
+    pub threshold: Option<f32>,
+    /// The rays the last frame's colour took per pixel the lens covers, on average: adaptive
+    /// sampling's measured count; `spp` for uniform sampling; `None` for cube maps.
+    pub rays_per_pixel: Option<f64>,
     /// Median GPU ms per frame, if timestamps exist.
     pub gpu_ms: Option<f64>,
     /// Median wall ms per frame.
@@ -195,6 +201,11 @@ pub fn compare(
                 done += 1;
             }
             let colour = renderer.colour(study.ctx)?;
+            let covered = colour.iter().filter(|c| c[3] > 0.0).count().max(1) as f64;
+            let rays_per_pixel = match renderer.rays_per_pixel(study.ctx)? {
+                Some(map) => Some(map.iter().map(|&n| f64::from(n)).sum::<f64>() / covered),
+                None => setup.spp().map(f64::from),
+            };
             save_png(
                 &error_map(size, &reference, &colour),
                 &out.join(format!("{stem}.{}.error.png", file_stem(&setup.label()))),
@@ -207,6 +218,8 @@ pub fn compare(
                 method: setup.method.name(),
                 cube_size: setup.cube_size(),
                 spp: setup.spp(),
+                threshold: setup.threshold(),
+                rays_per_pixel,
                 gpu_ms: gpu.map(|g| median(&g)),
                 wall_ms: median(&wall),
                 error: image_error(&reference, &colour),
@@ -265,8 +278,14 @@ fn envelope<'a>(
     Envelope::of(&points)
 }
 
+/// Every direct setup (`rt`, `rq`; uniform and adaptive): RT's family in the verdict.
 fn is_rt(e: &CompareEntry) -> bool {
-    e.method == "rt"
+    e.cube_size.is_none()
+}
+
+/// The direct setups that sample every pixel alike.
+fn is_uniform(e: &CompareEntry) -> bool {
+    is_rt(e) && e.threshold.is_none()
 }
 
 fn is_cube(e: &CompareEntry) -> bool {
@@ -423,10 +442,14 @@ impl CompareReport {
         let points: Vec<plot::TradeOff> = entries
             .iter()
             .map(|e| plot::TradeOff {
-                label: match (e.cube_size, e.spp) {
-                    (Some(size), _) => size.to_string(),
-                    (None, Some(spp)) => format!("{spp} spp"),
-                    (None, None) => e.setup.clone(),
+                label: match e.cube_size {
+                    Some(size) => size.to_string(),
+                    // `16spp`, `auto:0.1`: the sampling, after the method's name.
+                    None => e
+                        .setup
+                        .split_once('@')
+                        .map_or(&*e.setup, |(_, s)| s)
+                        .to_string(),
                 },
                 method: e.method,
                 ms: e.ms(),
@@ -440,12 +463,16 @@ impl CompareReport {
         let family = |pick| envelope(entries.iter().copied(), metric, pick).points;
         let envelopes = [
             plot::Series {
-                label: "direct RT over rays per pixel".into(),
+                label: "direct RT, uniform and adaptive".into(),
                 points: family(is_rt),
             },
             plot::Series {
                 label: "cube maps over face sizes".into(),
                 points: family(is_cube),
+            },
+            plot::Series {
+                label: "direct RT, uniform rays per pixel".into(),
+                points: family(is_uniform),
             },
         ];
         let title = format!(
@@ -486,6 +513,8 @@ mod tests {
             method: if method == "rt" { "rt" } else { "cube-rt" },
             cube_size,
             spp,
+            threshold: None,
+            rays_per_pixel: spp.map(f64::from),
             gpu_ms,
             wall_ms,
             error,

@@ -1,8 +1,10 @@
 //! The ray tracer: a scene on the GPU ([`GpuScene`], built and uploaded once), the trace pass
-//! for a lens and image size ([`TracePass`]), and [`render`], which does both in one call.
+//! for a lens and image size ([`TracePass`], or [`AdaptivePass`] to spend rays where the image
+//! needs them), and [`render`], which does both in one call.
 //! `cpu` holds the f64 reference the GPU output is tested against; `cast` casts arbitrary rays
 //! with the same traversal.
 
+mod adaptive;
 pub mod cast;
 pub mod cpu;
 mod display;
@@ -15,13 +17,16 @@ pub mod sampling;
 
 use glam::DVec3;
 
+pub use adaptive::{
+    ALL_STAGES, Adaptive, AdaptivePass, AdaptiveSpans, Stage, spp_picture, stages_for,
+};
 pub use display::{
     ColourFile, Display, KEY, MASKED_RGB, Tone, auto_exposure, check_writable,
     check_writable_folder, colour_image, colour_image_with, linear_to_srgb, refuse_non_regular,
     save_png, write_atomically, write_colour, write_file,
 };
 pub use gpu_scene::{GpuScene, SceneBytes, gpu_lights, shading_vertices};
-pub use options::{RenderOptions, Traversal, surface_constants, surface_id};
+pub use options::{RenderOptions, Sampling, Traversal, surface_constants, surface_id};
 pub use output::{Channel, RenderOutput, Values};
 pub use pass::TracePass;
 pub use ray_query::RayQueryScene;
@@ -58,6 +63,11 @@ pub fn render(
     options: &RenderOptions,
 ) -> Result<RenderOutput> {
     let gpu_scene = GpuScene::new(ctx, scene, options)?;
-    let pass = TracePass::supersampled(ctx, camera, &gpu_scene, options.directions, options.spp)?;
+    let (source, spp) = (options.directions, options.spp);
+    if let Some(adaptive) = options.adaptive {
+        let pass = AdaptivePass::new(ctx, camera, &gpu_scene, source, spp, adaptive)?;
+        return pass.trace(ctx, &gpu_scene, "tracing");
+    }
+    let pass = TracePass::supersampled(ctx, camera, &gpu_scene, source, spp)?;
     pass.trace(ctx, &gpu_scene, "tracing")
 }

@@ -28,7 +28,11 @@ pub struct RenderOptions {
     pub traversal: Traversal,
     /// Rays per pixel (a square: jittered stratified samples, box-filtered; see
     /// [`super::sampling`]). Ground-truth outputs stay the one ray through the pixel's centre.
+    /// With `adaptive`, the most a pixel takes.
     pub spp: u32,
+    /// Adaptive sampling ([`super::AdaptivePass`]): rays where neighbouring samples disagree,
+    /// fewer than one a pixel where the image is smooth; `None` samples every pixel alike.
+    pub adaptive: Option<super::Adaptive>,
 }
 
 /// How the tracer's rays find their hits; lens and shading code are the same for both.
@@ -50,6 +54,7 @@ impl Default for RenderOptions {
             directions: DirectionSource::Computed,
             traversal: Traversal::Software,
             spp: 1,
+            adaptive: None,
         }
     }
 }
@@ -65,4 +70,176 @@ pub fn surface_constants(f: Features) -> [(&'static str, f64); 5] {
         ("SMOOTH_NORMALS", flag(f.smooth_normals)),
         ("INSTANCED", flag(f.instanced)),
     ]
+}
+
+/// How many rays a pixel's colour takes, as `--spp` and a setup's label write it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Sampling {
+    /// `N`: every pixel `N` rays (a square: jittered stratified samples, box-filtered).
+    Uniform(u32),
+    /// `auto[:THRESHOLD[:MAX]]`: adaptive sampling ([`super::AdaptivePass`]) at the threshold
+    /// ([`super::Adaptive::threshold`], 0.02 by default), at most `MAX` samples a pixel (16 by
+    /// default).
+    Adaptive {
+        /// Displayed-colour difference at which samples disagree.
+        threshold: f32,
+        /// The most samples a pixel takes (a square).
+        max_spp: u32,
+    },
+}
+
+impl Sampling {
+    /// The most samples adaptive sampling takes a pixel unless told: 16, as `render`'s uniform
+    /// default.
+    pub const DEFAULT_MAX_SPP: u32 = 16;
+
+    /// Reads `N` or `auto[:THRESHOLD[:MAX]]`; errors say what is wrong and what is accepted.
+    pub fn parse(text: &str) -> crate::error::Result<Self> {
+        let bad = |why: String| {
+            crate::error::Error::Option(format!(
+                "{text:?}: {why}; rays per pixel are N (a square: 1, 4, 9, 16, ...) or \
+                 auto[:THRESHOLD[:MAX]] (adaptive, e.g. auto, auto:0.05, auto:0.01:64)"
+            ))
+        };
+        let check = |spp: u32| super::sampling::samples_per_side(spp).map(|_| spp);
+        let Some(rest) = text.strip_prefix("auto") else {
+            let spp: u32 = text.parse().map_err(|_| bad("not a number".into()))?;
+            return Ok(Sampling::Uniform(check(spp)?));
+        };
+        let mut parts = rest.split(':');
+        if parts.next() != Some("") {
+            return Err(bad("auto takes its values after colons".into()));
+        }
+        let threshold = match parts.next() {
+            None => super::Adaptive::DEFAULT_THRESHOLD,
+            Some(t) => match t.parse::<f32>() {
+                Ok(t) if t >= 0.0 && t.is_finite() => t,
+                _ => {
+                    return Err(bad(format!(
+                        "the threshold {t:?} is not a number of 0 or more"
+                    )));
+                }
+            },
+        };
+        let max_spp = match parts.next() {
+            None => Self::DEFAULT_MAX_SPP,
+            Some(m) => check(
+                m.parse()
+                    .map_err(|_| bad(format!("the most rays {m:?} is not a number")))?,
+            )?,
+        };
+        if parts.next().is_some() {
+            return Err(bad("too many parts".into()));
+        }
+        Ok(Sampling::Adaptive { threshold, max_spp })
+    }
+
+    /// The most samples a pixel takes.
+    pub fn max_spp(&self) -> u32 {
+        match *self {
+            Sampling::Uniform(spp) => spp,
+            Sampling::Adaptive { max_spp, .. } => max_spp,
+        }
+    }
+
+    /// Adaptive sampling's threshold, if adaptive.
+    pub fn threshold(&self) -> Option<f32> {
+        match *self {
+            Sampling::Uniform(_) => None,
+            Sampling::Adaptive { threshold, .. } => Some(threshold),
+        }
+    }
+
+    /// The render options' `spp` and `adaptive` for this sampling.
+    pub fn options(&self, ground_truth: bool) -> (u32, Option<super::Adaptive>) {
+        let adaptive = self.threshold().map(|threshold| super::Adaptive {
+            threshold,
+            ground_truth,
+        });
+        (self.max_spp(), adaptive)
+    }
+
+    /// As a setup's label writes it: `16spp`, `auto:0.02`, `auto:0.01:64`.
+    pub fn label(&self) -> String {
+        match *self {
+            Sampling::Uniform(spp) => format!("{spp}spp"),
+            _ => self.to_string(),
+        }
+    }
+}
+
+impl std::fmt::Display for Sampling {
+    /// As `--spp` takes it: `16`, `auto:0.02`, `auto:0.01:64`.
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match *self {
+            Sampling::Uniform(spp) => write!(f, "{spp}"),
+            Sampling::Adaptive { threshold, max_spp } if max_spp == Self::DEFAULT_MAX_SPP => {
+                write!(f, "auto:{threshold}")
+            }
+            Sampling::Adaptive { threshold, max_spp } => write!(f, "auto:{threshold}:{max_spp}"),
+        }
+    }
+}
+
+impl std::str::FromStr for Sampling {
+    type Err = crate::error::Error;
+
+    fn from_str(text: &str) -> crate::error::Result<Self> {
+        Sampling::parse(text)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn sampling_reads_and_writes_its_names() {
+        for (text, wanted) in [
+            ("16", Sampling::Uniform(16)),
+            (
+                "auto",
+                Sampling::Adaptive {
+                    threshold: 0.02,
+                    max_spp: 16,
+                },
+            ),
+            (
+                "auto:0.05",
+                Sampling::Adaptive {
+                    threshold: 0.05,
+                    max_spp: 16,
+                },
+            ),
+            (
+                "auto:0:64",
+                Sampling::Adaptive {
+                    threshold: 0.0,
+                    max_spp: 64,
+                },
+            ),
+        ] {
+            let read = Sampling::parse(text).unwrap();
+            assert_eq!(read, wanted, "{text}");
+            assert_eq!(Sampling::parse(&read.to_string()).unwrap(), read);
+        }
+        assert_eq!(Sampling::Uniform(4).label(), "4spp");
+        assert_eq!(Sampling::parse("auto").unwrap().label(), "auto:0.02");
+        for bad in [
+            "",
+            "8",
+            "auto:",
+            "auto:-1",
+            "auto:x",
+            "auto:0.1:8",
+            "auto:0.1:4:1",
+            "autox",
+        ] {
+            let message = Sampling::parse(bad).unwrap_err().to_string();
+            assert!(
+                message.contains(&format!("{bad:?}")) || message.contains("square"),
+                "{bad}: {message}"
+            );
+        }
+    }
 }

@@ -42,6 +42,12 @@ pub struct TracePass {
     geometry: wgpu::Buffer,
     ids: wgpu::Buffer,
     frame: wgpu::Buffer,
+    /// The lens parameters and the direction table (a placeholder without one), for kernels
+    /// that share the trace kernel's group 0 (`AdaptivePass`).
+    lens: wgpu::Buffer,
+    table: wgpu::Buffer,
+    constants: Vec<(&'static str, f64)>,
+    samples_per_side: u32,
     camera: LensCamera,
     /// The bands of rows traced one after another, `(first row, rows)`: one for an image
     /// whose outputs fit one storage binding.
@@ -107,16 +113,7 @@ impl TracePass {
                     storage_entry(5, false),
                 ],
             });
-            let mut constants = lens_constants(camera).to_vec();
-            constants.extend(surface_constants(scene.features));
-            constants.extend([
-                ("DIRECTION_SOURCE", f64::from(source as u32)),
-                ("SAMPLES_PER_SIDE", f64::from(samples_per_side)),
-                (
-                    "HAS_TRANSLUCENT",
-                    f64::from(u8::from(scene.features.translucent)),
-                ),
-            ]);
+            let constants = trace_constants(camera, scene, source, samples_per_side);
             let mut layouts = vec![&layout, &scene.layout];
             let file = match &scene.ray_query {
                 Some(rq) => {
@@ -159,8 +156,10 @@ impl TracePass {
                 &slots,
                 wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
             );
-            let placeholder = output("fisheye.trace.no_table", 16, none);
-            let table = table.as_ref().map_or(&placeholder, |t| &t.directions);
+            let table = match &table {
+                Some(t) => t.directions.clone(),
+                None => output("fisheye.trace.no_table", 16, none),
+            };
             let lens = params_buffer(device, camera);
             let bind_groups = (0..frames.len() as u64)
                 .map(|view| {
@@ -191,6 +190,10 @@ impl TracePass {
                 geometry,
                 ids,
                 frame,
+                lens,
+                table,
+                constants,
+                samples_per_side,
                 camera: *camera,
                 bands,
                 whole,
@@ -247,6 +250,30 @@ impl TracePass {
         encoder.copy_buffer_to_buffer(&staging, 0, &self.frame, 0, slots.len() as u64);
     }
 
+    /// The override constants of the trace kernel (lens, surfaces, direction source,
+    /// samples per pixel side): kernels that trace as it does are specialised the same way.
+    pub(crate) fn constants(&self) -> &[(&'static str, f64)] {
+        &self.constants
+    }
+
+    /// Group 0's shared bindings in `wgsl/pixel.wgsl`'s order (lens, table, the first view's
+    /// frame, colour, geometry, ids), for kernels that trace as this pass does. Only for an
+    /// image traced in one band.
+    pub(crate) fn shared_bindings(&self) -> [wgpu::BindingResource<'_>; 6] {
+        [
+            self.lens.as_entire_binding(),
+            self.table.as_entire_binding(),
+            wgpu::BindingResource::Buffer(wgpu::BufferBinding {
+                buffer: &self.frame,
+                offset: 0,
+                size: wgpu::BufferSize::new(size_of::<Frame>() as u64),
+            }),
+            self.colour.as_entire_binding(),
+            self.geometry.as_entire_binding(),
+            self.ids.as_entire_binding(),
+        ]
+    }
+
     /// The colour output of the last frame (as [`RenderOutput::colour`]), for passes that
     /// read it on the GPU.
     pub fn colour_buffer(&self) -> &wgpu::Buffer {
@@ -260,6 +287,16 @@ impl TracePass {
             Some([colour, geometry, ids]) => [colour, geometry, ids],
             None => [&self.colour, &self.geometry, &self.ids],
         }
+    }
+
+    /// The side of the grid of samples each pixel takes.
+    pub fn samples_per_side(&self) -> u32 {
+        self.samples_per_side
+    }
+
+    /// The image size.
+    pub fn size(&self) -> crate::lens::ImageSize {
+        self.camera.size
     }
 
     /// How many bands of rows a frame is traced in: 1 unless the image's outputs exceed one
@@ -352,6 +389,26 @@ impl TracePass {
             ids: ctx.read_buffer(ids)?,
         })
     }
+}
+
+/// The overrides of a kernel that traces `camera`'s rays in `scene` as the trace kernel does.
+fn trace_constants(
+    camera: &LensCamera,
+    scene: &GpuScene,
+    source: DirectionSource,
+    samples_per_side: u32,
+) -> Vec<(&'static str, f64)> {
+    let mut constants = lens_constants(camera).to_vec();
+    constants.extend(surface_constants(scene.features));
+    constants.extend([
+        ("DIRECTION_SOURCE", f64::from(source as u32)),
+        ("SAMPLES_PER_SIDE", f64::from(samples_per_side)),
+        (
+            "HAS_TRANSLUCENT",
+            f64::from(u8::from(scene.features.translucent)),
+        ),
+    ]);
+    constants
 }
 
 /// The frames' bytes, each in its `FRAME_SLOT`.

@@ -284,3 +284,61 @@ fn bare_meshes_are_exposed_automatically() {
     );
     std::fs::remove_dir_all(dir).unwrap();
 }
+
+/// `--spp auto` renders adaptively, says how many rays it spent and in which passes, and
+/// `--outputs spp` draws them: transparent outside the image circle, darkest where pixels
+/// were interpolated, brightest on edges; the id array beside it stays exact. A malformed
+/// `--spp` is refused with what it accepts.
+#[test]
+fn adaptive_render_writes_its_spp_map() {
+    let dir = std::env::temp_dir().join(format!("fisheye-adaptive-cli-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let out = dir.join("room.png");
+    let args = [
+        "render",
+        "--size",
+        "96x72",
+        "--spp",
+        "auto:0.05",
+        "--outputs",
+        "spp,id",
+        "-o",
+        out.to_str().unwrap(),
+    ];
+    let text = stdout(&fisheye(&args, ""));
+    for needle in [
+        "trace (rt@auto:0.05)",
+        "rays for their colour",
+        "coarse",
+        "refine",
+        "truth",
+    ] {
+        assert!(text.contains(needle), "{needle} missing from:\n{text}");
+    }
+    let map = image::open(dir.join("room.spp.png")).unwrap().to_rgba8();
+    assert_eq!(map.dimensions(), (96, 72));
+    assert_eq!(map.get_pixel(0, 0)[3], 0, "a masked corner is transparent");
+    let brightness = |p: &image::Rgba<u8>| u32::from(p[0]) + u32::from(p[1]) + u32::from(p[2]);
+    let shown: Vec<u32> = map
+        .pixels()
+        .filter(|p| p[3] == 255)
+        .map(brightness)
+        .collect();
+    let (least, most) = (shown.iter().min().unwrap(), shown.iter().max().unwrap());
+    assert!(
+        most > &(least + 300),
+        "one colour from {least} to {most}: nothing was refined"
+    );
+    assert!(dir.join("room.id.npy").is_file());
+    let refused = fisheye(
+        &["render", "--spp", "auto:x", "-o", out.to_str().unwrap()],
+        "",
+    );
+    let message = String::from_utf8_lossy(&refused.stderr);
+    assert!(!refused.status.success());
+    assert!(
+        message.contains("auto[:THRESHOLD[:MAX]]") && !message.contains("panicked"),
+        "{message}"
+    );
+    std::fs::remove_dir_all(dir).unwrap();
+}

@@ -76,7 +76,10 @@ fn bench_and_compare_write_their_reports_into_a_new_folder() {
         "{errors}"
     );
     let (ok, _, errors) = run(&["bench", "--spp", "1,3"]);
-    assert!(!ok && errors.contains("--spp 3: 3 samples"), "{errors}");
+    assert!(
+        !ok && errors.contains("'3' for '--spp") && errors.contains("3 samples per pixel"),
+        "{errors}"
+    );
     std::fs::remove_dir_all(dir).unwrap();
 }
 

@@ -13,7 +13,7 @@ use fisheye_rt::lens::{DirectionFormula, ImageSize, LensCamera, parse_spec};
 use fisheye_rt::raster::RasterMethod;
 use fisheye_rt::renderer;
 use fisheye_rt::scene::Scene;
-use fisheye_rt::trace::{Channel, Tone};
+use fisheye_rt::trace::{Channel, Sampling, Tone};
 use glam::DVec3;
 
 /// How the scene is built and shaded, for `render`, `bench` and `compare`.
@@ -64,10 +64,15 @@ pub(crate) struct StudyArgs {
     /// Cube face sizes to measure the cube-map methods at (comma-separated).
     #[arg(long, value_delimiter = ',', default_value = "512,1024,1920")]
     pub(crate) cube_size: Vec<u32>,
-    /// Rays per pixel to measure direct tracing at (comma-separated squares): RT is a family
-    /// over rays per pixel as the cube maps are over face sizes.
-    #[arg(long, value_delimiter = ',', default_value = "1,4,16")]
-    pub(crate) spp: Vec<u32>,
+    /// Rays per pixel to measure direct tracing at (comma-separated): squares N for uniform
+    /// sampling, auto:THRESHOLD or auto:THRESHOLD:MAX for adaptive sampling (as `render --spp`). Direct RT is
+    /// a family over these as the cube maps are over face sizes.
+    #[arg(
+        long,
+        value_delimiter = ',',
+        default_value = "1,4,16,auto:0.1:1,auto:0.1:4,auto:0.1,auto:0.02"
+    )]
+    pub(crate) spp: Vec<Sampling>,
     #[command(flatten)]
     pub(crate) shading: ShadingArgs,
     /// Folder for the results; by default a new folder `fisheye-COMMAND-N` here.
@@ -375,17 +380,21 @@ pub(crate) enum Output {
     Id,
     Direction,
     Mask,
+    /// The rays each pixel took, as a picture (`render` only).
+    Spp,
 }
 
-impl From<Output> for Channel {
-    fn from(o: Output) -> Self {
-        match o {
+impl Output {
+    /// The ground-truth array of this output; `None` for the spp map, which is a picture.
+    pub(crate) fn channel(self) -> Option<Channel> {
+        Some(match self {
             Output::Range => Channel::Range,
             Output::Normal => Channel::Normal,
             Output::Id => Channel::Id,
             Output::Direction => Channel::Direction,
             Output::Mask => Channel::Mask,
-        }
+            Output::Spp => return None,
+        })
     }
 }
 

@@ -12,7 +12,7 @@ use fisheye_rt::gpu::GpuContext;
 use fisheye_rt::lens::calib;
 use fisheye_rt::lens::{ImageSize, LensCamera, parse_spec};
 use fisheye_rt::pose::parse_transform;
-use fisheye_rt::trace::{Channel, ColourFile, Display, RenderOptions};
+use fisheye_rt::trace::{ColourFile, Display, RenderOptions};
 use glam::DAffine3;
 
 use crate::args::{ArrayFormat, Output, Quality, ToneArg, load_scene_with};
@@ -210,6 +210,7 @@ fn render(args: &RenderArgs) -> Result<()> {
             max_depth: args.max_depth,
             bvh: args.bvh.into(),
             spp: args.spp,
+            adaptive: None,
             ..RenderOptions::default()
         },
         colour: (
@@ -220,7 +221,13 @@ fn render(args: &RenderArgs) -> Result<()> {
             },
         ),
         outputs: (
-            args.outputs.iter().map(|&o| Channel::from(o)).collect(),
+            args.outputs
+                .iter()
+                .map(|&o| {
+                    o.channel()
+                        .context("--outputs spp is render's (a picture of one frame's rays)")
+                })
+                .collect::<Result<_>>()?,
             match args.format {
                 ArrayFormat::Npy => ArrayFile::Npy,
                 ArrayFormat::Exr => ArrayFile::Exr,

@@ -103,9 +103,6 @@ pub(crate) fn prepare(args: &StudyArgs, command: &str) -> Result<Prepared> {
     } else {
         args.method.iter().map(|m| m.method()).collect()
     };
-    for &spp in &args.spp {
-        samples_per_side(spp).with_context(|| format!("--spp {spp}"))?;
-    }
     let mut scene = load_scene_with(&args.scene, args.gltf_scene)?;
     if let Some(text) = &args.camera {
         let pose = parse_camera(text, &scene)?;

@@ -1,0 +1,422 @@
+//! Adaptive sampling ([`AdaptivePass`]): a first pass of one ray per
+//! [`ADAPTIVE_BLOCK`]² pixels, then rays only where neighbouring samples disagree, up to the
+//! uniform supersampling of [`super::sampling`] where colours still differ; every pass on the
+//! GPU, with no read-back between them. `wgsl/adaptive.wgsl` says how each pass decides.
+
+use super::pass::TracePass;
+use super::{GpuScene, RenderOutput};
+use crate::error::{Error, Result};
+use crate::gpu::{GpuContext, bind_group, storage_entry, uniform_entry};
+use crate::lens::LensCamera;
+use crate::lens::gpu::DirectionSource;
+use crate::scene::Camera;
+use crate::shader;
+use crate::shared::{
+    ADAPTIVE_BLOCK, ADAPTIVE_HEADER, ADAPTIVE_STORAGE_BUFFERS, AdaptiveParams,
+    TRACE_STORAGE_BUFFERS, WORKGROUP_2D,
+};
+
+/// Adaptive sampling's settings (see [`AdaptivePass`]); the most rays a pixel takes are
+/// [`super::RenderOptions::spp`] (plus its centre's).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Adaptive {
+    /// How far apart two samples' displayed colours (clamped, sRGB-encoded, the largest
+    /// channel, as [`crate::compare`] measures error) may be before the pixels between them
+    /// get rays of their own, and a traced pixel its full supersampling: 0.02 is 2 % of full
+    /// scale. At 0 every pixel takes every sample, as uniform sampling does.
+    pub threshold: f32,
+    /// Whether pixels that took no ray of their own (interpolated) still get their centre's
+    /// first hit traced, so the ground-truth outputs (range, normal, id) are exact everywhere.
+    /// Without it those pixels' geometry is zero and their id `NO_HIT`.
+    pub ground_truth: bool,
+}
+
+impl Adaptive {
+    /// The default threshold of `--spp auto`.
+    pub const DEFAULT_THRESHOLD: f32 = 0.02;
+}
+
+/// Two corners' shading normals further apart than this (about 25°) are not one smooth
+/// stretch of surface: their block is traced.
+const NORMAL_COSINE: f32 = 0.9;
+/// A corner's hit further than this share of the range from another corner's tangent plane is
+/// behind a depth step: their block is traced.
+const PLANE_DISTANCE: f32 = 0.01;
+
+/// A part of an adaptive frame, each its own compute pass (and its own timestamps).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Stage {
+    /// One ray per block corner.
+    Coarse,
+    /// The blocks whose corners disagree: one ray per pixel; the rest interpolated.
+    Refine,
+    /// The traced pixels whose colour differs from their neighbours': 2 × 2 samples, and
+    /// the error estimate that decides which take all of them (more than 4 samples a pixel,
+    /// threshold above 0).
+    Estimate,
+    /// The pixels whose samples still disagree (or, without the estimating stage, whose
+    /// colour differs from their neighbours'): every sample.
+    Supersample,
+    /// The interpolated pixels' first hits, for the ground truth.
+    Truth,
+}
+
+/// Every stage, in the order a frame runs them.
+pub const ALL_STAGES: [Stage; 5] = [
+    Stage::Coarse,
+    Stage::Refine,
+    Stage::Estimate,
+    Stage::Supersample,
+    Stage::Truth,
+];
+
+/// The stages a frame runs with `samples_per_side`² samples at most, in order: supersampling
+/// only with more than one sample a pixel, estimating first with more than 4 and a threshold
+/// above 0, the ground truth's only when asked for.
+pub fn stages_for(samples_per_side: u32, options: Adaptive) -> Vec<Stage> {
+    let mut stages = vec![Stage::Coarse, Stage::Refine];
+    if samples_per_side > 2 && options.threshold > 0.0 {
+        stages.push(Stage::Estimate);
+    }
+    if samples_per_side > 1 {
+        stages.push(Stage::Supersample);
+    }
+    if options.ground_truth {
+        stages.push(Stage::Truth);
+    }
+    stages
+}
+
+/// Timestamp writes for the stages of one frame; `None` leaves a stage untimed.
+#[derive(Default)]
+pub struct AdaptiveSpans<'a> {
+    /// One per [`Stage`], in order.
+    pub stages: [Option<wgpu::ComputePassTimestampWrites<'a>>; 5],
+}
+
+/// Adaptive sampling of one lens, image size and scene: the trace kernel's outputs and frame
+/// (a [`TracePass`] at the largest sample count, whose buffers it writes), the per-pixel
+/// state (rays taken, what the centre saw), the work list and its indirect dispatch.
+pub struct AdaptivePass {
+    trace: TracePass,
+    options: Adaptive,
+    /// The kernels that list each stage's pixels: lattice, classify, select_pixels, more,
+    /// untraced.
+    builders: [wgpu::ComputePipeline; 5],
+    /// `trace_list` for each [`Stage`] (coarse and refine share one).
+    trace_lists: [wgpu::ComputePipeline; 5],
+    args: wgpu::ComputePipeline,
+    group: wgpu::BindGroup,
+    args_group: wgpu::BindGroup,
+    state: wgpu::Buffer,
+    work: wgpu::Buffer,
+    dispatch: wgpu::Buffer,
+    params: AdaptiveParams,
+}
+
+impl AdaptivePass {
+    /// Creates the kernels and buffers for `camera` on `scene`, with at most `spp` samples a
+    /// pixel (a square, as uniform sampling takes them). Refuses an image whose outputs do not
+    /// fit one storage binding, and a device with too few storage buffers per stage.
+    pub fn new(
+        ctx: &GpuContext,
+        camera: &LensCamera,
+        scene: &GpuScene,
+        source: DirectionSource,
+        spp: u32,
+        options: Adaptive,
+    ) -> Result<Self> {
+        if !(options.threshold >= 0.0 && options.threshold.is_finite()) {
+            return Err(Error::Option(format!(
+                "adaptive sampling's threshold {}: it is a displayed-colour difference, 0 or \
+                 more (0.02 is 2 % of full scale)",
+                options.threshold
+            )));
+        }
+        let trace = TracePass::supersampled(ctx, camera, scene, source, spp)?;
+        if trace.bands() > 1 {
+            return Err(Error::Limit(format!(
+                "adaptive sampling of a {} image: its outputs exceed one storage binding of \
+                 this device; use a smaller image or uniform sampling (--spp N)",
+                camera.size
+            )));
+        }
+        let needed =
+            TRACE_STORAGE_BUFFERS + ADAPTIVE_STORAGE_BUFFERS + scene.arrays.extra_bindings();
+        let has = ctx.device.limits().max_storage_buffers_per_shader_stage;
+        if needed > has {
+            return Err(Error::Limit(format!(
+                "adaptive sampling binds {needed} storage buffers per kernel, above this \
+                 device's limit of {has}; use uniform sampling (--spp N)"
+            )));
+        }
+        let (width, height) = (camera.size.width, camera.size.height);
+        let pixels = camera.size.pixels() as u64;
+        let params = AdaptiveParams {
+            threshold: options.threshold,
+            normal_cosine: NORMAL_COSINE,
+            plane_distance: PLANE_DISTANCE,
+            _pad0: 0,
+            lattice: [
+                (width - 1).div_ceil(ADAPTIVE_BLOCK) + 1,
+                (height - 1).div_ceil(ADAPTIVE_BLOCK) + 1,
+            ],
+            blocks: [
+                width.div_ceil(ADAPTIVE_BLOCK),
+                height.div_ceil(ADAPTIVE_BLOCK),
+            ],
+        };
+        ctx.checked("creating the adaptive passes", || {
+            let device = &ctx.device;
+            let buffer = |label: &str, bytes: u64, usage: wgpu::BufferUsages| {
+                device.create_buffer(&wgpu::BufferDescriptor {
+                    label: Some(label),
+                    size: bytes,
+                    usage: wgpu::BufferUsages::STORAGE | usage,
+                    mapped_at_creation: false,
+                })
+            };
+            let state = buffer(
+                "fisheye.adaptive.state",
+                8 * pixels,
+                wgpu::BufferUsages::COPY_SRC,
+            );
+            let work = buffer(
+                "fisheye.adaptive.work",
+                4 * (u64::from(ADAPTIVE_HEADER) + pixels),
+                wgpu::BufferUsages::COPY_DST,
+            );
+            let dispatch = buffer(
+                "fisheye.adaptive.dispatch",
+                12,
+                wgpu::BufferUsages::INDIRECT,
+            );
+            let uniform = crate::gpu::buffer_init(
+                device,
+                "fisheye.adaptive.params",
+                bytemuck::bytes_of(&params),
+                wgpu::BufferUsages::UNIFORM,
+            );
+            // Group 0 as wgsl/pixel.wgsl and wgsl/adaptive.wgsl declare it.
+            let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+                label: Some("fisheye.adaptive"),
+                entries: &[
+                    uniform_entry(0),
+                    storage_entry(1, true),
+                    uniform_entry(2),
+                    storage_entry(3, false),
+                    storage_entry(4, false),
+                    storage_entry(5, false),
+                    storage_entry(6, false),
+                    storage_entry(7, false),
+                    uniform_entry(8),
+                ],
+            });
+            let resources = trace.shared_bindings().into_iter().chain([
+                state.as_entire_binding(),
+                work.as_entire_binding(),
+                uniform.as_entire_binding(),
+            ]);
+            let group = bind_group(device, "fisheye.adaptive", &layout, resources);
+            let mut layouts = vec![&layout, &scene.layout];
+            let file = match &scene.ray_query {
+                Some(rq) => {
+                    layouts.push(&rq.layout);
+                    "adaptive_rq"
+                }
+                None => "adaptive",
+            };
+            let kernel = |entry: &str, mode: u32| {
+                let mut constants = trace.constants().to_vec();
+                constants.push(("LIST_MODE", f64::from(mode)));
+                shader::scene_pipeline(device, file, &scene.arrays, entry, &constants, &layouts)
+            };
+            let builders =
+                ["lattice", "classify", "select_pixels", "more", "untraced"].map(|e| kernel(e, 0));
+            // The modes of wgsl/adaptive.wgsl: centres, samples, first hits, estimates.
+            let centres = kernel("trace_list", 0);
+            let trace_lists = [
+                centres.clone(),
+                centres,
+                kernel("trace_list", 3),
+                kernel("trace_list", 1),
+                kernel("trace_list", 2),
+            ];
+            let args_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+                label: Some("fisheye.adaptive.args"),
+                entries: &[storage_entry(0, true), storage_entry(1, false)],
+            });
+            let args =
+                shader::compute_pipeline(device, "adaptive_args", "main", &[], &[&args_layout]);
+            let args_group = crate::gpu::bind_buffers(
+                device,
+                "fisheye.adaptive.args",
+                &args_layout,
+                &[&work, &dispatch],
+            );
+            Self {
+                trace,
+                options,
+                builders,
+                trace_lists,
+                args,
+                group,
+                args_group,
+                state,
+                work,
+                dispatch,
+                params,
+            }
+        })
+    }
+
+    /// The settings.
+    pub fn options(&self) -> Adaptive {
+        self.options
+    }
+
+    /// The trace pass whose outputs the adaptive passes write (its pose, its buffers).
+    pub fn trace_pass(&self) -> &TracePass {
+        &self.trace
+    }
+
+    /// Moves the camera to `pose` for the frames encoded from now on (see
+    /// [`TracePass::set_pose`]).
+    pub fn set_pose(&self, ctx: &GpuContext, scene: &GpuScene, pose: &Camera) {
+        self.trace.set_pose(ctx, scene, pose);
+    }
+
+    /// Records a move of the camera to `pose` (see [`TracePass::encode_pose`]).
+    pub fn encode_pose(
+        &self,
+        device: &wgpu::Device,
+        encoder: &mut wgpu::CommandEncoder,
+        scene: &GpuScene,
+        pose: &Camera,
+    ) {
+        self.trace.encode_pose(device, encoder, scene, pose);
+    }
+
+    /// The stages a frame runs, in order (see [`stages_for`]).
+    pub fn stages(&self) -> Vec<Stage> {
+        stages_for(self.trace.samples_per_side(), self.options)
+    }
+
+    /// Records one frame: each stage a compute pass (a kernel lists pixels, a one-invocation
+    /// kernel sizes the dispatch, and `trace_list` traces them), timed by `spans`.
+    pub fn encode(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        scene: &GpuScene,
+        spans: AdaptiveSpans<'_>,
+    ) {
+        let size = self.trace.size();
+        let pixels = [size.width, size.height];
+        let stages = self.stages();
+        // The lister of each stage, by its index in `builders`: supersampling lists the
+        // pixels the estimate marked where there is an estimating stage.
+        let lister = |stage: Stage| match stage {
+            Stage::Coarse => 0,
+            Stage::Refine => 1,
+            Stage::Estimate => 2,
+            Stage::Supersample if stages.contains(&Stage::Estimate) => 3,
+            Stage::Supersample => 2,
+            Stage::Truth => 4,
+        };
+        let extent = |stage: Stage| match stage {
+            Stage::Coarse => self.params.lattice,
+            Stage::Refine => self.params.blocks,
+            _ => pixels,
+        };
+        let mut groups = vec![&self.group, &scene.bind_group];
+        if let Some(rq) = &scene.ray_query {
+            groups.push(&rq.bind_group);
+        }
+        for (stage, writes) in ALL_STAGES.into_iter().zip(spans.stages) {
+            if !stages.contains(&stage) {
+                continue;
+            }
+            let [w, h] = extent(stage);
+            encoder.clear_buffer(&self.work, 0, Some(4 * u64::from(ADAPTIVE_HEADER)));
+            let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some("fisheye.adaptive"),
+                timestamp_writes: writes,
+            });
+            pass.set_pipeline(&self.builders[lister(stage)]);
+            for (index, group) in groups.iter().enumerate() {
+                pass.set_bind_group(index as u32, *group, &[]);
+            }
+            pass.dispatch_workgroups(w.div_ceil(WORKGROUP_2D), h.div_ceil(WORKGROUP_2D), 1);
+            pass.set_pipeline(&self.args);
+            pass.set_bind_group(0, &self.args_group, &[]);
+            pass.dispatch_workgroups(1, 1, 1);
+            pass.set_pipeline(&self.trace_lists[stage as usize]);
+            pass.set_bind_group(0, &self.group, &[]);
+            pass.dispatch_workgroups_indirect(&self.dispatch, 0);
+        }
+    }
+
+    /// Traces one frame, reporting a GPU error as `what` failing, and reads it back.
+    pub fn trace(&self, ctx: &GpuContext, scene: &GpuScene, what: &str) -> Result<RenderOutput> {
+        ctx.checked(what, || {
+            let mut encoder = ctx.device.create_command_encoder(&Default::default());
+            self.encode(&mut encoder, scene, AdaptiveSpans::default());
+            ctx.queue.submit([encoder.finish()]);
+        })?;
+        self.trace.read(ctx)
+    }
+
+    /// The rays each pixel's colour took in the last frame, row-major (the spp map): 0 for a
+    /// pixel interpolated between its block's corners or masked, 1 for its centre alone, and
+    /// one more for each sample that the lens covers of a pixel's 2 × 2 estimating samples and
+    /// of its full supersampling.
+    pub fn read_rays(&self, ctx: &GpuContext) -> Result<Vec<u32>> {
+        let state: Vec<[u32; 2]> = ctx.read_buffer(&self.state)?;
+        Ok(state.into_iter().map(|[rays, _]| rays).collect())
+    }
+}
+
+/// Colours of the spp map's ramp from no ray to the most, at even steps: viridis's ends and
+/// quarter points (van der Walt and Smith's matplotlib colour map, chosen for being
+/// perceptually uniform and readable with colour-blindness).
+const RAMP: [[f32; 3]; 5] = [
+    [0.267, 0.005, 0.329],
+    [0.229, 0.322, 0.546],
+    [0.128, 0.567, 0.551],
+    [0.369, 0.789, 0.383],
+    [0.993, 0.906, 0.144],
+];
+
+/// A picture of the rays each pixel took (`rays`, row-major, as
+/// [`AdaptivePass::read_rays`] gives them): dark violet for none (interpolated), then along
+/// viridis to yellow at `most`, on a logarithmic scale (log(1 + rays)); transparent where
+/// `colour`'s mask says the lens covers nothing.
+pub fn spp_picture(
+    size: crate::lens::ImageSize,
+    rays: &[u32],
+    colour: &[[f32; 4]],
+    most: u32,
+) -> image::RgbaImage {
+    let top = f64::from(most.max(1)).ln_1p();
+    let mut picture = image::RgbaImage::new(size.width, size.height);
+    for ((pixel, &n), c) in picture.pixels_mut().zip(rays).zip(colour) {
+        if c[3] <= 0.0 {
+            continue;
+        }
+        let x = (f64::from(n).ln_1p() / top).clamp(0.0, 1.0) * (RAMP.len() - 1) as f64;
+        let (i, f) = ((x.floor() as usize).min(RAMP.len() - 2), x - x.floor());
+        let f = if x >= (RAMP.len() - 1) as f64 {
+            1.0
+        } else {
+            f as f32
+        };
+        let rgb: [f32; 3] = std::array::from_fn(|k| RAMP[i][k] + (RAMP[i + 1][k] - RAMP[i][k]) * f);
+        *pixel = image::Rgba([
+            (rgb[0] * 255.0).round() as u8,
+            (rgb[1] * 255.0).round() as u8,
+            (rgb[2] * 255.0).round() as u8,
+            255,
+        ]);
+    }
+    picture
+}

@@ -1,0 +1,270 @@
+//! Adaptive sampling (`trace::AdaptivePass`) against uniform sampling on the same device:
+//! exactly uniform at threshold 0, exact ground truth, rays where the image has edges and
+//! none of their own where it is smooth, the same image on every run, and error that falls
+//! as the threshold does.
+
+mod common;
+
+use common::{camera, ctx, scene};
+use fisheye_rt::compare::image_error;
+use fisheye_rt::lens::LensCamera;
+use fisheye_rt::lens::gpu::DirectionSource;
+use fisheye_rt::scene::Scene;
+use fisheye_rt::shared::ADAPTIVE_BLOCK;
+use fisheye_rt::trace::{
+    Adaptive, AdaptivePass, GpuScene, NO_HIT, RenderOptions, RenderOutput, TracePass,
+    linear_to_srgb,
+};
+
+fn uniform(gpu: &GpuScene, cam: &LensCamera, spp: u32) -> RenderOutput {
+    let options = RenderOptions::default();
+    TracePass::supersampled(ctx(), cam, gpu, options.directions, spp)
+        .unwrap()
+        .trace(ctx(), gpu, "uniform")
+        .unwrap()
+}
+
+/// An adaptive frame at `threshold` with at most `spp` samples a pixel: its outputs and the
+/// rays each pixel's colour took.
+fn adaptive(
+    gpu: &GpuScene,
+    cam: &LensCamera,
+    spp: u32,
+    threshold: f32,
+    ground_truth: bool,
+) -> (RenderOutput, Vec<u32>) {
+    let options = Adaptive {
+        threshold,
+        ground_truth,
+    };
+    let pass = AdaptivePass::new(ctx(), cam, gpu, DirectionSource::Computed, spp, options).unwrap();
+    let out = pass.trace(ctx(), gpu, "adaptive").unwrap();
+    (out, pass.read_rays(ctx()).unwrap())
+}
+
+fn upload(scene: &Scene) -> GpuScene {
+    GpuScene::new(ctx(), scene, &RenderOptions::default()).unwrap()
+}
+
+/// At threshold 0 every block is refined and every pixel supersampled with the very samples
+/// uniform sampling takes, summed in the same order: the same bits.
+#[test]
+fn threshold_zero_is_uniform_sampling_exactly() {
+    let room = scene("builtin:default");
+    let gpu = upload(&room);
+    let cam = camera("canon-8-15mm@8mm", 61, 46);
+    let reference = uniform(&gpu, &cam, 16);
+    let (out, rays) = adaptive(&gpu, &cam, 16, 0.0, true);
+    assert_eq!(out.colour, reference.colour, "colour");
+    assert_eq!(out.geometry, reference.geometry, "geometry");
+    assert_eq!(out.ids, reference.ids, "ids");
+    // Each pixel: its centre where the lens covers it, then its 16 samples that it covers.
+    let centres = uniform(&gpu, &cam, 1);
+    for (i, (&n, c)) in rays.iter().zip(&reference.colour).enumerate() {
+        let samples = (c[3] * 16.0).round() as u32;
+        assert_eq!(n, u32::from(centres.valid(i)) + samples, "pixel {i}");
+    }
+}
+
+/// Interpolated pixels get their first hits traced: ids, normals and ranges are never
+/// interpolated, and equal uniform sampling's bit for bit.
+#[test]
+fn ground_truth_is_uniform_samplings() {
+    let room = scene("builtin:default");
+    let gpu = upload(&room);
+    let cam = camera("samyang-7.5mm", 64, 48);
+    let reference = uniform(&gpu, &cam, 4);
+    let (out, rays) = adaptive(&gpu, &cam, 4, 0.05, true);
+    assert!(rays.contains(&0), "some pixels were interpolated");
+    assert_eq!(out.geometry, reference.geometry);
+    assert_eq!(out.ids, reference.ids);
+    // Without it, the interpolated pixels have none.
+    let (bare, rays) = adaptive(&gpu, &cam, 4, 0.05, false);
+    for (i, &n) in rays.iter().enumerate() {
+        if n == 0 && bare.valid(i) {
+            assert_eq!(
+                (bare.ids[i], bare.geometry[i]),
+                (NO_HIT, [0.0; 4]),
+                "pixel {i}"
+            );
+        }
+    }
+}
+
+#[test]
+fn reruns_are_bit_identical() {
+    let room = scene("builtin:default");
+    let gpu = upload(&room);
+    let cam = camera("canon-8-15mm@8mm", 80, 60);
+    let (a, rays_a) = adaptive(&gpu, &cam, 16, 0.03, true);
+    let (b, rays_b) = adaptive(&gpu, &cam, 16, 0.03, true);
+    assert_eq!(a.colour, b.colour);
+    assert_eq!(a.ids, b.ids);
+    assert_eq!(rays_a, rays_b);
+}
+
+/// A plane lit by a distant point light fills a pinhole's view: no edges, colour changing smoothly.
+/// Only the lattice of block corners is traced, and bilinear interpolation between them stays
+/// within a quarter of the threshold of the one-ray image in displayed colour: the blocks are
+/// kept only where the colour bends by less than the threshold along their edges (second
+/// differences h²f'' below it), and linear interpolation is off by at most h² max|f''| / 8 on
+/// each axis.
+#[test]
+fn a_smooth_scene_is_traced_at_block_corners_only() {
+    let dir = std::env::temp_dir().join(format!("fisheye-adaptive-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    std::fs::write(
+        dir.join("plane.obj"),
+        "v -20 -20 0\nv 20 -20 0\nv 20 20 0\nv -20 20 0\nf 1 2 3\nf 1 3 4\n",
+    )
+    .unwrap();
+    std::fs::write(
+        dir.join("plane.toml"),
+        "ambient = [0.0, 0.0, 0.0]\nsky = [0.0, 0.0, 0.0]\n[camera]\nposition = [0.0, 0.0, 3.0]\n\
+         look_at = [0.0, 0.0, 0.0]\n[[mesh]]\npath = \"plane.obj\"\n[[light]]\ntype = \"point\"\n\
+         position = [10.0, 6.0, 40.0]\nintensity = [1200.0, 1200.0, 1200.0]\n",
+    )
+    .unwrap();
+    let plane = fisheye_rt::scene::load(dir.join("plane.toml").to_str().unwrap())
+        .unwrap()
+        .scene;
+    std::fs::remove_dir_all(&dir).unwrap();
+    let gpu = upload(&plane);
+    let (w, h) = (65, 49);
+    let cam = camera("rectilinear:f=1", w, h);
+    let one = uniform(&gpu, &cam, 1);
+    assert!(
+        one.ids.iter().all(|&id| id != NO_HIT),
+        "the plane fills the view"
+    );
+    let threshold = 0.02;
+    let (out, rays) = adaptive(&gpu, &cam, 16, threshold, false);
+    let lattice = |n: u32| (n - 1).div_ceil(ADAPTIVE_BLOCK) + 1;
+    let corners = (lattice(w) * lattice(h)) as usize;
+    assert_eq!(
+        rays.iter().filter(|&&n| n == 1).count(),
+        corners,
+        "{rays:?}"
+    );
+    assert_eq!(
+        rays.iter().filter(|&&n| n == 0).count(),
+        rays.len() - corners
+    );
+    let shown = |c: f32| linear_to_srgb(c.clamp(0.0, 1.0));
+    let worst = one
+        .colour
+        .iter()
+        .zip(&out.colour)
+        .flat_map(|(a, b)| (0..3).map(move |k| (shown(a[k]) - shown(b[k])).abs()))
+        .fold(0.0f32, f32::max);
+    assert!(
+        worst <= threshold / 4.0,
+        "interpolated {worst} from the one-ray image"
+    );
+    assert!(
+        worst > 0.0,
+        "pixels between corners were interpolated, not traced"
+    );
+}
+
+/// Pixels on a silhouette (their centre's hit and a neighbour's differ between something and
+/// sky) take many rays; pixels of open sky, far from any object, take almost none.
+#[test]
+fn edges_get_more_rays_than_flat_pixels() {
+    let boxes = scene("builtin:many-small");
+    let gpu = upload(&boxes);
+    let (w, h) = (96, 72);
+    let cam = camera("canon-8-15mm@8mm", w, h);
+    let truth = uniform(&gpu, &cam, 1);
+    let (_, rays) = adaptive(&gpu, &cam, 16, 0.05, false);
+    let (w, h) = (w as usize, h as usize);
+    let sky = |x: usize, y: usize| truth.valid(y * w + x) && truth.ids[y * w + x] == NO_HIT;
+    let (mut edge, mut open) = (Vec::new(), Vec::new());
+    for y in 2..h - 2 {
+        for x in 2..w - 2 {
+            let i = y * w + x;
+            let hit = truth.ids[i] != NO_HIT;
+            if truth.valid(i)
+                && hit
+                && [(x - 1, y), (x + 1, y), (x, y - 1), (x, y + 1)]
+                    .iter()
+                    .any(|&(a, b)| sky(a, b))
+            {
+                edge.push(rays[i]);
+            }
+            if (y - 2..=y + 2).all(|b| (x - 2..=x + 2).all(|a| sky(a, b))) {
+                open.push(rays[i]);
+            }
+        }
+    }
+    let mean = |v: &[u32]| v.iter().map(|&n| f64::from(n)).sum::<f64>() / v.len() as f64;
+    assert!(
+        edge.len() > 20 && open.len() > 200,
+        "{} edge, {} open",
+        edge.len(),
+        open.len()
+    );
+    let (on_edges, in_sky) = (mean(&edge), mean(&open));
+    assert!(
+        on_edges >= 8.0,
+        "silhouette pixels took {on_edges:.2} rays on average"
+    );
+    assert!(in_sky <= 0.25, "open sky took {in_sky:.2} rays a pixel");
+}
+
+/// Lower thresholds refine more, so the error against a 64-ray reference falls (to uniform
+/// sampling's at threshold 0).
+#[test]
+fn error_falls_as_the_threshold_falls() {
+    let room = scene("builtin:default");
+    let gpu = upload(&room);
+    let cam = camera("canon-8-15mm@8mm", 80, 60);
+    let reference = uniform(&gpu, &cam, 64);
+    let mut last: Option<(f32, f64, f64)> = None;
+    for threshold in [0.3, 0.1, 0.03, 0.01, 0.0] {
+        let (out, rays) = adaptive(&gpu, &cam, 16, threshold, false);
+        let mse = image_error(&reference.colour, &out.colour).mse;
+        let spent = rays.iter().map(|&n| f64::from(n)).sum::<f64>();
+        if let Some((before, mse_before, spent_before)) = last {
+            assert!(
+                spent >= spent_before,
+                "{threshold} spent fewer rays than {before}"
+            );
+            assert!(
+                mse <= mse_before,
+                "MSE {mse:.3e} at {threshold}, above {mse_before:.3e} at {before}"
+            );
+        }
+        last = Some((threshold, mse, spent));
+    }
+}
+
+/// What adaptive sampling cannot do is refused with what to do instead: a negative or
+/// non-finite threshold, and an image whose outputs exceed one storage binding (uniform
+/// sampling traces those in bands).
+#[test]
+fn adaptive_sampling_refuses_what_it_cannot_do() {
+    let gpu = upload(&scene("builtin:default"));
+    let refuse = |cam: &LensCamera, threshold: f32| {
+        let options = Adaptive {
+            threshold,
+            ground_truth: false,
+        };
+        let source = DirectionSource::Computed;
+        match AdaptivePass::new(ctx(), cam, &gpu, source, 1, options) {
+            Ok(_) => panic!("threshold {threshold} at {} was accepted", cam.size),
+            Err(e) => e.to_string(),
+        }
+    };
+    let small = camera("canon-8-15mm@8mm", 32, 24);
+    for bad in [-0.1, f32::NAN, f32::INFINITY] {
+        assert!(refuse(&small, bad).contains("0 or more"), "{bad}");
+    }
+    let limit = ctx().device.limits().max_storage_buffer_binding_size;
+    let rows = (limit / (16 * 4096)) as u32 + 1;
+    let message = refuse(&camera("equidistant:f=0.6", 4096, rows), 0.05);
+    assert!(
+        message.contains("one storage binding") && message.contains("--spp N"),
+        "{message}"
+    );
+}

@@ -1,0 +1,448 @@
+// Adaptive sampling: rays where the picture needs them, every pass on the GPU. The image is
+// covered by blocks of ADAPTIVE_BLOCK × ADAPTIVE_BLOCK pixels whose corners form a lattice of
+// pixel centres (the last row and column of the image are lattice points too):
+//
+// 1. `lattice` lists the lattice pixels and `trace_list` traces one shaded ray through each
+//    centre (a first pass below one ray per pixel: 1/ADAPTIVE_BLOCK² of them);
+// 2. `classify` looks at each block's four corners (Whitted 1980 subdivided a pixel whose
+//    corners disagree): where they agree (the same surface, normals and tangent planes, and
+//    displayed colour along each edge that bends by less than the threshold, see `bend`) and
+//    the lens covers every pixel, the block's other pixels are interpolated bilinearly between
+//    the corners in linear radiance, so no interpolation crosses a change of surface or a depth
+//    step. Other blocks list their pixels and `trace_list` traces each one's centre;
+// 3. `select_pixels` lists the pixels traced whose displayed colour bends across them (the
+//    second difference with their neighbours, along either axis) by the threshold or more,
+//    and those on the lens's edge: a one-ray pixel is its box filter's value where colour
+//    changes linearly across it, and the bend estimates how far off it is (Mitchell 1987 drove
+//    supersampling by such local contrast). Where SAMPLES_PER_SIDE > 2 and the threshold is
+//    above 0, `trace_list` first takes 2 × 2 stratified samples of each (`MODE_ESTIMATE`) and
+//    marks those whose half-sample mean differs from the mean by the threshold or more
+//    (Dammertz et al. 2010's error estimate); `more` lists those. The last list's pixels take
+//    the SAMPLES_PER_SIDE² jittered stratified samples that uniform supersampling takes, in
+//    its order;
+// 4. with ground truth asked for, `untraced` lists the interpolated pixels and `trace_list`
+//    traces their centres' first hits, so ids, normals and ranges are never interpolated.
+//
+// Lists are compacted by one atomic per workgroup; `adaptive_args.wgsl` turns a list's length
+// into the indirect dispatch of `trace_list`; nothing is read back between passes. A pixel's result
+// depends on its own samples and its neighbours' alone, so the order in which lists fill does
+// not change the image: reruns are bit-identical.
+#import pixel
+#import colour
+
+// Mirrors `fisheye_rt::shared::AdaptiveParams`.
+struct AdaptiveParams {
+    // Displayed-colour difference (clamped sRGB, largest channel) at which two samples
+    // disagree; 0 traces every pixel with every sample.
+    threshold: f32,
+    // The least cosine between two corners' shading normals on one smooth surface.
+    normal_cosine: f32,
+    // The farthest a corner's hit may lie from another corner's tangent plane, relative to
+    // the larger range.
+    plane_distance: f32,
+    _pad0: u32,
+    // Lattice points across and down.
+    lattice: vec2<u32>,
+    // Blocks across and down.
+    blocks: vec2<u32>,
+}
+
+// Per pixel: x the rays its colour took (the spp map), y what its centre ray saw (KEY_*).
+@group(0) @binding(6) var<storage, read_write> state: array<vec2<u32>>;
+// The list's length (ADAPTIVE_COUNT), then the list of pixel indices from ADAPTIVE_HEADER on.
+@group(0) @binding(7) var<storage, read_write> work: array<atomic<u32>>;
+@group(0) @binding(8) var<uniform> adaptive: AdaptiveParams;
+
+// What `trace_list` does with the pixels listed: a pipeline for each (the modes' kernels
+// differ in size, and one kernel holding all three would be as slow as the largest).
+const MODE_CENTRE: u32 = 0u;
+const MODE_SAMPLES: u32 = 1u;
+const MODE_TRUTH: u32 = 2u;
+const MODE_ESTIMATE: u32 = 3u;
+override LIST_MODE: u32 = MODE_CENTRE;
+// What a pixel's centre saw: not traced (interpolated), masked by the lens, nothing (sky);
+// else the material and instance hit (`surface_key`).
+const KEY_UNTRACED: u32 = 0xffffffffu;
+const KEY_MASKED: u32 = 0xfffffffeu;
+const KEY_SKY: u32 = 0xfffffffdu;
+// A pixel whose first samples still disagree (`MODE_ESTIMATE`): it takes them all.
+const KEY_MORE: u32 = 0xfffffffcu;
+// The samples of the estimating stage, per side.
+const ESTIMATE_SIDE: u32 = 2u;
+
+var<workgroup> group_count: atomic<u32>;
+var<workgroup> group_base: u32;
+
+fn size() -> vec2<u32> {
+    return vec2<u32>(lens.width, lens.height);
+}
+
+fn index_of(p: vec2<u32>) -> u32 {
+    return p.y * lens.width + p.x;
+}
+
+// The material and instance of a primary hit, as one number below the KEY_* values.
+fn surface_key(traced: Traced) -> u32 {
+    if traced.triangle == NO_HIT {
+        return KEY_SKY;
+    }
+    let material = triangle_at(traced.hit.slot).material & 0xffffu;
+    return material | ((traced.hit.instance & 0x3fffu) << 16u);
+}
+
+// Reserves `n` list entries for this invocation, with one global atomic per workgroup, and
+// returns the first one's place in `work`. Every invocation of the workgroup must call it, in
+// uniform control flow (it has barriers).
+fn reserve(n: u32, local: u32) -> u32 {
+    let mine = atomicAdd(&group_count, n);
+    workgroupBarrier();
+    if local == 0u {
+        group_base = atomicAdd(&work[ADAPTIVE_COUNT], atomicLoad(&group_count));
+    }
+    return ADAPTIVE_HEADER + workgroupUniformLoad(&group_base) + mine;
+}
+
+// The pixel at lattice point `i`.
+fn lattice_pixel(i: vec2<u32>) -> vec2<u32> {
+    return min(i * ADAPTIVE_BLOCK, size() - 1u);
+}
+
+fn is_lattice(p: vec2<u32>) -> bool {
+    let last = size() - 1u;
+    return (p.x % ADAPTIVE_BLOCK == 0u || p.x == last.x) && (p.y % ADAPTIVE_BLOCK == 0u || p.y == last.y);
+}
+
+// The largest channel difference of two linear colours as displayed.
+fn shown_difference(a: vec4<f32>, b: vec4<f32>) -> f32 {
+    let d = abs(shown(a.rgb) - shown(b.rgb));
+    return max(d.x, max(d.y, d.z));
+}
+
+@compute @workgroup_size(WORKGROUP_2D, WORKGROUP_2D)
+fn lattice(@builtin(global_invocation_id) id: vec3<u32>, @builtin(local_invocation_index) local: u32) {
+    let inside = all(id.xy < adaptive.lattice);
+    let slot = reserve(select(0u, 1u, inside), local);
+    if inside {
+        atomicStore(&work[slot], index_of(lattice_pixel(id.xy)));
+    }
+}
+
+// Traces the listed pixels as LIST_MODE says.
+@compute @workgroup_size(WORKGROUP_1D)
+fn trace_list(
+    @builtin(workgroup_id) group: vec3<u32>,
+    @builtin(num_workgroups) groups: vec3<u32>,
+    @builtin(local_invocation_index) local: u32,
+) {
+    let i = (group.y * groups.x + group.x) * WORKGROUP_1D + local;
+    if i >= atomicLoad(&work[ADAPTIVE_COUNT]) {
+        return;
+    }
+    let index = atomicLoad(&work[ADAPTIVE_HEADER + i]);
+    let pixel = vec2<u32>(index % lens.width, index / lens.width);
+    let mode = LIST_MODE;
+    if mode == MODE_SAMPLES {
+        let c = supersampled(pixel, index);
+        colour_out[index] = c;
+        let count = f32(SAMPLES_PER_SIDE * SAMPLES_PER_SIDE);
+        state[index].x += u32(round(c.w * count));
+        return;
+    }
+    if mode == MODE_ESTIMATE {
+        // Dammertz et al. (2010) estimate a pixel's error by how far the mean of half its
+        // samples lies from the mean of all: here in displayed colour, where the threshold is.
+        let s = samples(pixel, index, ESTIMATE_SIDE);
+        colour_out[index] = s.colour;
+        state[index].x += u32(round(s.colour.w * f32(ESTIMATE_SIDE * ESTIMATE_SIDE)));
+        if largest(abs(shown(s.colour.rgb) - shown(s.half))) >= adaptive.threshold {
+            state[index].y = KEY_MORE;
+        }
+        return;
+    }
+    let ray = primary_ray(pixel);
+    if ray.w == 0.0 {
+        if mode == MODE_CENTRE {
+            colour_out[index] = vec4<f32>(0.0);
+            state[index] = vec2<u32>(0u, KEY_MASKED);
+        }
+        geometry_out[index] = vec4<f32>(0.0);
+        ids_out[index] = NO_HIT;
+        return;
+    }
+    if mode == MODE_TRUTH {
+        let hit = first_hit(from_eye(ray.xyz));
+        geometry_out[index] = geometry_of(hit);
+        ids_out[index] = hit.triangle;
+        return;
+    }
+    let traced = shade(from_eye(ray.xyz));
+    colour_out[index] = vec4<f32>(traced.colour, 1.0);
+    geometry_out[index] = geometry_of(traced);
+    ids_out[index] = traced.triangle;
+    state[index] = vec2<u32>(1u, surface_key(traced));
+}
+
+// What a block's corner saw: its key, and its hit's normal and position from the eye.
+struct Corner {
+    key: u32,
+    geometry: vec4<f32>,
+    position: vec3<f32>,
+}
+
+fn corner(p: vec2<u32>) -> Corner {
+    let i = index_of(p);
+    let g = geometry_out[i];
+    return Corner(state[i].y, g, world(primary_ray(p).xyz) * g.w);
+}
+
+// Whether two traced, unmasked corners see one smooth stretch of one surface: the same
+// material and instance, normals close, and each hit near the other's tangent plane (no depth
+// step between them).
+fn same_surface(a: Corner, b: Corner) -> bool {
+    if a.key != b.key {
+        return false;
+    }
+    if a.key == KEY_SKY {
+        return true;
+    }
+    if dot(a.geometry.xyz, b.geometry.xyz) < adaptive.normal_cosine {
+        return false;
+    }
+    let allowed = adaptive.plane_distance * max(a.geometry.w, b.geometry.w);
+    let d = b.position - a.position;
+    return abs(dot(a.geometry.xyz, d)) <= allowed && abs(dot(b.geometry.xyz, d)) <= allowed;
+}
+
+// Whether a lattice point among the 4 × 4 around the block at lattice point `l` (its corners
+// and the ring beyond) is masked (`masked`) or not: where none is, the lens's edge is more
+// than a block away and, the lens's valid region being convex (a disk or ellipse, or the
+// whole image), does not cross the block.
+fn lattice_near(l: vec2<u32>, masked: bool) -> bool {
+    let first = vec2<i32>(l) - 1;
+    let last = vec2<i32>(adaptive.lattice) - 1;
+    for (var y = max(first.y, 0); y <= min(first.y + 3, last.y); y++) {
+        for (var x = max(first.x, 0); x <= min(first.x + 3, last.x); x++) {
+            let key = state[index_of(lattice_pixel(vec2<u32>(u32(x), u32(y))))].y;
+            if (key == KEY_MASKED) == masked {
+                return true;
+            }
+        }
+    }
+    return false;
+}
+
+fn largest(v: vec3<f32>) -> f32 {
+    return max(v.x, max(v.y, v.z));
+}
+
+// How far linear interpolation between samples `a` and `b` may be off, in displayed colour,
+// judged from the samples beside them along the same line (`before` a, `after` b, where the
+// flags say they exist on the same surface): the larger second difference at either end,
+// which is zero along a linear change and the full step at a step (the error of linear
+// interpolation grows with the second derivative: |f - lerp| <= h² max|f''| / 8); with no
+// sample beside either end, the difference between the ends.
+fn bend(before: vec3<f32>, a: vec3<f32>, b: vec3<f32>, after: vec3<f32>, has: vec2<bool>) -> f32 {
+    if !any(has) {
+        return largest(abs(b - a));
+    }
+    var worst = 0.0;
+    if has.x {
+        worst = largest(abs(before - 2.0 * a + b));
+    }
+    if has.y {
+        worst = max(worst, largest(abs(a - 2.0 * b + after)));
+    }
+    return worst;
+}
+
+// `bend` along the lattice edge from lattice point `a` to its neighbour `b`.
+fn edge_bend(a: vec2<u32>, b: vec2<u32>) -> f32 {
+    let d = vec2<i32>(b) - vec2<i32>(a);
+    let before = vec2<i32>(a) - d;
+    let after = vec2<i32>(b) + d;
+    let last = vec2<i32>(adaptive.lattice) - 1;
+    let key_a = state[index_of(lattice_pixel(a))].y;
+    let key_b = state[index_of(lattice_pixel(b))].y;
+    var has = vec2<bool>(false);
+    var cb = vec3<f32>(0.0);
+    var ca = vec3<f32>(0.0);
+    if all(before >= vec2<i32>(0)) {
+        let i = index_of(lattice_pixel(vec2<u32>(before)));
+        has.x = state[i].y == key_a;
+        cb = shown(colour_out[i].rgb);
+    }
+    if all(after <= last) {
+        let i = index_of(lattice_pixel(vec2<u32>(after)));
+        has.y = state[i].y == key_b;
+        ca = shown(colour_out[i].rgb);
+    }
+    let sa = shown(colour_out[index_of(lattice_pixel(a))].rgb);
+    let sb = shown(colour_out[index_of(lattice_pixel(b))].rgb);
+    return bend(cb, sa, sb, ca, has);
+}
+
+// Whether the lens gives a ray to every pixel of the block from `first` to `end` (exclusive),
+// or (with `covered` false) to none.
+fn block_mask_is(first: vec2<u32>, end: vec2<u32>, covered: bool) -> bool {
+    for (var y = first.y; y < end.y; y++) {
+        for (var x = first.x; x < end.x; x++) {
+            if (primary_ray(vec2<u32>(x, y)).w != 0.0) != covered {
+                return false;
+            }
+        }
+    }
+    return true;
+}
+
+@compute @workgroup_size(WORKGROUP_2D, WORKGROUP_2D)
+fn classify(@builtin(global_invocation_id) id: vec3<u32>, @builtin(local_invocation_index) local: u32) {
+    let inside = all(id.xy < adaptive.blocks);
+    let first = id.xy * ADAPTIVE_BLOCK;
+    let end = min(first + ADAPTIVE_BLOCK, size());
+    let far = min(first + ADAPTIVE_BLOCK, size() - 1u);
+    let c00 = first;
+    let c10 = vec2<u32>(far.x, first.y);
+    let c01 = vec2<u32>(first.x, far.y);
+    let c11 = far;
+    var refine = false;
+    var listed = 0u;
+    if inside {
+        let keys = vec4<u32>(
+            state[index_of(c00)].y,
+            state[index_of(c10)].y,
+            state[index_of(c01)].y,
+            state[index_of(c11)].y,
+        );
+        let masked = keys == vec4<u32>(KEY_MASKED);
+        let l = id.xy;
+        if all(masked) {
+            refine = lattice_near(l, false) && !block_mask_is(first, end, false);
+        } else if any(masked) {
+            refine = true;
+        } else {
+            let l11 = min(l + 1u, adaptive.lattice - 1u);
+            let l10 = vec2<u32>(l11.x, l.y);
+            let l01 = vec2<u32>(l.x, l11.y);
+            let bent = max(max(edge_bend(l, l10), edge_bend(l01, l11)), max(edge_bend(l, l01), edge_bend(l10, l11)));
+            refine = bent >= adaptive.threshold;
+            if !refine {
+                let a = corner(c00);
+                let b = corner(c10);
+                let c = corner(c01);
+                let d = corner(c11);
+                refine = !(same_surface(a, b) && same_surface(a, c) && same_surface(b, d)
+                    && same_surface(c, d) && same_surface(a, d) && same_surface(b, c))
+                    || lattice_near(l, true) && !block_mask_is(first, end, true);
+            }
+        }
+        for (var y = first.y; y < end.y; y++) {
+            for (var x = first.x; x < end.x; x++) {
+                listed += select(1u, 0u, is_lattice(vec2<u32>(x, y)));
+            }
+        }
+    }
+    var slot = reserve(select(0u, listed, refine), local);
+    if !inside {
+        return;
+    }
+    let span = vec2<f32>(max(far - first, vec2<u32>(1u)));
+    let all_masked = state[index_of(c00)].y == KEY_MASKED;
+    for (var y = first.y; y < end.y; y++) {
+        for (var x = first.x; x < end.x; x++) {
+            let p = vec2<u32>(x, y);
+            if is_lattice(p) {
+                continue;
+            }
+            let i = index_of(p);
+            if refine {
+                atomicStore(&work[slot], i);
+                slot += 1u;
+                continue;
+            }
+            geometry_out[i] = vec4<f32>(0.0);
+            ids_out[i] = NO_HIT;
+            if all_masked {
+                colour_out[i] = vec4<f32>(0.0);
+                state[i] = vec2<u32>(0u, KEY_MASKED);
+                continue;
+            }
+            let f = vec2<f32>(p - first) / span;
+            let top = mix(colour_out[index_of(c00)], colour_out[index_of(c10)], f.x);
+            let bottom = mix(colour_out[index_of(c01)], colour_out[index_of(c11)], f.x);
+            colour_out[i] = vec4<f32>(mix(top, bottom, f.y).rgb, 1.0);
+            state[i] = vec2<u32>(0u, KEY_UNTRACED);
+        }
+    }
+}
+
+// The second difference of displayed colours `before`, `c`, `after` at `c` (see `bend`); the
+// first difference where only one neighbour exists (`has`), 0 where none does.
+fn curvature(before: vec3<f32>, c: vec3<f32>, after: vec3<f32>, has: vec2<bool>) -> f32 {
+    if all(has) {
+        return largest(abs(before - 2.0 * c + after));
+    }
+    if has.x {
+        return largest(abs(c - before));
+    }
+    if has.y {
+        return largest(abs(after - c));
+    }
+    return 0.0;
+}
+
+// Whether pixel `p` and its neighbour at `q` are on different sides of the lens's edge.
+fn mask_edge(p: vec2<u32>, q: vec2<u32>) -> bool {
+    return (state[index_of(p)].y == KEY_MASKED) != (state[index_of(q)].y == KEY_MASKED);
+}
+
+@compute @workgroup_size(WORKGROUP_2D, WORKGROUP_2D)
+fn select_pixels(@builtin(global_invocation_id) id: vec3<u32>, @builtin(local_invocation_index) local: u32) {
+    let p = id.xy;
+    var pick = false;
+    if all(p < size()) && state[index_of(p)].y != KEY_UNTRACED {
+        // The colour's bend across the pixel along each axis (see `bend`): a one-ray pixel
+        // is its box filter's value where the colour changes linearly across it.
+        let c = shown(colour_out[index_of(p)].rgb);
+        let last = size() - 1u;
+        let x = vec2<u32>(1u, 0u);
+        let y = vec2<u32>(0u, 1u);
+        let left = select(p, p - x, p.x > 0u);
+        let right = select(p, p + x, p.x < last.x);
+        let up = select(p, p - y, p.y > 0u);
+        let down = select(p, p + y, p.y < last.y);
+        let across = curvature(
+            shown(colour_out[index_of(left)].rgb), c, shown(colour_out[index_of(right)].rgb),
+            vec2<bool>(p.x > 0u, p.x < last.x),
+        );
+        let along = curvature(
+            shown(colour_out[index_of(up)].rgb), c, shown(colour_out[index_of(down)].rgb),
+            vec2<bool>(p.y > 0u, p.y < last.y),
+        );
+        pick = max(across, along) >= adaptive.threshold
+            || mask_edge(p, left) || mask_edge(p, right) || mask_edge(p, up) || mask_edge(p, down);
+    }
+    let slot = reserve(select(0u, 1u, pick), local);
+    if pick {
+        atomicStore(&work[slot], index_of(p));
+    }
+}
+
+@compute @workgroup_size(WORKGROUP_2D, WORKGROUP_2D)
+fn more(@builtin(global_invocation_id) id: vec3<u32>, @builtin(local_invocation_index) local: u32) {
+    let p = id.xy;
+    let pick = all(p < size()) && state[index_of(p)].y == KEY_MORE;
+    let slot = reserve(select(0u, 1u, pick), local);
+    if pick {
+        atomicStore(&work[slot], index_of(p));
+    }
+}
+
+@compute @workgroup_size(WORKGROUP_2D, WORKGROUP_2D)
+fn untraced(@builtin(global_invocation_id) id: vec3<u32>, @builtin(local_invocation_index) local: u32) {
+    let p = id.xy;
+    let pick = all(p < size()) && state[index_of(p)].y == KEY_UNTRACED;
+    let slot = reserve(select(0u, 1u, pick), local);
+    if pick {
+        atomicStore(&work[slot], index_of(p));
+    }
+}

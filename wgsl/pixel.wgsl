@@ -1,0 +1,88 @@
+// What every per-pixel tracing kernel shares (`trace.wgsl`, `adaptive.wgsl`): the frame, the
+// outputs, and a pixel's supersampled colour. Group 0's bindings 2 to 5; the lens and the
+// direction table (bindings 0 and 1) come from `primary.wgsl`.
+#import primary
+#import sampling
+#import shade
+
+override SAMPLES_PER_SIDE: u32 = 1u;
+
+// Mirrors `fisheye_rt::trace::Frame`: the camera-to-world rotation's columns (camera x right,
+// y down, z forward) and the eye. The scene is uploaded relative to its own camera, so the eye
+// is at the origin unless a camera path moved it.
+struct Frame {
+    right: vec4<f32>,
+    down: vec4<f32>,
+    forward: vec4<f32>,
+    eye: vec4<f32>,
+    // The pixel of the first invocation (xy), for dispatches over a part of the image; w:
+    // the first image row the outputs hold (a band of rows; 0 for a whole image).
+    offset: vec4<u32>,
+}
+
+@group(0) @binding(2) var<uniform> frame: Frame;
+// Linear RGB radiance; w = 1 where the pixel has a ray, all zero where masked.
+@group(0) @binding(3) var<storage, read_write> colour_out: array<vec4<f32>>;
+// World-space shading normal and distance of the primary hit; zero on a miss or mask.
+@group(0) @binding(4) var<storage, read_write> geometry_out: array<vec4<f32>>;
+// Scene triangle of the primary hit; NO_HIT on a miss or mask.
+@group(0) @binding(5) var<storage, read_write> ids_out: array<u32>;
+
+// A camera-space direction in the world.
+fn world(d: vec3<f32>) -> vec3<f32> {
+    return frame.right.xyz * d.x + frame.down.xyz * d.y + frame.forward.xyz * d.z;
+}
+
+// The ray through camera-space direction `d` from the eye.
+fn from_eye(d: vec3<f32>) -> Ray {
+    return Ray(frame.eye.xyz, world(d), 0.0, 3.0e38);
+}
+
+// A pixel's samples: the mean radiance of those that have a ray (a box filter) with the
+// share that do in w, and the mean of the half of them on the strata of one colour of a
+// checkerboard (Dammertz et al.'s error estimate compares the two).
+struct Sampled {
+    colour: vec4<f32>,
+    half: vec3<f32>,
+}
+
+// The `side`² jittered stratified samples of pixel `pixel` (index `index`).
+fn samples(pixel: vec2<u32>, index: u32, side: u32) -> Sampled {
+    let count = side * side;
+    var sum = vec3<f32>(0.0);
+    var half_sum = vec3<f32>(0.0);
+    var covered = 0u;
+    var half_covered = 0u;
+    for (var k = 0u; k < count; k++) {
+        let p = vec2<f32>(pixel) + sample_offset(index, k, side);
+        let d = lens_unproject(lens, p);
+        if d.w != 0.0 {
+            let c = shade(from_eye(d.xyz)).colour;
+            sum += c;
+            covered += 1u;
+            if (k % side + k / side) % 2u == 0u {
+                half_sum += c;
+                half_covered += 1u;
+            }
+        }
+    }
+    if covered == 0u {
+        return Sampled(vec4<f32>(0.0), vec3<f32>(0.0));
+    }
+    let mean = sum / f32(covered);
+    let half = select(mean, half_sum / f32(max(half_covered, 1u)), half_covered > 0u);
+    return Sampled(vec4<f32>(mean, f32(covered) / f32(count)), half);
+}
+
+// The pixel's SAMPLES_PER_SIDE² samples: their mean radiance, and the share with a ray (w).
+fn supersampled(pixel: vec2<u32>, index: u32) -> vec4<f32> {
+    return samples(pixel, index, SAMPLES_PER_SIDE).colour;
+}
+
+// The ground truth of a primary hit: normal and distance, zero on a miss.
+fn geometry_of(traced: Traced) -> vec4<f32> {
+    if traced.triangle == NO_HIT {
+        return vec4<f32>(0.0);
+    }
+    return vec4<f32>(traced.normal, traced.hit.t);
+}
