@@ -24,9 +24,9 @@
 //    traces their centres' first hits, so ids, normals and ranges are never interpolated.
 //
 // Lists are compacted by one atomic per workgroup; `adaptive_args.wgsl` turns a list's length
-// into the indirect dispatch of `trace_list`; nothing is read back between passes. A pixel's result
-// depends on its own samples and its neighbours' alone, so the order in which lists fill does
-// not change the image: reruns are bit-identical.
+// into the indirect dispatch of `trace_list`; nothing is read back between passes. A pixel's
+// result depends on its own samples and its neighbours' alone, so the order in which lists
+// fill does not change the image: reruns are bit-identical.
 #import pixel
 #import colour
 
@@ -54,7 +54,7 @@ struct AdaptiveParams {
 @group(0) @binding(8) var<uniform> adaptive: AdaptiveParams;
 
 // What `trace_list` does with the pixels listed: a pipeline for each (the modes' kernels
-// differ in size, and one kernel holding all three would be as slow as the largest).
+// differ in size, and one kernel holding all four would be as slow as the largest).
 const MODE_CENTRE: u32 = 0u;
 const MODE_SAMPLES: u32 = 1u;
 const MODE_TRUTH: u32 = 2u;
@@ -110,12 +110,6 @@ fn lattice_pixel(i: vec2<u32>) -> vec2<u32> {
 fn is_lattice(p: vec2<u32>) -> bool {
     let last = size() - 1u;
     return (p.x % ADAPTIVE_BLOCK == 0u || p.x == last.x) && (p.y % ADAPTIVE_BLOCK == 0u || p.y == last.y);
-}
-
-// The largest channel difference of two linear colours as displayed.
-fn shown_difference(a: vec4<f32>, b: vec4<f32>) -> f32 {
-    let d = abs(shown(a.rgb) - shown(b.rgb));
-    return max(d.x, max(d.y, d.z));
 }
 
 @compute @workgroup_size(WORKGROUP_2D, WORKGROUP_2D)

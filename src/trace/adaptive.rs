@@ -4,7 +4,7 @@
 //! GPU, with no read-back between them. `wgsl/adaptive.wgsl` says how each pass decides.
 
 use super::pass::TracePass;
-use super::{GpuScene, RenderOutput};
+use super::{Adaptive, GpuScene, RenderOutput};
 use crate::error::{Error, Result};
 use crate::gpu::{GpuContext, bind_group, storage_entry, uniform_entry};
 use crate::lens::LensCamera;
@@ -15,26 +15,6 @@ use crate::shared::{
     ADAPTIVE_BLOCK, ADAPTIVE_HEADER, ADAPTIVE_STORAGE_BUFFERS, AdaptiveParams,
     TRACE_STORAGE_BUFFERS, WORKGROUP_2D,
 };
-
-/// Adaptive sampling's settings (see [`AdaptivePass`]); the most rays a pixel takes are
-/// [`super::RenderOptions::spp`] (plus its centre's).
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Adaptive {
-    /// How far apart two samples' displayed colours (clamped, sRGB-encoded, the largest
-    /// channel, as [`crate::compare`] measures error) may be before the pixels between them
-    /// get rays of their own, and a traced pixel its full supersampling: 0.02 is 2 % of full
-    /// scale. At 0 every pixel takes every sample, as uniform sampling does.
-    pub threshold: f32,
-    /// Whether pixels that took no ray of their own (interpolated) still get their centre's
-    /// first hit traced, so the ground-truth outputs (range, normal, id) are exact everywhere.
-    /// Without it those pixels' geometry is zero and their id `NO_HIT`.
-    pub ground_truth: bool,
-}
-
-impl Adaptive {
-    /// The default threshold of `--spp auto`.
-    pub const DEFAULT_THRESHOLD: f32 = 0.02;
-}
 
 /// Two corners' shading normals further apart than this (about 25°) are not one smooth
 /// stretch of surface: their block is traced.

@@ -17,16 +17,14 @@ pub mod sampling;
 
 use glam::DVec3;
 
-pub use adaptive::{
-    ALL_STAGES, Adaptive, AdaptivePass, AdaptiveSpans, Stage, spp_picture, stages_for,
-};
+pub use adaptive::{ALL_STAGES, AdaptivePass, AdaptiveSpans, Stage, spp_picture, stages_for};
 pub use display::{
     ColourFile, Display, KEY, MASKED_RGB, Tone, auto_exposure, check_writable,
     check_writable_folder, colour_image, colour_image_with, linear_to_srgb, refuse_non_regular,
     save_png, write_atomically, write_colour, write_file,
 };
 pub use gpu_scene::{GpuScene, SceneBytes, gpu_lights, shading_vertices};
-pub use options::{RenderOptions, Sampling, Traversal, surface_constants, surface_id};
+pub use options::{Adaptive, RenderOptions, Sampling, Traversal, surface_constants, surface_id};
 pub use output::{Channel, RenderOutput, Values};
 pub use pass::TracePass;
 pub use ray_query::RayQueryScene;

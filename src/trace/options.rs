@@ -32,7 +32,27 @@ pub struct RenderOptions {
     pub spp: u32,
     /// Adaptive sampling ([`super::AdaptivePass`]): rays where neighbouring samples disagree,
     /// fewer than one a pixel where the image is smooth; `None` samples every pixel alike.
-    pub adaptive: Option<super::Adaptive>,
+    pub adaptive: Option<Adaptive>,
+}
+
+/// Adaptive sampling's settings (see `trace::AdaptivePass`); the most rays a pixel takes are
+/// [`RenderOptions::spp`] (plus its centre's).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Adaptive {
+    /// How far apart two samples' displayed colours (clamped, sRGB-encoded, the largest
+    /// channel, as [`crate::compare`] measures error) may be before the pixels between them
+    /// get rays of their own, and a traced pixel its full supersampling: 0.02 is 2 % of full
+    /// scale. At 0 every pixel takes every sample, as uniform sampling does.
+    pub threshold: f32,
+    /// Whether pixels that took no ray of their own (interpolated) still get their centre's
+    /// first hit traced, so the ground-truth outputs (range, normal, id) are exact everywhere.
+    /// Without it those pixels' geometry is zero and their id `NO_HIT`.
+    pub ground_truth: bool,
+}
+
+impl Adaptive {
+    /// The default threshold of `--spp auto`.
+    pub const DEFAULT_THRESHOLD: f32 = 0.02;
 }
 
 /// How the tracer's rays find their hits; lens and shading code are the same for both.
@@ -111,7 +131,7 @@ impl Sampling {
             return Err(bad("auto takes its values after colons".into()));
         }
         let threshold = match parts.next() {
-            None => super::Adaptive::DEFAULT_THRESHOLD,
+            None => Adaptive::DEFAULT_THRESHOLD,
             Some(t) => match t.parse::<f32>() {
                 Ok(t) if t >= 0.0 && t.is_finite() => t,
                 _ => {
@@ -151,8 +171,8 @@ impl Sampling {
     }
 
     /// The render options' `spp` and `adaptive` for this sampling.
-    pub fn options(&self, ground_truth: bool) -> (u32, Option<super::Adaptive>) {
-        let adaptive = self.threshold().map(|threshold| super::Adaptive {
+    pub fn options(&self, ground_truth: bool) -> (u32, Option<Adaptive>) {
+        let adaptive = self.threshold().map(|threshold| Adaptive {
             threshold,
             ground_truth,
         });
