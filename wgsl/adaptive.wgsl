@@ -102,6 +102,14 @@ fn reserve(n: u32, local: u32) -> u32 {
     return ADAPTIVE_HEADER + workgroupUniformLoad(&group_base) + mine;
 }
 
+// Lists pixel `index` where `pick` holds (`reserve`'s rules: every invocation calls it).
+fn list_if(pick: bool, index: u32, local: u32) {
+    let slot = reserve(select(0u, 1u, pick), local);
+    if pick {
+        atomicStore(&work[slot], index);
+    }
+}
+
 // The pixel at lattice point `i`.
 fn lattice_pixel(i: vec2<u32>) -> vec2<u32> {
     return min(i * ADAPTIVE_BLOCK, size() - 1u);
@@ -114,11 +122,7 @@ fn is_lattice(p: vec2<u32>) -> bool {
 
 @compute @workgroup_size(WORKGROUP_2D, WORKGROUP_2D)
 fn lattice(@builtin(global_invocation_id) id: vec3<u32>, @builtin(local_invocation_index) local: u32) {
-    let inside = all(id.xy < adaptive.lattice);
-    let slot = reserve(select(0u, 1u, inside), local);
-    if inside {
-        atomicStore(&work[slot], index_of(lattice_pixel(id.xy)));
-    }
+    list_if(all(id.xy < adaptive.lattice), index_of(lattice_pixel(id.xy)), local);
 }
 
 // Traces the listed pixels as LIST_MODE says.
@@ -415,28 +419,20 @@ fn select_pixels(@builtin(global_invocation_id) id: vec3<u32>, @builtin(local_in
         pick = max(across, along) >= adaptive.threshold
             || mask_edge(p, left) || mask_edge(p, right) || mask_edge(p, up) || mask_edge(p, down);
     }
-    let slot = reserve(select(0u, 1u, pick), local);
-    if pick {
-        atomicStore(&work[slot], index_of(p));
-    }
+    list_if(pick, index_of(p), local);
+}
+
+// Lists the pixels whose state says `key`.
+fn list_keyed(p: vec2<u32>, key: u32, local: u32) {
+    list_if(all(p < size()) && state[index_of(p)].y == key, index_of(p), local);
 }
 
 @compute @workgroup_size(WORKGROUP_2D, WORKGROUP_2D)
 fn more(@builtin(global_invocation_id) id: vec3<u32>, @builtin(local_invocation_index) local: u32) {
-    let p = id.xy;
-    let pick = all(p < size()) && state[index_of(p)].y == KEY_MORE;
-    let slot = reserve(select(0u, 1u, pick), local);
-    if pick {
-        atomicStore(&work[slot], index_of(p));
-    }
+    list_keyed(id.xy, KEY_MORE, local);
 }
 
 @compute @workgroup_size(WORKGROUP_2D, WORKGROUP_2D)
 fn untraced(@builtin(global_invocation_id) id: vec3<u32>, @builtin(local_invocation_index) local: u32) {
-    let p = id.xy;
-    let pick = all(p < size()) && state[index_of(p)].y == KEY_UNTRACED;
-    let slot = reserve(select(0u, 1u, pick), local);
-    if pick {
-        atomicStore(&work[slot], index_of(p));
-    }
+    list_keyed(id.xy, KEY_UNTRACED, local);
 }

@@ -214,29 +214,28 @@ impl Path {
 
     /// The lens image's colour output (linear RGB, w = the mask).
     pub(crate) fn colour_buffer(&self) -> &wgpu::Buffer {
-        match (self, self.trace_pass()) {
-            (_, Some(pass)) => pass.colour_buffer(),
-            (Path::Cube(cube), None) => cube.colour_buffer(),
-            _ => unreachable!("a traced frame has a trace pass"),
+        match self {
+            Path::Direct(pass) => pass.colour_buffer(),
+            Path::Adaptive(pass) => pass.trace_pass().colour_buffer(),
+            Path::Cube(cube) => cube.colour_buffer(),
         }
     }
 
     /// The last frame's outputs, read back: every output of a traced frame, the colour alone
     /// (geometry zero, ids `NO_HIT`) through a cube map.
     pub(crate) fn read(&self, ctx: &GpuContext) -> Result<RenderOutput> {
-        match (self, self.trace_pass()) {
-            (_, Some(pass)) => pass.read(ctx),
-            (Path::Cube(cube), None) => {
+        match self {
+            Path::Direct(pass) => pass.read(ctx),
+            Path::Adaptive(pass) => pass.trace_pass().read(ctx),
+            Path::Cube(cube) => {
                 let colour = cube.read(ctx)?;
-                let size = cube.camera().size;
                 Ok(RenderOutput {
-                    size,
+                    size: cube.camera().size,
                     geometry: vec![[0.0; 4]; colour.len()],
                     ids: vec![crate::shared::NO_HIT; colour.len()],
                     colour,
                 })
             }
-            _ => unreachable!("a traced frame has a trace pass"),
         }
     }
 }

@@ -3,7 +3,7 @@
 //! uniform supersampling of [`super::sampling`] where colours still differ; every pass on the
 //! GPU, with no read-back between them. `wgsl/adaptive.wgsl` says how each pass decides.
 
-use super::pass::TracePass;
+use super::pass::{TracePass, shared_entries};
 use super::{Adaptive, GpuScene, RenderOutput};
 use crate::error::{Error, Result};
 use crate::gpu::{GpuContext, bind_group, storage_entry, uniform_entry};
@@ -178,19 +178,15 @@ impl AdaptivePass {
                 wgpu::BufferUsages::UNIFORM,
             );
             // Group 0 as wgsl/pixel.wgsl and wgsl/adaptive.wgsl declare it.
+            let mut entries = shared_entries().to_vec();
+            entries.extend([
+                storage_entry(6, false),
+                storage_entry(7, false),
+                uniform_entry(8),
+            ]);
             let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
                 label: Some("fisheye.adaptive"),
-                entries: &[
-                    uniform_entry(0),
-                    storage_entry(1, true),
-                    uniform_entry(2),
-                    storage_entry(3, false),
-                    storage_entry(4, false),
-                    storage_entry(5, false),
-                    storage_entry(6, false),
-                    storage_entry(7, false),
-                    uniform_entry(8),
-                ],
+                entries: &entries,
             });
             let resources = trace.shared_bindings().into_iter().chain([
                 state.as_entire_binding(),

@@ -103,15 +103,7 @@ impl TracePass {
             let device = &ctx.device;
             let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
                 label: Some("fisheye.trace.frame"),
-                // Lens and table as wgsl/primary.wgsl declares them, then the frame.
-                entries: &[
-                    uniform_entry(0),
-                    storage_entry(1, true),
-                    uniform_entry(2),
-                    storage_entry(3, false),
-                    storage_entry(4, false),
-                    storage_entry(5, false),
-                ],
+                entries: &shared_entries(),
             });
             let constants = trace_constants(camera, scene, source, samples_per_side);
             let mut layouts = vec![&layout, &scene.layout];
@@ -389,6 +381,20 @@ impl TracePass {
             ids: ctx.read_buffer(ids)?,
         })
     }
+}
+
+/// Group 0's entries that every kernel tracing a pixel binds, as `wgsl/primary.wgsl` and
+/// `wgsl/pixel.wgsl` declare them: the lens and the direction table, the frame, the colour,
+/// geometry and id outputs ([`TracePass::shared_bindings`] in this order).
+pub(crate) fn shared_entries() -> [wgpu::BindGroupLayoutEntry; 6] {
+    [
+        uniform_entry(0),
+        storage_entry(1, true),
+        uniform_entry(2),
+        storage_entry(3, false),
+        storage_entry(4, false),
+        storage_entry(5, false),
+    ]
 }
 
 /// The overrides of a kernel that traces `camera`'s rays in `scene` as the trace kernel does.
