@@ -8,10 +8,16 @@
 //!
 //! Keys: W A S D (or the arrows) move, Q and E go down and up, dragging with the left button
 //! looks around; L switches lens, M switches method (rt, rq, cube-rt, cube-forward,
-//! cube-deferred, cube-single: those the adapter has), P switches the rays per pixel of the
-//! traced methods (1, 4, 16, then adaptive: auto:0.1:1 and auto), R goes back to the scene's camera, Esc quits. The title shows the lens, the method and the frame time. For tests:
-//! `--frames N --screenshot FILE` renders N frames from the scene's camera, saves the window's
-//! last frame as a PNG and exits.
+//! cube-deferred, cube-single: those the adapter has), P switches the sampling of the traced
+//! methods (adaptive `auto` first, then 1, 4 and 16 rays per pixel, then `auto:0.1:1`), R goes
+//! back to the scene's camera, Esc quits. The title shows the lens, the method and the frame
+//! time.
+//!
+//! Frames are progressive (`Renderer::encode_progressive`): with adaptive sampling, a moving
+//! camera sees the frame below one ray per pixel, and a still one sees it sharpen frame by
+//! frame (about one ray per pixel each) into the whole adaptive frame; other samplings draw
+//! their whole frame when the camera moves. For tests: `--frames N --screenshot FILE` renders
+//! N frames from the scene's camera, saves the window's last frame as a PNG and exits.
 
 use std::collections::HashSet;
 use std::path::PathBuf;
@@ -41,10 +47,10 @@ const LENSES: [&str; 5] = [
     "rectilinear:f=1",
 ];
 
-/// The rays per pixel P cycles through.
-/// The samplings P steps through: uniform rays per pixel, then adaptive sampling below one ray
-/// a pixel where the image is smooth (fast while moving) and up to 16 where it is not.
-const SPP: [&str; 5] = ["1", "4", "16", "auto:0.1:1", "auto"];
+/// The samplings P steps through: adaptive sampling (below one ray a pixel where the image is
+/// smooth, up to 16 where it is not), uniform rays per pixel, then adaptive sampling that
+/// stops at one ray a pixel.
+const SPP: [&str; 5] = ["auto", "1", "4", "16", "auto:0.1:1"];
 
 struct Args {
     scene: String,
@@ -319,7 +325,7 @@ impl State {
         let device = &self.ctx.device;
         let mut encoder = device.create_command_encoder(&Default::default());
         view.renderer
-            .encode(&mut encoder, &self.pose, &view.target)
+            .encode_progressive(&mut encoder, &self.pose, &view.target)
             .map_err(|e| e.to_string())?;
         let output = surface.texture.create_view(&Default::default());
         {

@@ -29,10 +29,15 @@ pub const ADAPTIVE_STORAGE_BUFFERS: u32 = 2;
 /// `ADAPTIVE_BLOCK`² pixels where the image is smooth.
 pub const ADAPTIVE_BLOCK: u32 = 4;
 /// The `u32`s before the list in adaptive sampling's work buffer: the list's length
-/// (at `ADAPTIVE_COUNT`), three unused (a 16-byte header).
+/// (at `ADAPTIVE_COUNT`), the part of it `trace_list` traces (from `ADAPTIVE_FIRST` to
+/// `ADAPTIVE_END`), one unused (a 16-byte header).
 pub const ADAPTIVE_HEADER: u32 = 4;
 /// Where the work buffer holds the list's length.
 pub const ADAPTIVE_COUNT: u32 = 0;
+/// Where the work buffer holds the first list entry `trace_list` traces.
+pub const ADAPTIVE_FIRST: u32 = 1;
+/// Where the work buffer holds the end (exclusive) of the entries `trace_list` traces.
+pub const ADAPTIVE_END: u32 = 2;
 
 /// The most samples per pixel side (`RenderOptions::spp` is a square of at most this).
 pub const MAX_SAMPLES_PER_SIDE: u32 = 16;
@@ -295,6 +300,8 @@ pub fn wgsl_constants() -> Vec<(String, u32)> {
         ("ADAPTIVE_BLOCK", ADAPTIVE_BLOCK),
         ("ADAPTIVE_HEADER", ADAPTIVE_HEADER),
         ("ADAPTIVE_COUNT", ADAPTIVE_COUNT),
+        ("ADAPTIVE_FIRST", ADAPTIVE_FIRST),
+        ("ADAPTIVE_END", ADAPTIVE_END),
         ("SURFACE_DIFFUSE", SURFACE_DIFFUSE),
         ("SURFACE_MIRROR", SURFACE_MIRROR),
         ("SURFACE_GLASS", SURFACE_GLASS),

@@ -268,3 +268,68 @@ fn adaptive_sampling_refuses_what_it_cannot_do() {
         "{message}"
     );
 }
+
+/// Progressive refinement (`AdaptivePass::encode_step`): step 0 is the frame below one ray a
+/// pixel that `--spp auto:T:1` makes; each later step spends about one ray a pixel (at most
+/// one slice of pixels × the most samples); the steps end in the whole adaptive frame, every
+/// output bit for bit, after which a step changes nothing.
+#[test]
+fn progressive_steps_sharpen_into_the_adaptive_frame() {
+    let room = scene("builtin:default");
+    let gpu = upload(&room);
+    let cam = camera("canon-8-15mm@8mm", 61, 46);
+    let (threshold, spp) = (0.02, 16);
+    let options = Adaptive {
+        threshold,
+        ground_truth: true,
+    };
+    let pass =
+        AdaptivePass::new(ctx(), &cam, &gpu, DirectionSource::Computed, spp, options).unwrap();
+    let step = |k: u32| {
+        let mut encoder = ctx().device.create_command_encoder(&Default::default());
+        pass.encode_step(&mut encoder, &gpu, k);
+        ctx().queue.submit([encoder.finish()]);
+        let out = pass.trace_pass().read(ctx()).unwrap();
+        let rays = pass.read_rays(ctx()).unwrap();
+        (out, rays.iter().map(|&n| u64::from(n)).sum::<u64>(), rays)
+    };
+    let (first, mut spent, _) = step(0);
+    let (coarse, coarse_rays) = adaptive(&gpu, &cam, 1, threshold, true);
+    assert_eq!(first.colour, coarse.colour, "step 0 is the auto:T:1 frame");
+    assert_eq!(first.ids, coarse.ids, "with its ground truth");
+    let pixels = cam.size.pixels() as u64;
+    assert!(spent < pixels, "step 0 is below a ray a pixel: {spent}");
+    assert_eq!(
+        spent,
+        coarse_rays.iter().map(|&n| u64::from(n)).sum::<u64>()
+    );
+
+    let (whole, whole_rays) = adaptive(&gpu, &cam, spp, threshold, true);
+    let slice = pixels / u64::from(spp);
+    let mut last = first;
+    let mut slices = 0;
+    for k in 1.. {
+        let (out, total, rays) = step(k);
+        let added = total - spent;
+        // Step 1 takes the 2 × 2 estimating samples of the pixels whose colour bends.
+        let budget = if k == 1 {
+            4 * pixels
+        } else {
+            slice * u64::from(spp)
+        };
+        assert!(added <= budget, "step {k}: {added} rays, above {budget}");
+        if k > 1 && added == 0 {
+            // Done: nothing left, so nothing changed, and it is the whole frame.
+            assert_eq!(out.colour, last.colour, "step {k}");
+            assert_eq!(out.colour, whole.colour, "colour");
+            assert_eq!(out.geometry, whole.geometry, "geometry");
+            assert_eq!(out.ids, whole.ids, "ids");
+            assert_eq!(rays, whole_rays, "rays");
+            break;
+        }
+        slices += u32::from(k > 1);
+        assert!(k < 2 + 16 + 1, "still refining after {k} steps");
+        (last, spent) = (out, total);
+    }
+    assert!(slices > 1, "the list took several steps: {slices}");
+}

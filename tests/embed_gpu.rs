@@ -7,7 +7,7 @@ use fisheye_rt::gpu::GpuContext;
 use fisheye_rt::lens::{ImageSize, LensCamera, parse_spec};
 use fisheye_rt::renderer::Renderer;
 use fisheye_rt::scene::{Camera, Scene, builtin};
-use fisheye_rt::trace::{GpuScene, RenderOptions, TracePass, render};
+use fisheye_rt::trace::{Adaptive, GpuScene, RenderOptions, TracePass, render};
 use glam::DVec3;
 
 /// A device and queue made the plain wgpu way, with no optional features and `limits`.
@@ -307,5 +307,67 @@ fn unwritable_targets_are_errors_naming_what_is_wanted() {
             message.contains(wanted) && message.contains("32x24 Rgba16Float"),
             "{message}"
         );
+    }
+}
+
+/// Progressive frames (`Renderer::encode_progressive`): the first at a pose is the adaptive
+/// frame below one ray a pixel, frames at the same pose sharpen it into the whole adaptive
+/// frame, and a move starts again; frames with uniform sampling are whole from the first.
+#[test]
+fn progressive_frames_sharpen_while_still_and_restart_on_a_move() {
+    // Adaptive sampling's kernels bind its state and work list beyond the trace kernel's.
+    let base = fisheye_rt::renderer::required_limits();
+    let (device, queue) = device_with(wgpu::Limits {
+        max_storage_buffers_per_shader_stage: base.max_storage_buffers_per_shader_stage
+            + fisheye_rt::shared::ADAPTIVE_STORAGE_BUFFERS,
+        ..base
+    });
+    let (scene, camera) = view("default", "samyang-7.5mm", 64, 48);
+    let format = wgpu::TextureFormat::Rgba32Float;
+    let sampled = |spp: u32, adaptive: bool| RenderOptions {
+        spp,
+        adaptive: adaptive.then_some(Adaptive {
+            threshold: Adaptive::DEFAULT_THRESHOLD,
+            ground_truth: false,
+        }),
+        ..RenderOptions::default()
+    };
+    let ctx = GpuContext::from_device(&device, &queue);
+    let image = |options: &RenderOptions| render(&ctx, &scene, &camera, options).unwrap().colour;
+    let home = scene.camera;
+    let moved = Camera {
+        position: home.position + DVec3::new(0.3, 0.0, 0.2),
+        ..home
+    };
+    for (options, first, last) in [
+        (sampled(16, true), sampled(1, true), sampled(16, true)),
+        (sampled(4, false), sampled(4, false), sampled(4, false)),
+    ] {
+        let renderer = Renderer::new(&device, &queue, &scene, &camera, &options, format).unwrap();
+        let target = renderer.target_texture(&device);
+        let frame = |pose: &Camera| {
+            let mut encoder = device.create_command_encoder(&Default::default());
+            renderer
+                .encode_progressive(&mut encoder, pose, &target)
+                .unwrap();
+            queue.submit([encoder.finish()]);
+            ctx.read_texture(&target).unwrap()
+        };
+        for _ in 0..3 {
+            frame(&moved);
+        }
+        assert_same(
+            "the first frame after a move",
+            &frame(&home),
+            &image(&first),
+        );
+        // Each still frame supersamples a sixteenth of the pixels at 16 samples, at least:
+        // 2 steps and 16 slices cover every pixel.
+        let mut still = Vec::new();
+        for _ in 0..18 {
+            still = frame(&home);
+        }
+        assert_same("the still frames' end", &still, &image(&last));
+        assert_same("a frame after that", &frame(&home), &still);
     }
 }

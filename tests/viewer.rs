@@ -28,8 +28,8 @@ fn viewer() -> PathBuf {
     exe
 }
 
-/// Runs the viewer under Xvfb for a few frames and returns its last frame.
-fn screenshot(args: &[&str]) -> image::RgbaImage {
+/// Runs the viewer under Xvfb for `frames` frames and returns the last.
+fn screenshot(args: &[&str], frames: u32) -> image::RgbaImage {
     let out = std::env::temp_dir().join(format!(
         "fisheye-viewer-{}-{}.png",
         std::process::id(),
@@ -39,7 +39,9 @@ fn screenshot(args: &[&str]) -> image::RgbaImage {
         .args(["-a", "-s", "-screen 0 640x480x24"])
         .arg(viewer())
         .args(args)
-        .args(["--frames", "4", "--screenshot"])
+        .arg("--frames")
+        .arg(frames.to_string())
+        .arg("--screenshot")
         .arg(&out)
         .output()
         .unwrap_or_else(|e| {
@@ -92,30 +94,41 @@ fn the_viewer_shows_the_scene_under_xvfb() {
     let args = ["builtin:default", "--lens", lens, "--size", "160x120"];
 
     let traced = render(&ctx, &scene, &camera, &options).unwrap().to_image();
-    assert_shows("rt", &screenshot(&args), &traced);
+    assert_shows(
+        "rt",
+        &screenshot(&[&args[..], &["--spp", "1"]].concat(), 4),
+        &traced,
+    );
     let four = RenderOptions { spp: 4, ..options };
     let traced = render(&ctx, &scene, &camera, &four).unwrap().to_image();
-    let window = screenshot(&[&args[..], &["--spp", "4"]].concat());
+    let window = screenshot(&[&args[..], &["--spp", "4"]].concat(), 4);
     assert_shows("rt at 4 rays a pixel", &window, &traced);
-    // Adaptive sampling through the embedding `Renderer` the viewer draws with.
-    let adaptive = Adaptive {
-        threshold: Adaptive::DEFAULT_THRESHOLD,
-        ground_truth: false,
-    };
-    let auto = RenderOptions {
-        spp: 16,
-        adaptive: Some(adaptive),
+    // Adaptive sampling, the viewer's default, through the embedding `Renderer` it draws
+    // with: its first frame is the one below a ray a pixel, and a still camera's frames
+    // sharpen into the whole adaptive frame (2 steps, then a sixteenth of the pixels at 16
+    // samples each frame, at least).
+    let adaptive = |spp: u32| RenderOptions {
+        spp,
+        adaptive: Some(Adaptive {
+            threshold: Adaptive::DEFAULT_THRESHOLD,
+            ground_truth: false,
+        }),
         ..options
     };
-    let traced = render(&ctx, &scene, &camera, &auto).unwrap().to_image();
-    let window = screenshot(&[&args[..], &["--spp", "auto"]].concat());
-    assert_shows("rt, adaptive", &window, &traced);
+    let coarse = render(&ctx, &scene, &camera, &adaptive(1))
+        .unwrap()
+        .to_image();
+    assert_shows("rt, adaptive, first frame", &screenshot(&args, 1), &coarse);
+    let whole = render(&ctx, &scene, &camera, &adaptive(16))
+        .unwrap()
+        .to_image();
+    assert_shows("rt, adaptive, still", &screenshot(&args, 20), &whole);
 
     // Through a cube map of the size the viewer picks: half the image's longer side.
     let gpu_scene = GpuScene::new(&ctx, &scene, &options).unwrap();
     let settings = CubeSettings::new(80, CubeMethod::Traced);
     let cube = CubeMap::new(&ctx, &camera, &gpu_scene, &settings).unwrap();
     let colour = cube.render(&ctx, &gpu_scene, &scene.camera).unwrap();
-    let window = screenshot(&[&args[..], &["--method", "cube-rt"]].concat());
+    let window = screenshot(&[&args[..], &["--method", "cube-rt"]].concat(), 4);
     assert_shows("cube-rt", &window, &colour_image(size, &colour));
 }

@@ -49,7 +49,9 @@ struct AdaptiveParams {
 
 // Per pixel: x the rays its colour took (the spp map), y what its centre ray saw (KEY_*).
 @group(0) @binding(6) var<storage, read_write> state: array<vec2<u32>>;
-// The list's length (ADAPTIVE_COUNT), then the list of pixel indices from ADAPTIVE_HEADER on.
+// The list's length (ADAPTIVE_COUNT) and the part of it to trace (ADAPTIVE_FIRST to
+// ADAPTIVE_END, set by `adaptive_args.wgsl`), then the list of pixel indices from
+// ADAPTIVE_HEADER on.
 @group(0) @binding(7) var<storage, read_write> work: array<atomic<u32>>;
 @group(0) @binding(8) var<uniform> adaptive: AdaptiveParams;
 
@@ -132,8 +134,8 @@ fn trace_list(
     @builtin(num_workgroups) groups: vec3<u32>,
     @builtin(local_invocation_index) local: u32,
 ) {
-    let i = (group.y * groups.x + group.x) * WORKGROUP_1D + local;
-    if i >= atomicLoad(&work[ADAPTIVE_COUNT]) {
+    let i = atomicLoad(&work[ADAPTIVE_FIRST]) + (group.y * groups.x + group.x) * WORKGROUP_1D + local;
+    if i >= atomicLoad(&work[ADAPTIVE_END]) {
         return;
     }
     let index = atomicLoad(&work[ADAPTIVE_HEADER + i]);

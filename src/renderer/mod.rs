@@ -38,6 +38,8 @@ mod offscreen;
 pub use offscreen::{FrameTime, Offscreen, Pass, SceneSet, Setup};
 
 use crate::cube::{CubeMap, CubeMethod, CubeSettings, CubeSpans};
+use std::sync::Mutex;
+
 use crate::error::{Error, Result};
 use crate::gpu::{GpuContext, bind_group, dispatch_over_image, storage_entry};
 use crate::lens::LensCamera;
@@ -53,7 +55,8 @@ use crate::trace::{
 
 /// The limits a device needs for the renderer: wgpu's downlevel defaults, with the storage
 /// buffers the trace kernel binds. Ask for these (or the adapter's own) when creating the
-/// device; ray queries also need `Features::EXPERIMENTAL_RAY_QUERY` and the adapter's
+/// device; adaptive sampling binds [`crate::shared::ADAPTIVE_STORAGE_BUFFERS`] storage
+/// buffers more; ray queries also need `Features::EXPERIMENTAL_RAY_QUERY` and the adapter's
 /// acceleration-structure limits.
 pub fn required_limits() -> wgpu::Limits {
     wgpu::Limits {
@@ -250,6 +253,9 @@ pub struct Renderer {
     present_layout: wgpu::BindGroupLayout,
     format: wgpu::TextureFormat,
     camera: LensCamera,
+    /// Progressive refinement's place: the pose its steps are for and the next step's number
+    /// (`None` after a whole frame).
+    progress: Mutex<Option<(Camera, u32)>>,
 }
 
 impl Renderer {
@@ -358,6 +364,7 @@ impl Renderer {
             present_layout,
             format,
             camera: *camera,
+            progress: Mutex::new(None),
         })
     }
 
@@ -399,6 +406,57 @@ impl Renderer {
         pose: &Camera,
         target: &wgpu::Texture,
     ) -> Result<()> {
+        *self.progress.lock().unwrap_or_else(|e| e.into_inner()) = None;
+        self.record(encoder, target, |encoder| {
+            self.path
+                .encode(&self.ctx, encoder, &self.scene, pose, Spans::default());
+        })
+    }
+
+    /// As [`Renderer::encode`], but refining progressively while the camera stays still: with
+    /// adaptive sampling ([`RenderOptions::adaptive`]), the first frame at a new `pose` is the
+    /// one below one ray per pixel (as `--spp auto:T:1` makes it), and each frame recorded at
+    /// the same pose after it sharpens it for about one ray per pixel, until the image is the
+    /// one [`Renderer::encode`] makes, bit for bit (see [`AdaptivePass::encode_step`]); after
+    /// that a frame costs next to nothing. Any other pose starts again. Other samplings and
+    /// methods make their whole frame at a new pose and leave it as it is while the pose
+    /// stays. Record progressive frames in the order they are submitted.
+    pub fn encode_progressive(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        pose: &Camera,
+        target: &wgpu::Texture,
+    ) -> Result<()> {
+        self.record(encoder, target, |encoder| {
+            let (ctx, scene) = (&self.ctx, &self.scene);
+            let mut progress = self.progress.lock().unwrap_or_else(|e| e.into_inner());
+            let step = match *progress {
+                Some((last, next)) if last == *pose => next,
+                _ => 0,
+            };
+            *progress = Some((*pose, step.saturating_add(1)));
+            match (&self.path, step) {
+                (Path::Adaptive(pass), _) => {
+                    if step == 0 {
+                        pass.encode_pose(&ctx.device, encoder, scene, pose);
+                    }
+                    pass.encode_step(encoder, scene, step);
+                }
+                (_, 0) => self
+                    .path
+                    .encode(ctx, encoder, scene, pose, Spans::default()),
+                _ => {}
+            }
+        })
+    }
+
+    /// Checks `target`, then records `frame` and the copy of its colour into `target`.
+    fn record(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        target: &wgpu::Texture,
+        frame: impl FnOnce(&mut wgpu::CommandEncoder),
+    ) -> Result<()> {
         let size = self.camera.size;
         let extent = target.size();
         let wanted = (size.width, size.height, 1);
@@ -421,9 +479,7 @@ impl Renderer {
             )));
         }
         self.ctx.checked("recording a frame", || {
-            let (ctx, scene) = (&self.ctx, &self.scene);
-            self.path
-                .encode(ctx, encoder, scene, pose, Spans::default());
+            frame(encoder);
             let colour = self.path.colour_buffer();
             let view = target.create_view(&Default::default());
             let group = bind_group(

@@ -85,7 +85,9 @@ pub struct AdaptivePass {
     builders: [wgpu::ComputePipeline; 5],
     /// `trace_list` for each [`Stage`] (coarse and refine share one).
     trace_lists: [wgpu::ComputePipeline; 5],
-    args: wgpu::ComputePipeline,
+    /// The kernels that size `trace_list`'s dispatch: over the whole list, and over the next
+    /// slice of it (progressive refinement, [`AdaptivePass::encode_step`]).
+    args: [wgpu::ComputePipeline; 2],
     group: wgpu::BindGroup,
     args_group: wgpu::BindGroup,
     state: wgpu::Buffer,
@@ -132,6 +134,10 @@ impl AdaptivePass {
         }
         let (width, height) = (camera.size.width, camera.size.height);
         let pixels = camera.size.pixels() as u64;
+        // A progressive step supersamples at most as many pixels as take one ray each, at
+        // the most samples a pixel: about one ray per pixel per frame.
+        let samples = trace.samples_per_side().pow(2) as usize;
+        let slice = (camera.size.pixels() / samples).max(1) as u32;
         let params = AdaptiveParams {
             threshold: options.threshold,
             normal_cosine: NORMAL_COSINE,
@@ -220,10 +226,19 @@ impl AdaptivePass {
             ];
             let args_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
                 label: Some("fisheye.adaptive.args"),
-                entries: &[storage_entry(0, true), storage_entry(1, false)],
+                entries: &[storage_entry(0, false), storage_entry(1, false)],
             });
-            let args =
-                shader::compute_pipeline(device, "adaptive_args", "main", &[], &[&args_layout]);
+            let args_kernel = |slice: u32| {
+                let constants = [("SLICE", f64::from(slice))];
+                shader::compute_pipeline(
+                    device,
+                    "adaptive_args",
+                    "main",
+                    &constants,
+                    &[&args_layout],
+                )
+            };
+            let args = [args_kernel(0), args_kernel(slice)];
             let args_group = crate::gpu::bind_buffers(
                 device,
                 "fisheye.adaptive.args",
@@ -286,50 +301,121 @@ impl AdaptivePass {
         scene: &GpuScene,
         spans: AdaptiveSpans<'_>,
     ) {
-        let size = self.trace.size();
-        let pixels = [size.width, size.height];
         let stages = self.stages();
+        for (stage, writes) in ALL_STAGES.into_iter().zip(spans.stages) {
+            if stages.contains(&stage) {
+                self.encode_stage(encoder, scene, stage, writes, true);
+            }
+        }
+    }
+
+    /// Records step `step` of a progressive frame, which shows a picture at once and sharpens
+    /// it step by step, ending with the frame [`AdaptivePass::encode`] makes, bit for bit:
+    /// - step 0 is the frame below one ray per pixel: the coarse and refining stages (and the
+    ///   ground truth's, where asked for), as `--spp auto:T:1` makes it;
+    /// - step 1 runs the estimating stage, where there is one, and lists the pixels to
+    ///   supersample;
+    /// - each later step supersamples the next part of that list: as many pixels as take one
+    ///   ray each at the most samples a pixel, so about one ray per pixel, until the list is
+    ///   done (a step after that records an empty dispatch).
+    ///
+    /// Steps build on the ones before them for the same pose: record step 0 after every move
+    /// of the camera, and the others in order.
+    pub fn encode_step(&self, encoder: &mut wgpu::CommandEncoder, scene: &GpuScene, step: u32) {
+        let stages = self.stages();
+        match step {
+            0 => {
+                for stage in [Stage::Coarse, Stage::Refine, Stage::Truth] {
+                    if stages.contains(&stage) {
+                        self.encode_stage(encoder, scene, stage, None, true);
+                    }
+                }
+            }
+            1 => {
+                if stages.contains(&Stage::Estimate) {
+                    self.encode_stage(encoder, scene, Stage::Estimate, None, true);
+                }
+                if stages.contains(&Stage::Supersample) {
+                    self.encode_stage(encoder, scene, Stage::Supersample, None, false);
+                }
+            }
+            _ => {
+                if stages.contains(&Stage::Supersample) {
+                    let mut pass = encoder.begin_compute_pass(&Default::default());
+                    self.trace_listed(&mut pass, scene, Stage::Supersample, 1);
+                }
+            }
+        }
+    }
+
+    /// Records `stage` as a compute pass timed by `writes`: its list made afresh, then traced
+    /// whole where `trace` says (else listed only, for progressive steps to trace part by
+    /// part).
+    fn encode_stage(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        scene: &GpuScene,
+        stage: Stage,
+        writes: Option<wgpu::ComputePassTimestampWrites<'_>>,
+        trace: bool,
+    ) {
+        let size = self.trace.size();
         // The lister of each stage, by its index in `builders`: supersampling lists the
         // pixels the estimate marked where there is an estimating stage.
-        let lister = |stage: Stage| match stage {
+        let lister = match stage {
             Stage::Coarse => 0,
             Stage::Refine => 1,
             Stage::Estimate => 2,
-            Stage::Supersample if stages.contains(&Stage::Estimate) => 3,
+            Stage::Supersample if self.stages().contains(&Stage::Estimate) => 3,
             Stage::Supersample => 2,
             Stage::Truth => 4,
         };
-        let extent = |stage: Stage| match stage {
+        let [w, h] = match stage {
             Stage::Coarse => self.params.lattice,
             Stage::Refine => self.params.blocks,
-            _ => pixels,
+            _ => [size.width, size.height],
         };
+        encoder.clear_buffer(&self.work, 0, Some(4 * u64::from(ADAPTIVE_HEADER)));
+        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+            label: Some("fisheye.adaptive"),
+            timestamp_writes: writes,
+        });
+        pass.set_pipeline(&self.builders[lister]);
+        for (index, group) in self.groups(scene).into_iter().enumerate() {
+            pass.set_bind_group(index as u32, group, &[]);
+        }
+        pass.dispatch_workgroups(w.div_ceil(WORKGROUP_2D), h.div_ceil(WORKGROUP_2D), 1);
+        if trace {
+            self.trace_listed(&mut pass, scene, stage, 0);
+        }
+    }
+
+    /// Records the sizing of `trace_list`'s dispatch by `args` kernel `args` (the whole
+    /// list, or its next slice), then `stage`'s `trace_list` over it.
+    fn trace_listed(
+        &self,
+        pass: &mut wgpu::ComputePass<'_>,
+        scene: &GpuScene,
+        stage: Stage,
+        args: usize,
+    ) {
+        pass.set_pipeline(&self.args[args]);
+        pass.set_bind_group(0, &self.args_group, &[]);
+        pass.dispatch_workgroups(1, 1, 1);
+        pass.set_pipeline(&self.trace_lists[stage as usize]);
+        for (index, group) in self.groups(scene).into_iter().enumerate() {
+            pass.set_bind_group(index as u32, group, &[]);
+        }
+        pass.dispatch_workgroups_indirect(&self.dispatch, 0);
+    }
+
+    /// The bind groups of the listing and tracing kernels, in order.
+    fn groups<'a>(&'a self, scene: &'a GpuScene) -> Vec<&'a wgpu::BindGroup> {
         let mut groups = vec![&self.group, &scene.bind_group];
         if let Some(rq) = &scene.ray_query {
             groups.push(&rq.bind_group);
         }
-        for (stage, writes) in ALL_STAGES.into_iter().zip(spans.stages) {
-            if !stages.contains(&stage) {
-                continue;
-            }
-            let [w, h] = extent(stage);
-            encoder.clear_buffer(&self.work, 0, Some(4 * u64::from(ADAPTIVE_HEADER)));
-            let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
-                label: Some("fisheye.adaptive"),
-                timestamp_writes: writes,
-            });
-            pass.set_pipeline(&self.builders[lister(stage)]);
-            for (index, group) in groups.iter().enumerate() {
-                pass.set_bind_group(index as u32, *group, &[]);
-            }
-            pass.dispatch_workgroups(w.div_ceil(WORKGROUP_2D), h.div_ceil(WORKGROUP_2D), 1);
-            pass.set_pipeline(&self.args);
-            pass.set_bind_group(0, &self.args_group, &[]);
-            pass.dispatch_workgroups(1, 1, 1);
-            pass.set_pipeline(&self.trace_lists[stage as usize]);
-            pass.set_bind_group(0, &self.group, &[]);
-            pass.dispatch_workgroups_indirect(&self.dispatch, 0);
-        }
+        groups
     }
 
     /// Traces one frame, reporting a GPU error as `what` failing, and reads it back.
