@@ -83,13 +83,14 @@ class Renderer:
         self,
         lens: Lens,
         pose: Optional[npt.ArrayLike] = None,
-        spp: int = 16,
+        spp: int | str = 16,
         outputs: Sequence[Output] = ("colour", "srgb"),
         exposure: float = 0.0,
         tone: Literal["aces", "clamp"] = "aces",
     ) -> dict[str, np.ndarray]:
         """Renders through `lens` from `pose` (4×4 T_scene_camera; the scene's camera if None)
-        with `spp` rays per pixel (a square, 1 to 256). Returns one array per output:
+        with `spp` rays per pixel (a square, 1 to 256, or "auto[:THRESHOLD[:MAX]]": adaptive
+        sampling, as `fisheye render --spp` takes it). Returns one array per output:
         "colour" H×W×4 float32 (linear RGB, alpha the lens's coverage), "srgb" H×W×4 uint8
         (through `exposure` stops and the `tone` curve), and the centre ray's "range" H×W
         float32, "normal" H×W×3 float32, "id" H×W uint32 (4294967295: none), "direction"

@@ -399,3 +399,45 @@ fn rigs_put_each_camera_where_their_extrinsics_say() {
         assert!(error.contains(wanted), "{error:?} lacks {wanted:?}");
     }
 }
+
+/// `--spp auto:...` renders a dataset adaptively: its ids are uniform sampling's, byte for
+/// byte (the hits of interpolated pixels are traced, never interpolated), its images are not,
+/// and the plan says which sampling made them.
+#[test]
+fn adaptive_datasets_keep_exact_ground_truth() {
+    let dir = temp_dir("adaptive");
+    let trajectory = repo("scenes/dataset/room-loop.tum");
+    let render = |spp: &str, out: &Path| {
+        succeed(
+            fisheye()
+                .args(["dataset", "render", "--trajectory", &trajectory])
+                .args(["--lens", "samyang-7.5mm", "--size", "64x48", "--spp", spp])
+                .args(["--outputs", "id", "--shard", "0/25", "-o"])
+                .arg(out),
+        )
+    };
+    let (auto, uniform) = (dir.join("auto"), dir.join("uniform"));
+    render("auto:0.05:4", &auto);
+    render("4", &uniform);
+    let (auto_files, uniform_files) = (files(&auto), files(&uniform));
+    let names = |f: &[(PathBuf, Vec<u8>)]| f.iter().map(|(p, _)| p.clone()).collect::<Vec<_>>();
+    assert_eq!(names(&auto_files), names(&uniform_files));
+    let mut ids = 0;
+    let mut images_differ = false;
+    for ((path, a), (_, u)) in auto_files.iter().zip(&uniform_files) {
+        let name = path.to_string_lossy();
+        if name.ends_with(".id.npy") {
+            assert_eq!(a, u, "{name}");
+            ids += 1;
+        } else if name.ends_with(".png") {
+            images_differ |= a != u;
+        }
+    }
+    assert_eq!(ids, 4, "four poses' ids");
+    assert!(images_differ, "adaptive sampling made other images");
+    let plan: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(auto.join("plan.json")).unwrap()).unwrap();
+    assert_eq!(plan["render"]["sampling"], "auto:0.05:4");
+    assert_eq!(plan["render"]["spp"], 4);
+    std::fs::remove_dir_all(&dir).unwrap();
+}

@@ -15,7 +15,7 @@ use fisheye_rt::lens::points::{self, PixelOrigin};
 use fisheye_rt::lens::{ImageSize, LensCamera, calib, parse_spec};
 use fisheye_rt::scene::Camera;
 use fisheye_rt::trace::{
-    Channel, Display, GpuScene, RenderOptions, RenderOutput, Tone, TracePass, Values,
+    Channel, Display, FramePass, GpuScene, RenderOptions, RenderOutput, Sampling, Tone, Values,
     colour_image_with, world_directions,
 };
 use fisheye_rt::{Error, LensError};
@@ -309,11 +309,32 @@ const OUTPUTS: [&str; 7] = [
     "mask",
 ];
 
-/// What a renderer keeps between calls: the scene on the GPU and a trace pass per lens and
-/// rays per pixel.
+/// `render`'s `spp`: a count of rays per pixel, or `"auto[:THRESHOLD[:MAX]]"`.
+#[derive(FromPyObject)]
+enum Spp {
+    Count(u32),
+    Text(String),
+}
+
+impl Spp {
+    fn sampling(&self) -> PyResult<Sampling> {
+        let text = match self {
+            Spp::Count(n) => n.to_string(),
+            Spp::Text(t) => t.clone(),
+        };
+        Sampling::parse(&text).map_err(|e| PyValueError::new_err(format!("spp: {e}")))
+    }
+}
+
+/// A pass's key: the lens, its size, the sampling (as `--spp` writes it) and whether the
+/// ground truth is traced everywhere.
+type PassKey = (String, u32, u32, String, bool);
+
+/// What a renderer keeps between calls: the scene on the GPU and the passes of each lens and
+/// sampling.
 struct State {
     scene: GpuScene,
-    passes: HashMap<(String, u32, u32, u32), TracePass>,
+    passes: HashMap<PassKey, FramePass>,
 }
 
 /// A scene on the GPU, rendered through any lens from any pose into numpy arrays; the scene is
@@ -366,21 +387,22 @@ impl Renderer {
 
     /// Renders the scene through `lens` from `pose` (a 4×4 `T_scene_camera`, OpenCV camera
     /// frame, e.g. from `look_at`; the scene's own camera if None) with `spp` rays per pixel
-    /// (a square, 1 to 256), and returns a dict of arrays, one per name in `outputs`:
+    /// (a square, 1 to 256, or "auto[:THRESHOLD[:MAX]]" for adaptive sampling, as
+    /// `fisheye render --spp` takes it), and returns a dict of arrays, one per name in `outputs`:
     /// "colour" (H×W×4 float32: linear RGB, alpha the lens's coverage), "srgb" (H×W×4 uint8,
     /// through `exposure` stops and the `tone` curve "aces" or "clamp", as `fisheye render`
     /// writes PNGs), and the centre ray's ground truth "range" (H×W float32), "normal"
     /// (H×W×3 float32), "id" (H×W uint32, 4294967295 for none), "direction" (H×W×3 float32,
     /// scene frame) and "mask" (H×W uint8). The same arrays `fisheye render --outputs`
     /// writes, bit for bit.
-    #[pyo3(signature = (lens, pose = None, spp = 16, outputs = vec!["colour".to_string(), "srgb".to_string()], exposure = 0.0, tone = "aces"))]
+    #[pyo3(signature = (lens, pose = None, spp = Spp::Count(16), outputs = vec!["colour".to_string(), "srgb".to_string()], exposure = 0.0, tone = "aces"))]
     #[allow(clippy::too_many_arguments)]
     fn render<'py>(
         &self,
         py: Python<'py>,
         lens: &Lens,
         pose: Option<PyArrayLikeDyn<'py, f64, AllowTypeChange>>,
-        spp: u32,
+        spp: Spp,
         outputs: Vec<String>,
         exposure: f32,
         tone: &str,
@@ -391,6 +413,10 @@ impl Renderer {
                 OUTPUTS.join(", ")
             )));
         }
+        let sampling = spp.sampling()?;
+        let ground_truth = Channel::ALL
+            .iter()
+            .any(|c| c.traced() && outputs.iter().any(|o| o == c.name()));
         let tone = match tone {
             "aces" => Tone::Aces,
             "clamp" => Tone::Clamp,
@@ -427,7 +453,8 @@ impl Renderer {
         let ctx = context()?;
         let camera = lens.camera;
         let options = self.options;
-        let output = py.detach(|| self.trace(ctx, &camera, &pose, spp, &options))?;
+        let rays = (sampling, ground_truth);
+        let output = py.detach(|| self.trace(ctx, &camera, &pose, rays, &options))?;
         let dict = PyDict::new(py);
         let (h, w) = (camera.size.height as usize, camera.size.width as usize);
         // Only the direction and mask arrays read the rays (an f64 lens evaluation a pixel).
@@ -477,13 +504,15 @@ impl Renderer {
 }
 
 impl Renderer {
-    /// Traces one frame (a pass per lens and `spp`, made at first use) and reads it back.
+    /// Traces one frame (passes per lens and sampling, made at first use; adaptive ones trace
+    /// the ground truth of the pixels they interpolate where `ground_truth` says) and reads it
+    /// back.
     fn trace(
         &self,
         ctx: &GpuContext,
         camera: &LensCamera,
         pose: &Camera,
-        spp: u32,
+        (sampling, ground_truth): (Sampling, bool),
         options: &RenderOptions,
     ) -> PyResult<RenderOutput> {
         let mut state = self
@@ -491,26 +520,26 @@ impl Renderer {
             .lock()
             .map_err(|_| PyRuntimeError::new_err("an earlier render panicked"))?;
         let State { scene, passes } = &mut *state;
+        let (spp, adaptive) = sampling.options(ground_truth);
         let key = (
             camera.lens.to_string(),
             camera.size.width,
             camera.size.height,
-            spp,
+            sampling.to_string(),
+            ground_truth && adaptive.is_some(),
         );
         if !passes.contains_key(&key) {
-            let pass = TracePass::supersampled(ctx, camera, scene, options.directions, spp)
-                .map_err(raise)?;
+            let options = RenderOptions {
+                spp,
+                adaptive,
+                ..*options
+            };
+            let pass = FramePass::new(ctx, camera, scene, &options).map_err(raise)?;
             passes.insert(key.clone(), pass);
         }
-        let pass = &passes[&key];
-        ctx.checked("rendering", || {
-            let mut encoder = ctx.device.create_command_encoder(&Default::default());
-            pass.encode_pose(&ctx.device, &mut encoder, scene, pose);
-            pass.encode(&mut encoder, scene, None);
-            ctx.queue.submit([encoder.finish()]);
-        })
-        .map_err(raise)?;
-        pass.read(ctx).map_err(raise)
+        passes[&key]
+            .trace(ctx, scene, pose, "rendering")
+            .map_err(raise)
     }
 }
 

@@ -149,6 +149,28 @@ def test_a_render_equals_the_commands_files_bit_for_bit(tmp_path):
     assert np.array_equal(arrays["srgb"], png)
 
 
+def test_adaptive_sampling_equals_the_commands_and_keeps_exact_ground_truth(tmp_path):
+    """spp="auto:..." renders what `fisheye render --spp auto:...` writes, bit for bit; its
+    ids are uniform sampling's (never interpolated); at threshold 0 it is uniform sampling at
+    its most rays exactly; and it spends fewer rays than that, so it differs somewhere."""
+    out = tmp_path / "auto.png"
+    fisheye(
+        "render", "builtin:default", "--lens", "samyang-7.5mm", "--size", "96x72", "--spp",
+        "auto:0.05:4", "--outputs", "range,id", "-o", str(out),
+    )
+    renderer = fr.Renderer(fr.Scene.load("builtin:default"))
+    lens = fr.Lens.from_spec("samyang-7.5mm", size=(96, 72))
+    auto = renderer.render(lens, spp="auto:0.05:4", outputs=["srgb", "colour", "range", "id"])
+    for name in ["range", "id"]:
+        assert auto[name].tobytes() == np.load(tmp_path / f"auto.{name}.npy").tobytes(), name
+    assert np.array_equal(auto["srgb"], np.asarray(Image.open(out).convert("RGBA")))
+    uniform = renderer.render(lens, spp=4, outputs=["colour", "id"])
+    assert np.array_equal(auto["id"], uniform["id"])
+    assert not np.array_equal(auto["colour"], uniform["colour"])
+    exact = renderer.render(lens, spp="auto:0:4", outputs=["colour"])
+    assert exact["colour"].tobytes() == uniform["colour"].tobytes()
+
+
 def test_the_camera_moves_without_uploading_the_scene_again(tmp_path):
     """One renderer, three poses: the first pose again gives the same bytes; a pose made with
     look_at sees what `fisheye render --camera` sees from there (the same triangle at all but
@@ -220,6 +242,8 @@ def test_bad_input_raises_with_the_librarys_message(tmp_path):
         (lambda: renderer.render(lens, outputs=["depth"]), ValueError, "depth"),
         (lambda: renderer.render(lens, spp=3), ValueError, "3"),
         (lambda: renderer.render(lens, spp=0), ValueError, "0"),
+        (lambda: renderer.render(lens, spp="auto:x"), ValueError, "threshold"),
+        (lambda: renderer.render(lens, spp="most"), ValueError, "auto[:THRESHOLD[:MAX]]"),
         (lambda: renderer.render(lens, pose=np.eye(3)), ValueError, "4×4"),
         (lambda: renderer.render(lens, pose=shear), ValueError, "rotation"),
         (lambda: renderer.render(lens, tone="filmic"), ValueError, "tone"),

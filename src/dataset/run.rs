@@ -18,7 +18,7 @@ use crate::lens::{CalibratedModel, Lens, LensCamera};
 use crate::pose::rows;
 use crate::scene::Scene;
 use crate::trace::{
-    Channel, ColourFile, Display, GpuScene, RenderOptions, RenderOutput, Tone, TracePass, rotated,
+    Channel, ColourFile, Display, FramePass, GpuScene, RenderOptions, RenderOutput, Tone, rotated,
     write_colour, write_file,
 };
 
@@ -239,6 +239,7 @@ impl Dataset {
             "render": {
                 "method": "rt",
                 "spp": self.options.spp,
+                "sampling": self.options.sampling().to_string(),
                 "max_depth": self.options.max_depth,
                 "bvh": self.options.bvh.name(),
                 "colour": match file {
@@ -392,27 +393,31 @@ impl Dataset {
         let lens_cameras: Vec<LensCamera> = (0..self.cameras.len())
             .map(|c| self.lens_camera(c))
             .collect();
-        let passes: Vec<TracePass> = lens_cameras
+        let options = RenderOptions {
+            directions: DirectionSource::Computed,
+            ..self.options
+        };
+        let passes: Vec<FramePass> = lens_cameras
             .iter()
-            .map(|camera| {
-                TracePass::supersampled(
-                    ctx,
-                    camera,
-                    &gpu_scene,
-                    DirectionSource::Computed,
-                    self.options.spp,
-                )
-            })
+            .map(|camera| FramePass::new(ctx, camera, &gpu_scene, &options))
             .collect::<Result<_>>()?;
         // Drivers compile a pipeline at its first dispatch (lavapipe does): one pixel of each
-        // camera's, so that the poses' times are rendering alone.
+        // camera's (an adaptive frame's passes: a whole frame), so that the poses' times are
+        // rendering alone.
         let t = Instant::now();
         ctx.checked("compiling the kernels", || {
             let mut encoder = ctx.device.create_command_encoder(&Default::default());
             let one = crate::lens::ImageSize::new(1, 1).expect("1x1 is a size");
             for pass in &passes {
-                pass.encode_pose(&ctx.device, &mut encoder, &gpu_scene, &scene.camera);
-                pass.encode_region(&mut encoder, &gpu_scene, 0, one, None);
+                match pass {
+                    FramePass::Uniform(pass) => {
+                        pass.encode_pose(&ctx.device, &mut encoder, &gpu_scene, &scene.camera);
+                        pass.encode_region(&mut encoder, &gpu_scene, 0, one, None);
+                    }
+                    FramePass::Adaptive(_) => {
+                        pass.encode(&ctx.device, &mut encoder, &gpu_scene, &scene.camera)
+                    }
+                }
             }
             ctx.queue.submit([encoder.finish()]);
         })?;
@@ -460,13 +465,7 @@ impl Dataset {
                             let mut encoder =
                                 ctx.device.create_command_encoder(&Default::default());
                             for &c in &group {
-                                passes[c].encode_pose(
-                                    &ctx.device,
-                                    &mut encoder,
-                                    &gpu_scene,
-                                    &poses[c],
-                                );
-                                passes[c].encode(&mut encoder, &gpu_scene, None);
+                                passes[c].encode(&ctx.device, &mut encoder, &gpu_scene, &poses[c]);
                             }
                             ctx.queue.submit([encoder.finish()]);
                         })?;
@@ -474,13 +473,13 @@ impl Dataset {
                         report.trace_seconds += t.elapsed().as_secs_f64();
                         let t = Instant::now();
                         for &c in &group {
-                            outputs.push(passes[c].read(ctx)?);
+                            let output = passes[c].trace_pass().read(ctx)?;
+                            report.rays += passes[c].rays(ctx, &output)?;
+                            outputs.push(output);
                         }
                         report.readback_seconds += t.elapsed().as_secs_f64();
                     }
                     for (c, output) in outputs.into_iter().enumerate() {
-                        let (valid, _) = output.counts();
-                        report.rays += valid as u64 * u64::from(self.options.spp);
                         report.images += 1;
                         let w = Written {
                             index: p,

@@ -1,6 +1,7 @@
 //! The ray tracer: a scene on the GPU ([`GpuScene`], built and uploaded once), the trace pass
 //! for a lens and image size ([`TracePass`], or [`AdaptivePass`] to spend rays where the image
-//! needs them), and [`render`], which does both in one call.
+//! needs them; [`FramePass`] is either, as the options say), and [`render`], which does both
+//! in one call.
 //! `cpu` holds the f64 reference the GPU output is tested against; `cast` casts arbitrary rays
 //! with the same traversal.
 
@@ -8,6 +9,7 @@ mod adaptive;
 pub mod cast;
 pub mod cpu;
 mod display;
+mod frame;
 mod gpu_scene;
 mod options;
 mod output;
@@ -23,6 +25,7 @@ pub use display::{
     check_writable_folder, colour_image, colour_image_with, linear_to_srgb, refuse_non_regular,
     save_png, write_atomically, write_colour, write_file,
 };
+pub use frame::FramePass;
 pub use gpu_scene::{GpuScene, SceneBytes, gpu_lights, shading_vertices};
 pub use options::{Adaptive, RenderOptions, Sampling, Traversal, surface_constants, surface_id};
 pub use output::{Channel, RenderOutput, Values};
@@ -61,11 +64,10 @@ pub fn render(
     options: &RenderOptions,
 ) -> Result<RenderOutput> {
     let gpu_scene = GpuScene::new(ctx, scene, options)?;
-    let (source, spp) = (options.directions, options.spp);
-    if let Some(adaptive) = options.adaptive {
-        let pass = AdaptivePass::new(ctx, camera, &gpu_scene, source, spp, adaptive)?;
-        return pass.trace(ctx, &gpu_scene, "tracing");
-    }
-    let pass = TracePass::supersampled(ctx, camera, &gpu_scene, source, spp)?;
-    pass.trace(ctx, &gpu_scene, "tracing")
+    FramePass::new(ctx, camera, &gpu_scene, options)?.trace(
+        ctx,
+        &gpu_scene,
+        &scene.camera,
+        "tracing",
+    )
 }

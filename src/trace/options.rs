@@ -79,6 +79,19 @@ impl Default for RenderOptions {
     }
 }
 
+impl RenderOptions {
+    /// The sampling `spp` and `adaptive` make, as `--spp` names it.
+    pub fn sampling(&self) -> Sampling {
+        match self.adaptive {
+            Some(Adaptive { threshold, .. }) => Sampling::Adaptive {
+                threshold,
+                max_spp: self.spp,
+            },
+            None => Sampling::Uniform(self.spp),
+        }
+    }
+}
+
 /// The overrides of `wgsl/surface.wgsl` for a scene's features: code for what the scene does
 /// not use is dead.
 pub fn surface_constants(f: Features) -> [(&'static str, f64); 5] {
@@ -242,6 +255,14 @@ mod tests {
             let read = Sampling::parse(text).unwrap();
             assert_eq!(read, wanted, "{text}");
             assert_eq!(Sampling::parse(&read.to_string()).unwrap(), read);
+            // Through the render options and back.
+            let (spp, adaptive) = read.options(true);
+            let options = RenderOptions {
+                spp,
+                adaptive,
+                ..RenderOptions::default()
+            };
+            assert_eq!(options.sampling(), read, "{text}");
         }
         assert_eq!(Sampling::Uniform(4).label(), "4spp");
         assert_eq!(Sampling::parse("auto").unwrap().label(), "auto:0.02");

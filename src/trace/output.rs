@@ -86,6 +86,13 @@ impl Channel {
         Self::Mask,
     ];
 
+    /// Whether the array is the centre ray's hit, traced on the GPU (range, normal, id), rather
+    /// than the lens's own (direction, mask): adaptive sampling traces the hits of the pixels
+    /// it interpolates only where one is wanted.
+    pub fn traced(&self) -> bool {
+        matches!(self, Self::Range | Self::Normal | Self::Id)
+    }
+
     /// The name on the command line and in file names.
     pub fn name(&self) -> &'static str {
         match self {

@@ -12,7 +12,7 @@ use fisheye_rt::gpu::GpuContext;
 use fisheye_rt::lens::calib;
 use fisheye_rt::lens::{ImageSize, LensCamera, parse_spec};
 use fisheye_rt::pose::parse_transform;
-use fisheye_rt::trace::{ColourFile, Display, RenderOptions};
+use fisheye_rt::trace::{Channel, ColourFile, Display, RenderOptions, Sampling};
 use glam::DAffine3;
 
 use crate::args::{ArrayFormat, Output, Quality, ToneArg, load_scene_with};
@@ -70,9 +70,10 @@ pub(crate) struct RenderArgs {
     /// world whose z axis points up, into a y-up scene) or `tx,ty,tz,qx,qy,qz,qw`.
     #[arg(long, default_value = "identity", allow_hyphen_values = true)]
     t_scene_world: String,
-    /// Rays per pixel (a square, 1 to 256), box-filtered; ground truth is the centre ray's.
-    #[arg(long, default_value_t = 16)]
-    spp: u32,
+    /// Rays per pixel, as `render --spp` takes them: N (a square, 1 to 256, box-filtered) or
+    /// auto[:THRESHOLD[:MAX]] (adaptive sampling); ground truth is the centre ray's.
+    #[arg(long, default_value = "16")]
+    spp: Sampling,
     /// Deepest reflection/refraction bounce (0 to 8).
     #[arg(long, default_value_t = 5,
           value_parser = clap::value_parser!(u32).range(0..=i64::from(fisheye_rt::shared::MAX_DEPTH_LIMIT)))]
@@ -167,8 +168,6 @@ fn render(args: &RenderArgs) -> Result<()> {
             args.exposure
         );
     }
-    fisheye_rt::trace::sampling::samples_per_side(args.spp)
-        .with_context(|| format!("--spp {}", args.spp))?;
     let body_from_rig =
         parse_transform(&args.t_body_rig).map_err(|e| anyhow::anyhow!("--t-body-rig {e}"))?;
     let scene_from_world =
@@ -194,6 +193,17 @@ fn render(args: &RenderArgs) -> Result<()> {
     });
     let (detected, poses) = trajectory::read(&args.trajectory, format, args.fps)?;
     let scene = load_scene_with(&args.scene, args.gltf_scene)?;
+    let channels: Vec<Channel> = args
+        .outputs
+        .iter()
+        .map(|&o| {
+            o.channel()
+                .context("--outputs spp is render's (a picture of one frame's rays)")
+        })
+        .collect::<Result<_>>()?;
+    // Adaptive sampling traces the hits of the pixels it interpolates where arrays of them
+    // are written.
+    let (spp, adaptive) = args.spp.options(channels.iter().any(Channel::traced));
     let dataset = Dataset {
         // The plan records the scene by this name: a glTF file's other scene is another.
         scene_name: match args.gltf_scene {
@@ -209,8 +219,8 @@ fn render(args: &RenderArgs) -> Result<()> {
         options: RenderOptions {
             max_depth: args.max_depth,
             bvh: args.bvh.into(),
-            spp: args.spp,
-            adaptive: None,
+            spp,
+            adaptive,
             ..RenderOptions::default()
         },
         colour: (
@@ -221,13 +231,7 @@ fn render(args: &RenderArgs) -> Result<()> {
             },
         ),
         outputs: (
-            args.outputs
-                .iter()
-                .map(|&o| {
-                    o.channel()
-                        .context("--outputs spp is render's (a picture of one frame's rays)")
-                })
-                .collect::<Result<_>>()?,
+            channels,
             match args.format {
                 ArrayFormat::Npy => ArrayFile::Npy,
                 ArrayFormat::Exr => ArrayFile::Exr,

@@ -137,9 +137,9 @@ pub(crate) fn render(args: &RenderArgs) -> Result<()> {
         Some(_) => Setup::cube(method, args.cube_size),
         None => Setup::sampled(method, args.spp),
     };
-    // Adaptive sampling traces the ground truth of the pixels it interpolates only when the
-    // arrays are written.
-    let ground_truth = !channels.is_empty();
+    // Adaptive sampling traces the hits of the pixels it interpolates only when arrays of
+    // them are written.
+    let ground_truth = channels.iter().any(Channel::traced);
     let (spp, adaptive) = args.spp.options(ground_truth);
     let directions = DirectionSource::from(args.directions);
     if setup.method.cube().is_some() && directions == DirectionSource::Table {

@@ -1,0 +1,90 @@
+//! A frame's passes as the render options say: uniform sampling ([`TracePass`]) or adaptive
+//! sampling ([`AdaptivePass`]), behind one type for the callers that take either and only
+//! want frames and their outputs: [`super::render`], `dataset render`, the Python package.
+
+use super::{AdaptivePass, AdaptiveSpans, GpuScene, RenderOptions, RenderOutput, TracePass};
+use crate::error::Result;
+use crate::gpu::GpuContext;
+use crate::lens::LensCamera;
+use crate::scene::Camera;
+
+/// The passes of one lens, image size and sampling on one scene.
+pub enum FramePass {
+    /// Every pixel the same rays (`RenderOptions::spp`).
+    Uniform(Box<TracePass>),
+    /// Rays where the image needs them (`RenderOptions::adaptive`).
+    Adaptive(Box<AdaptivePass>),
+}
+
+impl FramePass {
+    /// The passes `options` asks for (its directions, `spp` and `adaptive`) through `camera`.
+    pub fn new(
+        ctx: &GpuContext,
+        camera: &LensCamera,
+        scene: &GpuScene,
+        options: &RenderOptions,
+    ) -> Result<Self> {
+        let (source, spp) = (options.directions, options.spp);
+        Ok(match options.adaptive {
+            Some(adaptive) => FramePass::Adaptive(Box::new(AdaptivePass::new(
+                ctx, camera, scene, source, spp, adaptive,
+            )?)),
+            None => FramePass::Uniform(Box::new(TracePass::supersampled(
+                ctx, camera, scene, source, spp,
+            )?)),
+        })
+    }
+
+    /// The trace pass whose buffers hold the outputs.
+    pub fn trace_pass(&self) -> &TracePass {
+        match self {
+            FramePass::Uniform(pass) => pass,
+            FramePass::Adaptive(pass) => pass.trace_pass(),
+        }
+    }
+
+    /// Records a frame seen from `pose`.
+    pub fn encode(
+        &self,
+        device: &wgpu::Device,
+        encoder: &mut wgpu::CommandEncoder,
+        scene: &GpuScene,
+        pose: &Camera,
+    ) {
+        self.trace_pass().encode_pose(device, encoder, scene, pose);
+        match self {
+            FramePass::Uniform(pass) => pass.encode(encoder, scene, None),
+            FramePass::Adaptive(pass) => pass.encode(encoder, scene, AdaptiveSpans::default()),
+        }
+    }
+
+    /// Traces one frame from `pose`, reporting a GPU error as `what` failing, and reads it
+    /// back.
+    pub fn trace(
+        &self,
+        ctx: &GpuContext,
+        scene: &GpuScene,
+        pose: &Camera,
+        what: &str,
+    ) -> Result<RenderOutput> {
+        ctx.checked(what, || {
+            let mut encoder = ctx.device.create_command_encoder(&Default::default());
+            self.encode(&ctx.device, &mut encoder, scene, pose);
+            ctx.queue.submit([encoder.finish()]);
+        })?;
+        self.trace_pass().read(ctx)
+    }
+
+    /// The rays the last frame's colour took, all pixels together: counted by adaptive
+    /// sampling (read back), `spp` for each pixel with a ray in `output` (that frame's
+    /// outputs) under uniform sampling.
+    pub fn rays(&self, ctx: &GpuContext, output: &RenderOutput) -> Result<u64> {
+        Ok(match self {
+            FramePass::Uniform(pass) => {
+                let spp = u64::from(pass.samples_per_side().pow(2));
+                output.counts().0 as u64 * spp
+            }
+            FramePass::Adaptive(pass) => pass.read_rays(ctx)?.iter().map(|&n| u64::from(n)).sum(),
+        })
+    }
+}
