@@ -9,7 +9,8 @@
 #
 #   bash results/run.sh results/NAME
 #   # SIZE, CUBES, SPP, REFERENCE_SPP, BENCH_CUBES, BENCH_SPP, FRAMES, COMPARE_FRAMES, SCENES,
-#   # SOAK, THESIS, VALIDATE override; FISHEYE=PATH runs a binary built elsewhere instead of building one
+#   # COMPARE, SOAK, THESIS, VALIDATE override (0 leaves the part out); FISHEYE=PATH runs a
+#   # binary built elsewhere instead of building one
 #
 # The defaults suit a CPU (lavapipe): 256x192 images, and cube faces of 128, 256 and 480
 # texels (0.5, 1 and 2 texels per pixel at the 180° image's centre, as the 512, 1024
@@ -36,13 +37,15 @@ scenes=${SCENES:-builtin:many-small builtin:few-detailed scenes/sibenik.toml \
 scenes/cornell-box.toml scenes/bunny.toml scenes/buddha.toml}
 for scene in $scenes; do
     name=$(basename "${scene#builtin:}" .toml)
-    "$bin" compare "$scene" "${lenses[@]}" --no-pinhole --size "$size" --cube-size "$cubes" \
-        --spp "$spp" --reference-spp "$reference_spp" --frames "$compare_frames" \
-        -o "$out/$name/compare"
-    if [ "$first" = 0 ]; then
-        rm -f "$out/$name/compare/"*.error.png "$out/$name/compare/"*.reference.png
+    if [ "${COMPARE:-1}" = 1 ]; then
+        "$bin" compare "$scene" "${lenses[@]}" --no-pinhole --size "$size" --cube-size "$cubes" \
+            --spp "$spp" --reference-spp "$reference_spp" --frames "$compare_frames" \
+            -o "$out/$name/compare"
+        if [ "$first" = 0 ]; then
+            rm -f "$out/$name/compare/"*.error.png "$out/$name/compare/"*.reference.png
+        fi
+        first=0
     fi
-    first=0
     "$bin" bench "$scene" "${lenses[@]}" --size "$size" --cube-size "$bench_cubes" \
         --spp "$bench_spp" --frames "$frames" --warmup 2 -o "$out/$name/bench"
 done

@@ -34,6 +34,9 @@ pub const ADAPTIVE_BLOCK: u32 = 4;
 pub const ADAPTIVE_HEADER: u32 = 4;
 /// Where the work buffer holds the list's length.
 pub const ADAPTIVE_COUNT: u32 = 0;
+/// The samples per side of adaptive sampling's estimating stage (Dammertz et al.'s error
+/// estimate compares the mean of half of them with the mean of all).
+pub const ADAPTIVE_ESTIMATE_SIDE: u32 = 2;
 /// Where the work buffer holds the first list entry `trace_list` traces.
 pub const ADAPTIVE_FIRST: u32 = 1;
 /// Where the work buffer holds the end (exclusive) of the entries `trace_list` traces.
@@ -300,6 +303,7 @@ pub fn wgsl_constants() -> Vec<(String, u32)> {
         ("ADAPTIVE_BLOCK", ADAPTIVE_BLOCK),
         ("ADAPTIVE_HEADER", ADAPTIVE_HEADER),
         ("ADAPTIVE_COUNT", ADAPTIVE_COUNT),
+        ("ADAPTIVE_ESTIMATE_SIDE", ADAPTIVE_ESTIMATE_SIDE),
         ("ADAPTIVE_FIRST", ADAPTIVE_FIRST),
         ("ADAPTIVE_END", ADAPTIVE_END),
         ("SURFACE_DIFFUSE", SURFACE_DIFFUSE),

@@ -12,7 +12,7 @@ use fisheye_rt::lens::gpu::DirectionSource;
 use fisheye_rt::scene::Scene;
 use fisheye_rt::shared::ADAPTIVE_BLOCK;
 use fisheye_rt::trace::{
-    Adaptive, AdaptivePass, GpuScene, NO_HIT, RenderOptions, RenderOutput, TracePass,
+    Adaptive, AdaptivePass, GpuScene, NO_HIT, RenderOptions, RenderOutput, Stage, TracePass,
     linear_to_srgb,
 };
 
@@ -33,13 +33,26 @@ fn adaptive(
     threshold: f32,
     ground_truth: bool,
 ) -> (RenderOutput, Vec<u32>) {
+    let (out, rays, _) = adaptive_stages(gpu, cam, spp, threshold, ground_truth);
+    (out, rays)
+}
+
+/// As [`adaptive`], with the rays each stage traced.
+fn adaptive_stages(
+    gpu: &GpuScene,
+    cam: &LensCamera,
+    spp: u32,
+    threshold: f32,
+    ground_truth: bool,
+) -> (RenderOutput, Vec<u32>, Vec<(Stage, u64)>) {
     let options = Adaptive {
         threshold,
         ground_truth,
     };
     let pass = AdaptivePass::new(ctx(), cam, gpu, DirectionSource::Computed, spp, options).unwrap();
     let out = pass.trace(ctx(), gpu, "adaptive").unwrap();
-    (out, pass.read_rays(ctx()).unwrap())
+    let stages = pass.read_stage_rays(ctx()).unwrap();
+    (out, pass.read_rays(ctx()).unwrap(), stages)
 }
 
 fn upload(scene: &Scene) -> GpuScene {
@@ -54,12 +67,41 @@ fn threshold_zero_is_uniform_sampling_exactly() {
     let gpu = upload(&room);
     let cam = camera("canon-8-15mm@8mm", 61, 46);
     let reference = uniform(&gpu, &cam, 16);
-    let (out, rays) = adaptive(&gpu, &cam, 16, 0.0, true);
+    let (out, rays, stages) = adaptive_stages(&gpu, &cam, 16, 0.0, true);
     assert_eq!(out.colour, reference.colour, "colour");
+    // Every lattice point; every other pixel but those of blocks wholly outside the lens
+    // (filled as masked), so at least every one the lens covers; every pixel's 16 samples
+    // (counted as rays where the lens masks them, though they cost a lens evaluation
+    // alone); none interpolated.
+    let (w, h) = (61u32, 46u32);
+    let on_lattice = |x: u32, y: u32| {
+        (x.is_multiple_of(ADAPTIVE_BLOCK) || x == w - 1)
+            && (y.is_multiple_of(ADAPTIVE_BLOCK) || y == h - 1)
+    };
+    let lattice = (0..h)
+        .flat_map(|y| (0..w).map(move |x| (x, y)))
+        .filter(|&(x, y)| on_lattice(x, y))
+        .count() as u64;
+    let pixels = u64::from(w * h);
+    let centres = uniform(&gpu, &cam, 1);
+    let covered_off_lattice = (0..h)
+        .flat_map(|y| (0..w).map(move |x| (x, y)))
+        .filter(|&(x, y)| !on_lattice(x, y) && centres.valid((y * w + x) as usize))
+        .count() as u64;
+    let [coarse, refine, supersample, truth] = stages[..] else {
+        panic!("{stages:?}")
+    };
+    assert_eq!(coarse, (Stage::Coarse, lattice));
+    assert_eq!(refine.0, Stage::Refine);
+    assert!(
+        (covered_off_lattice..=pixels - lattice).contains(&refine.1),
+        "{refine:?}: {covered_off_lattice} covered"
+    );
+    assert_eq!(supersample, (Stage::Supersample, 16 * pixels));
+    assert_eq!(truth, (Stage::Truth, 0));
     assert_eq!(out.geometry, reference.geometry, "geometry");
     assert_eq!(out.ids, reference.ids, "ids");
     // Each pixel: its centre where the lens covers it, then its 16 samples that it covers.
-    let centres = uniform(&gpu, &cam, 1);
     for (i, (&n, c)) in rays.iter().zip(&reference.colour).enumerate() {
         let samples = (c[3] * 16.0).round() as u32;
         assert_eq!(n, u32::from(centres.valid(i)) + samples, "pixel {i}");
@@ -138,9 +180,12 @@ fn a_smooth_scene_is_traced_at_block_corners_only() {
         "the plane fills the view"
     );
     let threshold = 0.02;
-    let (out, rays) = adaptive(&gpu, &cam, 16, threshold, false);
+    let (out, rays, stages) = adaptive_stages(&gpu, &cam, 16, threshold, false);
     let lattice = |n: u32| (n - 1).div_ceil(ADAPTIVE_BLOCK) + 1;
     let corners = (lattice(w) * lattice(h)) as usize;
+    let c = corners as u64;
+    let none = [Stage::Refine, Stage::Estimate, Stage::Supersample].map(|s| (s, 0));
+    assert_eq!(stages, [[(Stage::Coarse, c)].as_slice(), &none].concat());
     assert_eq!(
         rays.iter().filter(|&&n| n == 1).count(),
         corners,

@@ -54,6 +54,12 @@ fn every_method_times_each_of_its_passes_and_renders_what_render_does() {
             let colour = renderer.colour(ctx()).unwrap();
             let once = render(ctx(), &scene, &cam, &RenderOptions::default()).unwrap();
             assert_eq!(colour, once.colour);
+            // One ray for each pixel the lens gives one.
+            let covered = once.counts().0 as u64;
+            assert_eq!(time.passes_rays, Some(vec![covered]));
+        }
+        if setup.method.cube().is_some() {
+            assert_eq!(time.passes_rays, None, "{}", setup.label());
         }
     }
 }

@@ -69,8 +69,6 @@ const KEY_MASKED: u32 = 0xfffffffeu;
 const KEY_SKY: u32 = 0xfffffffdu;
 // A pixel whose first samples still disagree (`MODE_ESTIMATE`): it takes them all.
 const KEY_MORE: u32 = 0xfffffffcu;
-// The samples of the estimating stage, per side.
-const ESTIMATE_SIDE: u32 = 2u;
 
 var<workgroup> group_count: atomic<u32>;
 var<workgroup> group_base: u32;
@@ -151,9 +149,9 @@ fn trace_list(
     if mode == MODE_ESTIMATE {
         // Dammertz et al. (2010) estimate a pixel's error by how far the mean of half its
         // samples lies from the mean of all: here in displayed colour, where the threshold is.
-        let s = samples(pixel, index, ESTIMATE_SIDE);
+        let s = samples(pixel, index, ADAPTIVE_ESTIMATE_SIDE);
         colour_out[index] = s.colour;
-        state[index].x += u32(round(s.colour.w * f32(ESTIMATE_SIDE * ESTIMATE_SIDE)));
+        state[index].x += u32(round(s.colour.w * f32(ADAPTIVE_ESTIMATE_SIDE * ADAPTIVE_ESTIMATE_SIDE)));
         if largest(abs(shown(s.colour.rgb) - shown(s.half))) >= adaptive.threshold {
             state[index].y = KEY_MORE;
         }

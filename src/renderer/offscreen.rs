@@ -267,6 +267,8 @@ pub struct Offscreen {
     setup: Setup,
     passes: Vec<Pass>,
     queries: Option<Queries>,
+    /// The rays of a uniformly sampled frame: the pixels the lens gives a ray, times spp.
+    uniform_rays: u64,
 }
 
 /// How long one frame took.
@@ -277,6 +279,10 @@ pub struct FrameTime {
     /// GPU milliseconds per pass, in [`Offscreen::passes`] order; `None` without timestamp
     /// queries.
     pub passes_ms: Option<Vec<f64>>,
+    /// Rays each pass traced, in the same order, for direct tracing (see
+    /// [`crate::trace::AdaptivePass::read_stage_rays`]; a uniform frame's are the pixels the
+    /// lens gives a ray times spp); `None` through a cube map.
+    pub passes_rays: Option<Vec<u64>>,
 }
 
 impl FrameTime {
@@ -332,11 +338,13 @@ impl Offscreen {
         let path = Path::new(ctx, camera, scene, rays, cube.as_ref())?;
         let passes = setup.passes(ground_truth);
         let queries = Queries::new(ctx, passes.len() as u32);
+        let covered = camera.directions().iter().filter(|d| d.is_some()).count() as u64;
         Ok(Self {
             path,
             setup,
             passes,
             queries,
+            uniform_rays: covered * u64::from(spp),
         })
     }
 
@@ -394,7 +402,21 @@ impl Offscreen {
             Some(q) => Some(q.read_ns(ctx)?.into_iter().map(|ns| ns * 1e-6).collect()),
             None => None,
         };
-        Ok(FrameTime { wall_ms, passes_ms })
+        let passes_rays = match &self.path {
+            Path::Direct(_) => Some(vec![self.uniform_rays]),
+            Path::Adaptive(pass) => Some(
+                pass.read_stage_rays(ctx)?
+                    .into_iter()
+                    .map(|(_, rays)| rays)
+                    .collect(),
+            ),
+            Path::Cube(_) => None,
+        };
+        Ok(FrameTime {
+            wall_ms,
+            passes_ms,
+            passes_rays,
+        })
     }
 
     /// Compiles the frame's kernels before anything is timed (lavapipe, like many drivers,

@@ -34,6 +34,10 @@ pub struct BenchEntry {
     pub wall: FrameStats,
     /// Median GPU ms of each pass.
     pub pass_median_ms: Option<Vec<f64>>,
+    /// Median GPU nanoseconds per ray of each pass that traces rays (`None` where it traced
+    /// none, and for cube maps or without timestamps): what a ray costs in each stage of
+    /// adaptive sampling against a uniform frame's.
+    pub pass_median_ns_per_ray: Option<Vec<Option<f64>>>,
     /// Every timed frame.
     pub frames: Vec<FrameTime>,
     /// Memory in use before the first timed frame (after the warm-up).
@@ -130,6 +134,22 @@ pub fn bench(
                         .map(|p| median(&per_frame.iter().map(|f| f[p]).collect::<Vec<_>>()))
                         .collect()
                 });
+            let pass_median_ns_per_ray = timed
+                .iter()
+                .map(|t| t.passes_ms.clone().zip(t.passes_rays.clone()))
+                .collect::<Option<Vec<_>>>()
+                .map(|per_frame| {
+                    (0..passes.len())
+                        .map(|p| {
+                            let ns: Vec<f64> = per_frame
+                                .iter()
+                                .filter(|(_, rays)| rays[p] > 0)
+                                .map(|(ms, rays)| ms[p] * 1e6 / rays[p] as f64)
+                                .collect();
+                            (!ns.is_empty()).then(|| median(&ns))
+                        })
+                        .collect()
+                });
             entries.push(BenchEntry {
                 lens: lens.name.clone(),
                 setup: setup.label(),
@@ -140,6 +160,7 @@ pub fn bench(
                 gpu: gpu.as_deref().and_then(FrameStats::of),
                 wall: FrameStats::of(&wall).expect("at least one frame"),
                 pass_median_ms,
+                pass_median_ns_per_ray,
                 frames: timed,
                 memory_start,
                 memory_end: Memory::now(study.ctx),
@@ -176,7 +197,7 @@ impl BenchReport {
         };
         let _ = writeln!(
             md,
-            "| lens | setup | mean fps ({clock}) | fps variance | min fps | max fps | p50 ms | p99 ms | wall mean fps | median ms per pass |\n|---|---|---:|---:|---:|---:|---:|---:|---:|---|"
+            "| lens | setup | mean fps ({clock}) | fps variance | min fps | max fps | p50 ms | p99 ms | wall mean fps | median ms per pass (ns per ray) |\n|---|---|---:|---:|---:|---:|---:|---:|---:|---|"
         );
         for e in &self.entries {
             let s = e.stats();
@@ -185,7 +206,14 @@ impl BenchReport {
                     .passes
                     .iter()
                     .zip(ms)
-                    .map(|(p, ms)| format!("{} {}", p.name(), sig(*ms)))
+                    .enumerate()
+                    .map(|(k, (p, ms))| {
+                        let per_ray = e.pass_median_ns_per_ray.as_ref().and_then(|n| n[k]);
+                        match per_ray {
+                            Some(ns) => format!("{} {} ({} ns/ray)", p.name(), sig(*ms), sig(ns)),
+                            None => format!("{} {}", p.name(), sig(*ms)),
+                        }
+                    })
                     .collect::<Vec<_>>()
                     .join(", "),
                 None => "untimed".into(),

@@ -12,8 +12,8 @@ use crate::lens::gpu::DirectionSource;
 use crate::scene::Camera;
 use crate::shader;
 use crate::shared::{
-    ADAPTIVE_BLOCK, ADAPTIVE_HEADER, ADAPTIVE_STORAGE_BUFFERS, AdaptiveParams,
-    TRACE_STORAGE_BUFFERS, WORKGROUP_2D,
+    ADAPTIVE_BLOCK, ADAPTIVE_COUNT, ADAPTIVE_ESTIMATE_SIDE, ADAPTIVE_HEADER,
+    ADAPTIVE_STORAGE_BUFFERS, AdaptiveParams, TRACE_STORAGE_BUFFERS, WORKGROUP_2D,
 };
 
 /// Two corners' shading normals further apart than this (about 25°) are not one smooth
@@ -93,6 +93,9 @@ pub struct AdaptivePass {
     state: wgpu::Buffer,
     work: wgpu::Buffer,
     dispatch: wgpu::Buffer,
+    /// The length of each stage's list in the last frame, in [`ALL_STAGES`] order (0 for a
+    /// stage not run), copied from the work buffer's header after each stage.
+    listed: wgpu::Buffer,
     params: AdaptiveParams,
 }
 
@@ -170,8 +173,14 @@ impl AdaptivePass {
             let work = buffer(
                 "fisheye.adaptive.work",
                 4 * (u64::from(ADAPTIVE_HEADER) + pixels),
-                wgpu::BufferUsages::COPY_DST,
+                wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::COPY_SRC,
             );
+            let listed = device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("fisheye.adaptive.listed"),
+                size: 4 * ALL_STAGES.len() as u64,
+                usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::COPY_SRC,
+                mapped_at_creation: false,
+            });
             let dispatch = buffer(
                 "fisheye.adaptive.dispatch",
                 12,
@@ -256,6 +265,7 @@ impl AdaptivePass {
                 state,
                 work,
                 dispatch,
+                listed,
                 params,
             }
         })
@@ -302,6 +312,7 @@ impl AdaptivePass {
         spans: AdaptiveSpans<'_>,
     ) {
         let stages = self.stages();
+        encoder.clear_buffer(&self.listed, 0, None);
         for (stage, writes) in ALL_STAGES.into_iter().zip(spans.stages) {
             if stages.contains(&stage) {
                 self.encode_stage(encoder, scene, stage, writes, true);
@@ -325,6 +336,7 @@ impl AdaptivePass {
         let stages = self.stages();
         match step {
             0 => {
+                encoder.clear_buffer(&self.listed, 0, None);
                 for stage in [Stage::Coarse, Stage::Refine, Stage::Truth] {
                     if stages.contains(&stage) {
                         self.encode_stage(encoder, scene, stage, None, true);
@@ -376,18 +388,22 @@ impl AdaptivePass {
             _ => [size.width, size.height],
         };
         encoder.clear_buffer(&self.work, 0, Some(4 * u64::from(ADAPTIVE_HEADER)));
-        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
-            label: Some("fisheye.adaptive"),
-            timestamp_writes: writes,
-        });
-        pass.set_pipeline(&self.builders[lister]);
-        for (index, group) in self.groups(scene).into_iter().enumerate() {
-            pass.set_bind_group(index as u32, group, &[]);
+        {
+            let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some("fisheye.adaptive"),
+                timestamp_writes: writes,
+            });
+            pass.set_pipeline(&self.builders[lister]);
+            for (index, group) in self.groups(scene).into_iter().enumerate() {
+                pass.set_bind_group(index as u32, group, &[]);
+            }
+            pass.dispatch_workgroups(w.div_ceil(WORKGROUP_2D), h.div_ceil(WORKGROUP_2D), 1);
+            if trace {
+                self.trace_listed(&mut pass, scene, stage, 0);
+            }
         }
-        pass.dispatch_workgroups(w.div_ceil(WORKGROUP_2D), h.div_ceil(WORKGROUP_2D), 1);
-        if trace {
-            self.trace_listed(&mut pass, scene, stage, 0);
-        }
+        let count = 4 * u64::from(ADAPTIVE_COUNT);
+        encoder.copy_buffer_to_buffer(&self.work, count, &self.listed, 4 * stage as u64, 4);
     }
 
     /// Records the sizing of `trace_list`'s dispatch by `args` kernel `args` (the whole
@@ -416,6 +432,32 @@ impl AdaptivePass {
             groups.push(&rq.bind_group);
         }
         groups
+    }
+
+    /// The rays each stage of the last frame traced, in [`AdaptivePass::stages`] order: the
+    /// pixels it listed times the samples each takes there (1 at the coarse, refining and
+    /// ground truth's stages, where the last traces first hits alone; 2 × 2 estimating; all
+    /// of them supersampling), counting samples the lens masks (which cost a lens evaluation,
+    /// not a ray) as rays. After progressive steps, supersampling's are the pixels listed,
+    /// whether or not their slices are traced yet.
+    pub fn read_stage_rays(&self, ctx: &GpuContext) -> Result<Vec<(Stage, u64)>> {
+        let listed: Vec<u32> = ctx.read_buffer(&self.listed)?;
+        let all = self.trace.samples_per_side().pow(2);
+        Ok(self
+            .stages()
+            .into_iter()
+            .map(|stage| {
+                let samples = match stage {
+                    Stage::Estimate => ADAPTIVE_ESTIMATE_SIDE.pow(2),
+                    Stage::Supersample => all,
+                    _ => 1,
+                };
+                (
+                    stage,
+                    u64::from(listed[stage as usize]) * u64::from(samples),
+                )
+            })
+            .collect())
     }
 
     /// Traces one frame, reporting a GPU error as `what` failing, and reads it back.

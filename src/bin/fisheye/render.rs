@@ -214,11 +214,13 @@ pub(crate) fn render(args: &RenderArgs) -> Result<()> {
         (None, Some(map)) => {
             let traced: u64 = map.iter().map(|&n| u64::from(n)).sum();
             let per_pixel = traced as f64 / rays.max(1) as f64;
+            let rays_of = |k: usize| time.passes_rays.as_ref().map_or(0, |r| r[k]);
             let passes: Vec<String> = renderer
                 .passes()
                 .iter()
                 .zip(time.passes_ms.iter().flatten())
-                .map(|(pass, ms)| format!("{} {ms:.2}", pass.name()))
+                .enumerate()
+                .map(|(k, (pass, ms))| format!("{} {ms:.2} ({} rays)", pass.name(), rays_of(k)))
                 .collect();
             let what = format!(
                 "trace ({}): {rays} pixels, {traced} rays for their colour ({per_pixel:.2} a \
