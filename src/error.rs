@@ -48,6 +48,16 @@ pub enum LensError {
         /// What is wrong with it.
         reason: String,
     },
+    /// A lens prescription that cannot be read (`line` 0: the file as a whole).
+    #[error("lens prescription {path}{}: {reason}", at_line(*line))]
+    Prescription {
+        /// The file.
+        path: String,
+        /// The line at fault, from 1; 0 for the file as a whole.
+        line: usize,
+        /// What is wrong with it.
+        reason: String,
+    },
     /// A calibration format that cannot express a model.
     #[error("the {format} calibration format cannot express {model}")]
     Unsupported {
@@ -72,6 +82,15 @@ pub enum LensError {
         /// What is wrong with it.
         reason: String,
     },
+}
+
+/// ", line N" for a line from 1; nothing for 0 (the file as a whole).
+fn at_line(line: usize) -> String {
+    if line == 0 {
+        String::new()
+    } else {
+        format!(", line {line}")
+    }
 }
 
 impl LensError {

@@ -31,6 +31,8 @@ pub enum InputKind {
     Trajectory,
     /// A glTF file (`.gltf` JSON or `.glb`) or one of its external buffers: 1 GiB, as OBJ.
     Gltf,
+    /// A lens prescription (a table of surfaces): 1 MiB.
+    Prescription,
 }
 
 impl InputKind {
@@ -44,6 +46,7 @@ impl InputKind {
             InputKind::Calibration => "calibration files",
             InputKind::Trajectory => "trajectories",
             InputKind::Gltf => "glTF files and buffers",
+            InputKind::Prescription => "lens prescriptions",
         }
     }
 
@@ -54,6 +57,7 @@ impl InputKind {
             InputKind::Obj | InputKind::Gltf => 1024 * MIB,
             InputKind::Texture | InputKind::Trajectory => 256 * MIB,
             InputKind::Mtl | InputKind::SceneFile | InputKind::Calibration => 16 * MIB,
+            InputKind::Prescription => MIB,
         }
     }
 

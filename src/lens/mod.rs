@@ -12,6 +12,7 @@ pub mod gpu;
 mod json;
 mod model;
 pub mod points;
+pub mod prescription;
 mod spec;
 
 pub use calibrated::{CalibratedLens, CalibratedModel, Intrinsics, newton_bound, solve};

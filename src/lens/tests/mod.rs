@@ -7,6 +7,7 @@ use glam::{DVec2, DVec3};
 use super::*;
 
 mod calibrated;
+mod prescription;
 
 fn lens(spec: &str) -> ClassicLens {
     *parse_spec(spec).unwrap().classic().unwrap()
