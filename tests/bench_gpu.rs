@@ -64,6 +64,46 @@ fn every_method_times_each_of_its_passes_and_renders_what_render_does() {
     }
 }
 
+/// An adaptive frame is timed in two passes a stage, the listing (bookkeeping, no rays) and
+/// the tracing, and counts each stage's rays: the block corners first, then at least the
+/// rays its spp map counts (which leaves out the samples the lens masks).
+#[test]
+fn adaptive_frames_time_listing_and_tracing_apart_and_count_their_rays() {
+    use fisheye_rt::renderer::Pass;
+    let scene = builtin::scene("default").unwrap();
+    let cam = camera("canon-8-15mm@8mm", 48, 36);
+    let setup = Setup::sampled(Method::Rt, Sampling::parse("auto:0.05:4").unwrap());
+    let scenes = SceneSet::new(ctx(), &scene, &RenderOptions::default(), &[setup]).unwrap();
+    let renderer = Offscreen::new(ctx(), &cam, &scenes, setup, 256).unwrap();
+    let passes = [
+        Pass::CoarseList,
+        Pass::Coarse,
+        Pass::RefineList,
+        Pass::Refine,
+        Pass::SupersampleList,
+        Pass::Supersample,
+    ];
+    assert_eq!(renderer.passes(), passes);
+    renderer.warm_up(ctx(), &scenes, &scene.camera).unwrap();
+    let time = renderer.frame(ctx(), &scenes, &scene.camera).unwrap();
+    let ms = time.passes_ms.expect("lavapipe has timestamp queries");
+    assert!(ms.iter().all(|ms| ms.is_finite() && *ms > 0.0), "{ms:?}");
+    let rays = time.passes_rays.expect("a traced frame");
+    assert_eq!(rays.len(), passes.len());
+    assert!(rays.iter().step_by(2).all(|&n| n == 0), "listing traces nothing: {rays:?}");
+    let lattice = u64::from(47u32.div_ceil(4) + 1) * u64::from(35u32.div_ceil(4) + 1);
+    assert_eq!(rays[1], lattice);
+    let map: u64 = renderer
+        .rays_per_pixel(ctx())
+        .unwrap()
+        .expect("an adaptive frame")
+        .iter()
+        .map(|&n| u64::from(n))
+        .sum();
+    let counted: u64 = rays.iter().sum();
+    assert!(counted >= map && map > lattice, "{counted} counted, {map} in the map");
+}
+
 /// A study of `setups` on one lens, the built-in scene `name`.
 fn study_on<'a>(
     scene: &'a fisheye_rt::scene::Scene,

@@ -114,7 +114,7 @@ impl Setup {
         };
         stages_for(side, options)
             .into_iter()
-            .map(Pass::of)
+            .flat_map(|stage| [Pass::listing(stage), Pass::of(stage)])
             .collect()
     }
 
@@ -161,6 +161,22 @@ pub enum Pass {
     Supersample,
     /// Adaptive sampling's first hits of interpolated pixels, for the ground truth.
     Truth,
+    /// Listing the block corners (bookkeeping before [`Pass::Coarse`]).
+    #[serde(rename = "coarse-list")]
+    CoarseList,
+    /// Classifying blocks, listing the pixels of those to refine and interpolating the others
+    /// (before [`Pass::Refine`]).
+    #[serde(rename = "refine-list")]
+    RefineList,
+    /// Listing the pixels whose colour bends (before [`Pass::Estimate`]).
+    #[serde(rename = "estimate-list")]
+    EstimateList,
+    /// Listing the pixels to supersample (before [`Pass::Supersample`]).
+    #[serde(rename = "supersample-list")]
+    SupersampleList,
+    /// Listing the interpolated pixels (before [`Pass::Truth`]).
+    #[serde(rename = "truth-list")]
+    TruthList,
 }
 
 impl Pass {
@@ -172,6 +188,18 @@ impl Pass {
             Stage::Estimate => Pass::Estimate,
             Stage::Supersample => Pass::Supersample,
             Stage::Truth => Pass::Truth,
+        }
+    }
+
+    /// The pass that times an adaptive stage's listing of its pixels, the bookkeeping before
+    /// its rays.
+    pub fn listing(stage: Stage) -> Pass {
+        match stage {
+            Stage::Coarse => Pass::CoarseList,
+            Stage::Refine => Pass::RefineList,
+            Stage::Estimate => Pass::EstimateList,
+            Stage::Supersample => Pass::SupersampleList,
+            Stage::Truth => Pass::TruthList,
         }
     }
 
@@ -187,6 +215,11 @@ impl Pass {
             Pass::Estimate => "estimate",
             Pass::Supersample => "supersample",
             Pass::Truth => "truth",
+            Pass::CoarseList => "coarse list",
+            Pass::RefineList => "refine list",
+            Pass::EstimateList => "estimate list",
+            Pass::SupersampleList => "supersample list",
+            Pass::TruthList => "truth list",
         }
     }
 }
@@ -382,6 +415,7 @@ impl Offscreen {
             let spans = Spans {
                 trace: writes(Pass::Trace),
                 adaptive: AdaptiveSpans {
+                    lists: ALL_STAGES.map(|stage| writes(Pass::listing(stage))),
                     stages: ALL_STAGES.map(|stage| writes(Pass::of(stage))),
                 },
                 cube: CubeSpans {
@@ -404,10 +438,11 @@ impl Offscreen {
         };
         let passes_rays = match &self.path {
             Path::Direct(_) => Some(vec![self.uniform_rays]),
+            // Listing traces nothing; each stage's rays are its tracing pass's.
             Path::Adaptive(pass) => Some(
                 pass.read_stage_rays(ctx)?
                     .into_iter()
-                    .map(|(_, rays)| rays)
+                    .flat_map(|(_, rays)| [0, rays])
                     .collect(),
             ),
             Path::Cube(_) => None,

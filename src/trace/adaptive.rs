@@ -67,10 +67,13 @@ pub fn stages_for(samples_per_side: u32, options: Adaptive) -> Vec<Stage> {
     stages
 }
 
-/// Timestamp writes for the stages of one frame; `None` leaves a stage untimed.
+/// Timestamp writes for the stages of one frame, each in two compute passes: the listing of
+/// its pixels (the bookkeeping), then the tracing of the list; `None` leaves a pass untimed.
 #[derive(Default)]
 pub struct AdaptiveSpans<'a> {
-    /// One per [`Stage`], in order.
+    /// The listing pass of each [`Stage`], in order.
+    pub lists: [Option<wgpu::ComputePassTimestampWrites<'a>>; 5],
+    /// The tracing pass of each [`Stage`], in order.
     pub stages: [Option<wgpu::ComputePassTimestampWrites<'a>>; 5],
 }
 
@@ -313,9 +316,10 @@ impl AdaptivePass {
     ) {
         let stages = self.stages();
         encoder.clear_buffer(&self.listed, 0, None);
-        for (stage, writes) in ALL_STAGES.into_iter().zip(spans.stages) {
+        let writes = spans.lists.into_iter().zip(spans.stages);
+        for (stage, (list, trace)) in ALL_STAGES.into_iter().zip(writes) {
             if stages.contains(&stage) {
-                self.encode_stage(encoder, scene, stage, writes, true);
+                self.encode_stage(encoder, scene, stage, list, Some(trace));
             }
         }
     }
@@ -339,16 +343,16 @@ impl AdaptivePass {
                 encoder.clear_buffer(&self.listed, 0, None);
                 for stage in [Stage::Coarse, Stage::Refine, Stage::Truth] {
                     if stages.contains(&stage) {
-                        self.encode_stage(encoder, scene, stage, None, true);
+                        self.encode_stage(encoder, scene, stage, None, Some(None));
                     }
                 }
             }
             1 => {
                 if stages.contains(&Stage::Estimate) {
-                    self.encode_stage(encoder, scene, Stage::Estimate, None, true);
+                    self.encode_stage(encoder, scene, Stage::Estimate, None, Some(None));
                 }
                 if stages.contains(&Stage::Supersample) {
-                    self.encode_stage(encoder, scene, Stage::Supersample, None, false);
+                    self.encode_stage(encoder, scene, Stage::Supersample, None, None);
                 }
             }
             _ => {
@@ -360,16 +364,16 @@ impl AdaptivePass {
         }
     }
 
-    /// Records `stage` as a compute pass timed by `writes`: its list made afresh, then traced
-    /// whole where `trace` says (else listed only, for progressive steps to trace part by
-    /// part).
+    /// Records `stage`: its list made afresh in a compute pass timed by `list`, then, where
+    /// `trace` is given, traced whole in a second pass timed by it (else listed only, for
+    /// progressive steps to trace part by part).
     fn encode_stage(
         &self,
         encoder: &mut wgpu::CommandEncoder,
         scene: &GpuScene,
         stage: Stage,
-        writes: Option<wgpu::ComputePassTimestampWrites<'_>>,
-        trace: bool,
+        list: Option<wgpu::ComputePassTimestampWrites<'_>>,
+        trace: Option<Option<wgpu::ComputePassTimestampWrites<'_>>>,
     ) {
         let size = self.trace.size();
         // The lister of each stage, by its index in `builders`: supersampling lists the
@@ -390,17 +394,21 @@ impl AdaptivePass {
         encoder.clear_buffer(&self.work, 0, Some(4 * u64::from(ADAPTIVE_HEADER)));
         {
             let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
-                label: Some("fisheye.adaptive"),
-                timestamp_writes: writes,
+                label: Some("fisheye.adaptive.list"),
+                timestamp_writes: list,
             });
             pass.set_pipeline(&self.builders[lister]);
             for (index, group) in self.groups(scene).into_iter().enumerate() {
                 pass.set_bind_group(index as u32, group, &[]);
             }
             pass.dispatch_workgroups(w.div_ceil(WORKGROUP_2D), h.div_ceil(WORKGROUP_2D), 1);
-            if trace {
-                self.trace_listed(&mut pass, scene, stage, 0);
-            }
+        }
+        if let Some(writes) = trace {
+            let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some("fisheye.adaptive.trace"),
+                timestamp_writes: writes,
+            });
+            self.trace_listed(&mut pass, scene, stage, 0);
         }
         let count = 4 * u64::from(ADAPTIVE_COUNT);
         encoder.copy_buffer_to_buffer(&self.work, count, &self.listed, 4 * stage as u64, 4);

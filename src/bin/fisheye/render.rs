@@ -220,7 +220,10 @@ pub(crate) fn render(args: &RenderArgs) -> Result<()> {
                 .iter()
                 .zip(time.passes_ms.iter().flatten())
                 .enumerate()
-                .map(|(k, (pass, ms))| format!("{} {ms:.2} ({} rays)", pass.name(), rays_of(k)))
+                .map(|(k, (pass, ms))| match rays_of(k) {
+                    0 => format!("{} {ms:.2}", pass.name()),
+                    rays => format!("{} {ms:.2} ({rays} rays)", pass.name()),
+                })
                 .collect();
             let what = format!(
                 "trace ({}): {rays} pixels, {traced} rays for their colour ({per_pixel:.2} a \
