@@ -90,7 +90,10 @@ fn adaptive_frames_time_listing_and_tracing_apart_and_count_their_rays() {
     assert!(ms.iter().all(|ms| ms.is_finite() && *ms > 0.0), "{ms:?}");
     let rays = time.passes_rays.expect("a traced frame");
     assert_eq!(rays.len(), passes.len());
-    assert!(rays.iter().step_by(2).all(|&n| n == 0), "listing traces nothing: {rays:?}");
+    assert!(
+        rays.iter().step_by(2).all(|&n| n == 0),
+        "listing traces nothing: {rays:?}"
+    );
     let lattice = u64::from(47u32.div_ceil(4) + 1) * u64::from(35u32.div_ceil(4) + 1);
     assert_eq!(rays[1], lattice);
     let map: u64 = renderer
@@ -101,7 +104,10 @@ fn adaptive_frames_time_listing_and_tracing_apart_and_count_their_rays() {
         .map(|&n| u64::from(n))
         .sum();
     let counted: u64 = rays.iter().sum();
-    assert!(counted >= map && map > lattice, "{counted} counted, {map} in the map");
+    assert!(
+        counted >= map && map > lattice,
+        "{counted} counted, {map} in the map"
+    );
 }
 
 /// A study of `setups` on one lens, the built-in scene `name`.

@@ -3,8 +3,8 @@
 //! word is the language, further words are comma-separated):
 //!
 //! - `sh`: run by bash (`set -euo pipefail`) in a scratch folder of the page's own, with the
-//!   `fisheye` built for these tests first on `PATH` and the repository's `scenes/` and
-//!   `examples/` linked in; it must succeed.
+//!   `fisheye` built for these tests first on `PATH` and the repository's `scenes/`,
+//!   `examples/` and `lenses/` linked in; it must succeed.
 //! - `sh,no_run`: shown only; its first line must be a comment saying why it is not run.
 //! - `toml,file=NAME` (or `yaml`, `json`): written into the scratch folder for the blocks
 //!   after it; every `toml` and `yaml` block must parse.
@@ -84,7 +84,7 @@ fn scratch(name: &str) -> (PathBuf, String) {
     let bin = dir.join(".bin");
     std::fs::create_dir_all(&bin).unwrap();
     std::os::unix::fs::symlink(env!("CARGO_BIN_EXE_fisheye"), bin.join("fisheye")).unwrap();
-    for linked in ["scenes", "examples"] {
+    for linked in ["scenes", "examples", "lenses"] {
         std::os::unix::fs::symlink(root().join(linked), dir.join(linked)).unwrap();
     }
     let path = format!(

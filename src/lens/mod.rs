@@ -8,6 +8,7 @@ pub mod calib;
 mod calibrated;
 mod camera;
 pub mod fit;
+pub mod glass;
 pub mod gpu;
 mod json;
 mod model;

@@ -101,6 +101,13 @@ pub fn parse_spec(spec: &str) -> Result<Lens, LensError> {
         reason,
     };
     let (name, params) = spec.trim().split_once(':').unwrap_or((spec.trim(), ""));
+    if name == "prescription" {
+        return Err(err(
+            "lens prescriptions are read by `fisheye lens info` so far; rendering through \
+             them, and `lens project`/`unproject`, are not there yet"
+                .into(),
+        ));
+    }
     let mut values: Vec<(&str, f64)> = Vec::new();
     for pair in params.split(',').map(str::trim).filter(|p| !p.is_empty()) {
         let (key, value) = pair

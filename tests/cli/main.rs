@@ -2,6 +2,7 @@
 
 #[path = "../common/mod.rs"]
 mod common;
+mod lens_info;
 mod outputs;
 mod render;
 mod studies;

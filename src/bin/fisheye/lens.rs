@@ -10,6 +10,7 @@ use fisheye_rt::demo::LensDemo;
 use fisheye_rt::gpu::{GpuContext, Queries};
 use fisheye_rt::lens::calib::{self, CalibFormat, Calibration};
 use fisheye_rt::lens::fit::calibrated_equivalent;
+use fisheye_rt::lens::glass::GlassLens;
 use fisheye_rt::lens::gpu::DirectionSource;
 use fisheye_rt::lens::points;
 use fisheye_rt::lens::{
@@ -52,6 +53,21 @@ pub(crate) enum LensCommand {
         #[arg(long, short)]
         out: PathBuf,
     },
+    /// Print a lens's figures: its field of view and image circle for any spec; for a
+    /// prescription (`prescription:FILE[,sensor=MM][,fstop=N]`) also its paraxial focal
+    /// lengths (effective, and back from the rear vertex), f-number, entrance pupil and
+    /// sensor.
+    Info {
+        /// The lens spec (see `fisheye lens list`), or `prescription:FILE[,sensor=MM][,fstop=N]`
+        /// for a table of glass surfaces in pbrt's format.
+        spec: String,
+        /// Image size in pixels, WIDTHxHEIGHT, for the figures in pixels.
+        #[arg(long, default_value = "1024x768")]
+        size: ImageSize,
+        /// Write JSON (figures a lens has no physical scale for are null).
+        #[arg(long)]
+        json: bool,
+    },
     /// Draw what lenses do to the sphere of directions (10° grid, rings every 30° off the
     /// axis), one PNG per lens.
     Demo {
@@ -65,6 +81,132 @@ pub(crate) enum LensCommand {
         #[arg(long, short, default_value = "fisheye-demo")]
         out: PathBuf,
     },
+}
+
+/// `fisheye lens info`: a prescription's figures, in millimetres and at `size`'s pixels; a
+/// model's field and image circle, in the image's normalized units (half its width is 1)
+/// and pixels.
+pub(crate) fn info(spec: &str, size: ImageSize, json: bool) -> Result<()> {
+    let width = f64::from(size.width);
+    let (values, text) = if GlassLens::is_spec(spec) {
+        let glass = GlassLens::parse(spec)?;
+        let f = glass.figures();
+        let p = &glass.prescription;
+        // Millimetres on the film per pixel.
+        let pitch = glass.sensor_mm / width;
+        let values = serde_json::json!({
+            "spec": spec,
+            "surfaces": p.surfaces().len(),
+            "stop_surface": p.stop() + 1,
+            "efl_mm": f.efl_mm,
+            "bfl_mm": f.bfl_mm,
+            "f_number": f.f_number,
+            "entrance_pupil_diameter_mm": 2.0 * f.pupil_radius_mm,
+            "entrance_pupil_position_mm": f.pupil_position_mm,
+            "fov_deg": f.fov_deg,
+            "image_circle_mm": f.image_circle_mm,
+            "sensor_mm": glass.sensor_mm,
+            "size": size.to_string(),
+            "pixel_um": pitch * 1e3,
+            "efl_px": f.efl_mm / pitch,
+            "image_circle_px": f.image_circle_mm / pitch,
+        });
+        let text = [
+            format!(
+                "{spec}: {} surfaces, the stop at surface {}",
+                p.surfaces().len(),
+                p.stop() + 1
+            ),
+            row(
+                "efl_mm",
+                format!("{:.4}", f.efl_mm),
+                "effective focal length, paraxial",
+            ),
+            row(
+                "bfl_mm",
+                format!("{:.4}", f.bfl_mm),
+                "back focal length, from the rear vertex",
+            ),
+            row("f_number", format!("{:.3}", f.f_number), ""),
+            row(
+                "entrance pupil",
+                format!("{:.4} mm across", 2.0 * f.pupil_radius_mm),
+                &format!("{:.4} mm behind the front vertex", f.pupil_position_mm),
+            ),
+            row(
+                "fov_deg",
+                format!("{:.2}", f.fov_deg),
+                "the full field any ray gets through",
+            ),
+            row("image_circle_mm", format!("{:.4}", f.image_circle_mm), ""),
+            row(
+                "sensor_mm",
+                format!("{:.4}", glass.sensor_mm),
+                "the image's width on the film",
+            ),
+            row(
+                &format!("at {size}"),
+                format!("{:.3} µm pixels", pitch * 1e3),
+                &format!(
+                    "efl {:.1} px, image circle {:.1} px",
+                    f.efl_mm / pitch,
+                    f.image_circle_mm / pitch
+                ),
+            ),
+        ]
+        .join("\n");
+        (values, text)
+    } else {
+        let lens = parse_spec(spec)?;
+        let fov = 2.0 * lens.theta_max().to_degrees();
+        // Normalized units: half the image's width is 1.
+        let circle = 2.0 * lens.r_max();
+        let values = serde_json::json!({
+            "spec": spec,
+            "model": lens.name(),
+            "efl_mm": null,
+            "bfl_mm": null,
+            "f_number": null,
+            "fov_deg": fov,
+            "image_circle": circle,
+            "size": size.to_string(),
+            "image_circle_px": circle * width / 2.0,
+        });
+        let text = [
+            format!(
+                "{spec}: the {} model, a mapping of directions to the image with no physical \
+                 scale (no focal lengths in mm, no f-number)",
+                lens.name()
+            ),
+            row("fov_deg", format!("{fov:.2}"), ""),
+            row(
+                "image_circle",
+                format!("{circle:.4}"),
+                "normalized: half the image's width is 1",
+            ),
+            row(
+                &format!("at {size}"),
+                format!("image circle {:.1} px", circle * width / 2.0),
+                "",
+            ),
+        ]
+        .join("\n");
+        (values, text)
+    };
+    if json {
+        println!("{}", serde_json::to_string_pretty(&values)?);
+    } else {
+        println!("{text}");
+    }
+    Ok(())
+}
+
+/// A line of `lens info`: the name, the value, and a note in brackets where there is one.
+fn row(name: &str, value: String, note: &str) -> String {
+    match note {
+        "" => format!("  {name:<17} {value}"),
+        note => format!("  {name:<17} {value}   ({note})"),
+    }
 }
 
 pub(crate) fn list() {

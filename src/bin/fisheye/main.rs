@@ -13,7 +13,7 @@ use anyhow::Result;
 use clap::{Parser, Subcommand};
 use fisheye_rt::scene::builtin;
 
-use crate::lens::{LensCommand, convert, demo, fit, list, project, unproject};
+use crate::lens::{LensCommand, convert, demo, fit, info, list, project, unproject};
 use crate::render::RenderArgs;
 use crate::study::{BenchArgs, CompareArgs, run_bench, run_compare};
 use crate::validate::ValidateArgs;
@@ -104,6 +104,7 @@ pub(crate) fn run(cli: Cli) -> Result<()> {
                 out,
             } => convert(&camera, format.into(), &out),
             LensCommand::Demo { lens, size, out } => demo(lens, size, out),
+            LensCommand::Info { spec, size, json } => info(&spec, size, json),
         },
     }
 }

@@ -1,0 +1,151 @@
+//! A lens prescription on a camera: the spec `prescription:FILE[,sensor=MM][,fstop=N]` and
+//! the figures `fisheye lens info` prints for it (see [`super::prescription`] for the glass).
+//!
+//! `sensor` is the image's width on the film in millimetres (pixels are square); by default
+//! the image circle's diameter, so that the circle spans the image's width. `fstop` stops the
+//! aperture down to that f-number (not below the lens's own). The film sits at the paraxial
+//! focus for light from infinity.
+
+use std::path::Path;
+
+use super::prescription::Prescription;
+use crate::error::LensError;
+
+/// What a prescription spec starts with.
+pub const PREFIX: &str = "prescription:";
+
+/// A prescription with its sensor and stop, as a spec names them.
+#[derive(Clone, Debug, PartialEq)]
+pub struct GlassLens {
+    /// The prescription, stopped down where the spec says.
+    pub prescription: Prescription,
+    /// The image's width on the film, mm.
+    pub sensor_mm: f64,
+}
+
+/// A lens's figures, as `fisheye lens info` prints them.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Figures {
+    /// Effective focal length, mm (paraxial).
+    pub efl_mm: f64,
+    /// Back focal length from the rear vertex, mm (paraxial).
+    pub bfl_mm: f64,
+    /// Focal length over the entrance pupil's diameter.
+    pub f_number: f64,
+    /// The entrance pupil's radius, mm.
+    pub pupil_radius_mm: f64,
+    /// The entrance pupil's axial place behind the front vertex, mm (paraxial).
+    pub pupil_position_mm: f64,
+    /// The full field of view any ray gets through, degrees.
+    pub fov_deg: f64,
+    /// The image circle's diameter on the film, mm: twice the farthest a chief ray lands from
+    /// the axis, out to the edge of the field.
+    pub image_circle_mm: f64,
+}
+
+impl GlassLens {
+    /// Whether `spec` names a prescription.
+    pub fn is_spec(spec: &str) -> bool {
+        spec.trim_start().starts_with(PREFIX)
+    }
+
+    /// Reads `prescription:FILE[,sensor=MM][,fstop=N]`, loading FILE.
+    pub fn parse(spec: &str) -> Result<Self, LensError> {
+        let err = |reason: String| LensError::Spec {
+            spec: spec.to_string(),
+            reason,
+        };
+        let rest = spec
+            .trim()
+            .strip_prefix(PREFIX)
+            .ok_or_else(|| err(format!("a prescription spec starts {PREFIX:?}")))?;
+        let mut parts = rest.split(',');
+        let file = parts.next().unwrap_or("").trim();
+        if file.is_empty() {
+            return Err(err("give the prescription's file: prescription:FILE".into()));
+        }
+        let (mut sensor, mut fstop) = (None, None);
+        for pair in parts.map(str::trim).filter(|p| !p.is_empty()) {
+            let (key, value) = pair
+                .split_once('=')
+                .ok_or_else(|| err(format!("{pair:?} is not key=value")))?;
+            let number: f64 = value
+                .trim()
+                .parse()
+                .ok()
+                .filter(|v: &f64| v.is_finite() && *v > 0.0)
+                .ok_or_else(|| err(format!("{key} = {value:?}: give a number above 0")))?;
+            let slot = match key.trim() {
+                "sensor" => &mut sensor,
+                "fstop" => &mut fstop,
+                "focus" => {
+                    return Err(err(
+                        "focus is not supported yet: the film sits at the focus for infinity"
+                            .into(),
+                    ));
+                }
+                other => {
+                    return Err(err(format!(
+                        "unknown key {other:?}; a prescription takes sensor=MM and fstop=N"
+                    )));
+                }
+            };
+            if slot.replace(number).is_some() {
+                return Err(err(format!("{} is given twice", key.trim())));
+            }
+        }
+        let mut prescription = Prescription::load(Path::new(file))?;
+        if let Some(wanted) = fstop {
+            let own = prescription.f_number();
+            if wanted < own * (1.0 - 1e-9) {
+                return Err(err(format!(
+                    "fstop = {wanted}: the lens opens to f/{own:.3} at most"
+                )));
+            }
+            prescription = prescription.with_stop_scaled(own / wanted);
+        }
+        let sensor_mm = match sensor {
+            Some(mm) => mm,
+            None => image_circle(&prescription).ok_or_else(|| {
+                err(
+                    "no chief ray reaches the film, so the image circle, the default sensor \
+                     width, is unknown: give sensor=MM"
+                        .into(),
+                )
+            })?,
+        };
+        Ok(Self {
+            prescription,
+            sensor_mm,
+        })
+    }
+
+    /// The lens's figures.
+    pub fn figures(&self) -> Figures {
+        let p = &self.prescription;
+        let (pupil_radius_mm, pupil_position_mm) = p.entrance_pupil();
+        Figures {
+            efl_mm: p.efl(),
+            bfl_mm: p.bfl(),
+            f_number: p.f_number(),
+            pupil_radius_mm,
+            pupil_position_mm,
+            fov_deg: 2.0 * p.half_field().to_degrees(),
+            image_circle_mm: image_circle(p).unwrap_or(f64::NAN),
+        }
+    }
+}
+
+/// The image circle's diameter, mm: twice the farthest the chief ray lands from the axis on
+/// the film (at the focus for infinity), over 256 angles out to the edge of the field any ray
+/// gets through (a chief ray may fail before that edge, reflected inside the glass, where
+/// rays off the stop's centre still pass).
+fn image_circle(p: &Prescription) -> Option<f64> {
+    let (edge, film) = (p.half_field(), p.bfl());
+    let steps = 256;
+    (1..=steps)
+        .filter_map(|k| p.image_height(edge * f64::from(k) / f64::from(steps), film))
+        .map(f64::abs)
+        .reduce(f64::max)
+        .map(|r| 2.0 * r)
+}

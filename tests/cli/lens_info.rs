@@ -1,0 +1,123 @@
+//! `fisheye lens info`: a prescription's figures against optics worked out by hand, stopping
+//! down, a model's field and image circle, and the errors.
+
+use super::{fisheye, stdout};
+
+fn json(args: &[&str]) -> serde_json::Value {
+    serde_json::from_str(&stdout(&fisheye(args, ""))).unwrap()
+}
+
+fn repo(path: &str) -> String {
+    format!("{}/{path}", env!("CARGO_MANIFEST_DIR"))
+}
+
+/// A singlet behind a stop of 10 mm: nothing is in front of the stop, so it is the entrance
+/// pupil, and the f-number is the thick-lens focal length over 10 mm; the default sensor is
+/// the image circle, so the circle spans the image's width in pixels.
+#[test]
+fn a_singlets_figures_are_the_thick_lens_ones() {
+    let dir = std::env::temp_dir().join(format!("fisheye-lens-info-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let file = dir.join("singlet.dat");
+    std::fs::write(&file, "# a singlet\n0 1 0 10\n50 2 1.5 30\n-50 0 1 30\n").unwrap();
+    let spec = format!("prescription:{}", file.display());
+    let info = json(&["lens", "info", &spec, "--size", "800x600", "--json"]);
+    let (n, t) = (1.5, 2.0);
+    let f = 1.0 / ((n - 1.0) * (2.0 / 50.0 - (n - 1.0) * t / (n * 2500.0)));
+    let number = |key: &str| {
+        info[key]
+            .as_f64()
+            .unwrap_or_else(|| panic!("{key}: {info}"))
+    };
+    assert!((number("efl_mm") - f).abs() < 1e-9, "{info}");
+    assert!((number("bfl_mm") - f * (1.0 - (n - 1.0) * t / (n * 50.0))).abs() < 1e-9);
+    assert!((number("entrance_pupil_diameter_mm") - 10.0).abs() < 1e-12);
+    assert!((number("f_number") - f / 10.0).abs() < 1e-9);
+    assert_eq!(number("sensor_mm"), number("image_circle_mm"));
+    assert!((number("image_circle_px") - 800.0).abs() < 1e-6);
+    assert!((number("efl_px") - f / (number("sensor_mm") / 800.0)).abs() < 1e-6);
+    assert!(number("fov_deg") > 0.0 && number("fov_deg") < 180.0);
+
+    // Stopped down to f/8: the stop's diameter scales, the focal length does not.
+    let stopped = json(&["lens", "info", &format!("{spec},fstop=8"), "--json"]);
+    assert!(
+        (stopped["f_number"].as_f64().unwrap() - 8.0).abs() < 1e-9,
+        "{stopped}"
+    );
+    assert_eq!(stopped["efl_mm"], info["efl_mm"]);
+    // A given sensor is the image's width.
+    let sensor = json(&[
+        "lens",
+        "info",
+        &format!("{spec},sensor=24"),
+        "--size",
+        "1200x800",
+        "--json",
+    ]);
+    assert!(
+        (sensor["pixel_um"].as_f64().unwrap() - 20.0).abs() < 1e-9,
+        "{sensor}"
+    );
+
+    for (bad, wanted) in [
+        (format!("{spec},fstop=1"), "opens to f/"),
+        (format!("{spec},focus=2"), "focus"),
+        (format!("{spec},iso=100"), "unknown key \"iso\""),
+        (format!("{spec},sensor=-3"), "above 0"),
+        ("prescription:".to_string(), "give the prescription's file"),
+        (
+            format!("prescription:{}/none.dat", dir.display()),
+            "none.dat",
+        ),
+    ] {
+        let out = fisheye(&["lens", "info", &bad], "");
+        let message = String::from_utf8_lossy(&out.stderr);
+        assert!(
+            !out.status.success() && message.contains(wanted),
+            "{bad}: {message}"
+        );
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// The shipped fisheye: 10 mm, f/4, about 156°, as its design says.
+#[test]
+fn the_shipped_fisheyes_figures() {
+    let spec = format!("prescription:{}", repo("lenses/fisheye-10mm.dat"));
+    let text = stdout(&fisheye(&["lens", "info", &spec], ""));
+    assert!(text.contains("efl_mm            9.99"), "{text}");
+    let info = json(&["lens", "info", &spec, "--json"]);
+    let fov = info["fov_deg"].as_f64().unwrap();
+    assert!((150.0..160.0).contains(&fov), "{info}");
+}
+
+/// A model has a field and an image circle but no physical scale: equidistant r = f θ at
+/// f = 0.42 over 180° reaches r = 0.42 π / 2, a circle 0.42 π across in normalized units.
+#[test]
+fn a_models_field_and_image_circle() {
+    let info = json(&[
+        "lens",
+        "info",
+        "equidistant:f=0.42,fov=180",
+        "--size",
+        "1000x750",
+        "--json",
+    ]);
+    assert_eq!(info["fov_deg"].as_f64().unwrap(), 180.0);
+    let circle = info["image_circle"].as_f64().unwrap();
+    assert!(
+        (circle - 0.42 * std::f64::consts::PI).abs() < 1e-12,
+        "{info}"
+    );
+    assert!((info["image_circle_px"].as_f64().unwrap() - circle * 500.0).abs() < 1e-9);
+    assert!(info["efl_mm"].is_null() && info["f_number"].is_null());
+    // Rendering through a prescription is not there yet, and says so.
+    let never = std::env::temp_dir().join("fisheye-never-written.png");
+    let never = never.to_str().unwrap();
+    let out = fisheye(&["render", "--lens", "prescription:x.dat", "-o", never], "");
+    let message = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        !out.status.success() && message.contains("lens info"),
+        "{message}"
+    );
+}
