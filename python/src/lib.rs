@@ -11,8 +11,9 @@ use std::sync::{Arc, Mutex, OnceLock};
 
 use fisheye_rt::dataset::camera_from_transform;
 use fisheye_rt::gpu::GpuContext;
+use fisheye_rt::lens::glass::camera_for;
 use fisheye_rt::lens::points::{self, PixelOrigin};
-use fisheye_rt::lens::{ImageSize, LensCamera, calib, parse_spec};
+use fisheye_rt::lens::{ImageSize, LensCamera, calib};
 use fisheye_rt::scene::Camera;
 use fisheye_rt::trace::{
     Channel, Display, FramePass, GpuScene, RenderOptions, RenderOutput, Sampling, Tone, Values,
@@ -109,13 +110,14 @@ struct Lens {
 #[pymethods]
 impl Lens {
     /// A lens from its spec (see `fisheye lens list`: `"samyang-7.5mm"`,
-    /// `"equisolid:f=0.6,fov=180"`, `"kb:fx=...,k1=..."`) at `size = (width, height)`.
+    /// `"equisolid:f=0.6,fov=180"`, `"kb:fx=...,k1=..."`, or
+    /// `"prescription:FILE[,sensor=MM][,fstop=N]"` for a lens's glass, through its chief
+    /// rays) at `size = (width, height)`.
     #[staticmethod]
     fn from_spec(spec: &str, size: (u32, u32)) -> PyResult<Self> {
         let size = ImageSize::new(size.0, size.1).map_err(lens_error)?;
-        let lens = parse_spec(spec).map_err(lens_error)?;
         Ok(Self {
-            camera: LensCamera::new(lens, size),
+            camera: camera_for(spec, size).map_err(lens_error)?,
         })
     }
 

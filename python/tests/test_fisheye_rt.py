@@ -171,6 +171,24 @@ def test_adaptive_sampling_equals_the_commands_and_keeps_exact_ground_truth(tmp_
     assert exact["colour"].tobytes() == uniform["colour"].tobytes()
 
 
+def test_a_prescription_is_a_lens_as_the_command_line_has_it():
+    """Lens.from_spec takes a lens prescription (its chief rays, fitted as Kannala-Brandt
+    at the size): directions land where `fisheye lens project` puts them, to print precision."""
+    spec = f"prescription:{ROOT / 'lenses' / 'fisheye-10mm.dat'},fstop=5.6"
+    lens = fr.Lens.from_spec(spec, size=(320, 240))
+    dirs = np.array([[0.0, 0.0, 1.0], [0.5, 0.2, 0.8], [-0.9, 0.1, 0.3]])
+    dirs /= np.linalg.norm(dirs, axis=1, keepdims=True)
+    pixels = lens.project(dirs)
+    out = subprocess.run(
+        [FISHEYE, "lens", "project", "--lens", spec, "--size", "320x240"],
+        input="\n".join(" ".join(repr(float(v)) for v in d) for d in dirs),
+        check=True, capture_output=True, text=True,
+    ).stdout
+    expected = np.array([[float(v) for v in line.split()] for line in out.splitlines()])
+    assert np.allclose(pixels, expected, atol=1e-6)
+    assert np.allclose(pixels[0], [160.0, 120.0])
+
+
 def test_the_camera_moves_without_uploading_the_scene_again(tmp_path):
     """One renderer, three poses: the first pose again gives the same bytes; a pose made with
     look_at sees what `fisheye render --camera` sees from there (the same triangle at all but

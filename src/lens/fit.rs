@@ -232,7 +232,7 @@ fn residual(
 /// Kannala–Brandt's k1..k4 for `θd(θ)` (the radius over the focal length) by least squares:
 /// `θd/θ - 1 = k1θ² + k2θ⁴ + k3θ⁶ + k4θ⁸` is linear in the k's (normal equations, solved by
 /// Gauss–Jordan elimination with partial pivoting).
-fn fit_kb(angles: &[f64], theta_d: impl Fn(f64) -> Option<f64>) -> [f64; 4] {
+pub(crate) fn fit_kb(angles: &[f64], theta_d: impl Fn(f64) -> Option<f64>) -> [f64; 4] {
     let mut a = [[0.0f64; 5]; 4];
     for &t in angles {
         let Some(d) = theta_d(t) else { continue };

@@ -8,7 +8,10 @@
 
 use std::path::Path;
 
+use super::calibrated::{CalibratedLens, CalibratedModel, Intrinsics};
+use super::camera::{ImageSize, LensCamera};
 use super::prescription::Prescription;
+use super::spec::parse_spec;
 use crate::error::LensError;
 
 /// What a prescription spec starts with.
@@ -21,6 +24,35 @@ pub struct GlassLens {
     pub prescription: Prescription,
     /// The image's width on the film, mm.
     pub sensor_mm: f64,
+}
+
+/// A prescription's chief-ray mapping fitted as a Kannala–Brandt model at an image size.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Fitted {
+    /// The camera: Kannala–Brandt, principal point at the image's centre, square pixels, its
+    /// field the prescription's.
+    pub camera: LensCamera,
+    /// The largest radial difference from the traced chief rays over the fitted field,
+    /// pixels.
+    pub residual_px: f64,
+}
+
+impl Fitted {
+    /// The full field of view the fitted camera shows, radians: the lens's, or less where the
+    /// fitted polynomial turns back before its edge.
+    pub fn fov(&self) -> f64 {
+        2.0 * self.camera.lens.theta_max()
+    }
+}
+
+/// The camera of `spec` at `size`: a prescription's fitted chief-ray mapping
+/// ([`GlassLens::fitted`]), any other spec's lens ([`parse_spec`]).
+pub fn camera_for(spec: &str, size: ImageSize) -> Result<LensCamera, LensError> {
+    if GlassLens::is_spec(spec) {
+        Ok(GlassLens::parse(spec)?.fitted(size)?.camera)
+    } else {
+        Ok(LensCamera::new(parse_spec(spec)?, size))
+    }
 }
 
 /// A lens's figures, as `fisheye lens info` prints them.
@@ -120,6 +152,57 @@ impl GlassLens {
         })
     }
 
+    /// The chief-ray mapping at `size` as Kannala–Brandt's `θ(1 + k1θ² + … + k4θ⁸)`, fitted
+    /// by least squares to the traced chief rays at 512 angles out to the edge of the field
+    /// (or of the chief rays, where they end first), with the paraxial focal length in pixels
+    /// as its own (the mapping's slope at the axis): where the chief ray of a direction lands
+    /// on the film, read out upright.
+    pub fn fitted(&self, size: ImageSize) -> Result<Fitted, LensError> {
+        let p = &self.prescription;
+        let pitch = self.sensor_mm / f64::from(size.width);
+        let (efl, edge) = (p.efl(), p.half_field());
+        let angles: Vec<f64> = (1..=512).map(|k| edge * f64::from(k) / 512.0).collect();
+        let traced: Vec<(f64, f64)> = angles
+            .iter()
+            .zip(p.image_heights(&angles, p.bfl()))
+            .map_while(|(&t, r)| Some((t, r?)))
+            .collect();
+        let Some(&(widest, _)) = traced.last() else {
+            return Err(LensError::Spec {
+                spec: "prescription".into(),
+                reason: "no chief ray reaches the film".into(),
+            });
+        };
+        let used: Vec<f64> = traced.iter().map(|s| s.0).collect();
+        let k = super::fit::fit_kb(&used, |t| {
+            traced.iter().find(|s| s.0 == t).map(|s| s.1 / efl)
+        });
+        let f = efl / pitch;
+        let intrinsics = Intrinsics {
+            fx: f,
+            fy: f,
+            cx: f64::from(size.width) / 2.0,
+            cy: f64::from(size.height) / 2.0,
+        };
+        let model = CalibratedModel::KannalaBrandt { k };
+        // The lens's field, or less where the fitted polynomial turns back first.
+        let whole = CalibratedLens::new(model, intrinsics)?;
+        let lens = if widest < whole.theta_max() {
+            CalibratedLens::with_fov(model, intrinsics, 2.0 * widest)?
+        } else {
+            whole
+        };
+        let mut residual_px = 0.0f64;
+        for &(t, r) in traced.iter().filter(|s| s.0 <= lens.theta_max()) {
+            let fitted = lens.radius(t).unwrap_or(f64::INFINITY);
+            residual_px = residual_px.max((r / pitch - fitted * f).abs());
+        }
+        Ok(Fitted {
+            camera: LensCamera::new(lens, size),
+            residual_px,
+        })
+    }
+
     /// The lens's figures.
     pub fn figures(&self) -> Figures {
         let p = &self.prescription;
@@ -141,10 +224,11 @@ impl GlassLens {
 /// gets through (a chief ray may fail before that edge, reflected inside the glass, where
 /// rays off the stop's centre still pass).
 fn image_circle(p: &Prescription) -> Option<f64> {
-    let (edge, film) = (p.half_field(), p.bfl());
-    let steps = 256;
-    (1..=steps)
-        .filter_map(|k| p.image_height(edge * f64::from(k) / f64::from(steps), film))
+    let edge = p.half_field();
+    let angles: Vec<f64> = (1..=256).map(|k| edge * f64::from(k) / 256.0).collect();
+    p.image_heights(&angles, p.bfl())
+        .into_iter()
+        .flatten()
         .map(f64::abs)
         .reduce(f64::max)
         .map(|r| 2.0 * r)

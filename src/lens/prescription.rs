@@ -380,23 +380,53 @@ impl Prescription {
     /// The chief ray of light from infinity at `theta` radians off the axis (in the x–z
     /// plane, travelling toward +x): the ray through the stop's centre, with apertures
     /// ignored; `None` where no such ray gets through the glass (it misses a surface or
-    /// reflects). Found by Newton's method on its height at the front vertex's plane,
-    /// continued from the axis in steps of at most a degree: a fisheye's pupil moves far from
-    /// its paraxial place at wide angles, where the paraxial guess would miss the glass.
+    /// reflects). See [`Prescription::chief_rays`].
     pub fn chief_ray(&self, theta: f64) -> Option<Ray> {
-        if !(0.0..FRAC_PI_2).contains(&theta) {
-            return None;
-        }
-        let steps = (theta.to_degrees().ceil() as usize).max(1);
-        // The paraxial chief ray's height at the front plane starts the search.
+        self.chief_rays(&[theta]).pop().flatten()
+    }
+
+    /// The chief rays at `thetas` (increasing, radians, below 90°), as
+    /// [`Prescription::chief_ray`]: found by Newton's method on their height at the front
+    /// vertex's plane, continued from the axis a degree at a time (a fisheye's pupil moves
+    /// far from its paraxial place at wide angles, where the paraxial guess would miss the
+    /// glass). Past an angle with none, none.
+    pub fn chief_rays(&self, thetas: &[f64]) -> Vec<Option<Ray>> {
         let m = self.abcd(self.stop);
-        let first = theta / steps as f64;
-        let mut h = -m.b / m.a * first.tan();
-        for k in 1..=steps {
-            h = self.chief_height(theta * k as f64 / steps as f64, h)?;
-        }
-        let direction = DVec3::new(theta.sin(), 0.0, theta.cos());
-        Some(self.ray_through_front_plane(h, direction))
+        // The last angle solved, and its chief ray's height at the front plane.
+        let (mut at, mut h) = (0.0, Some(0.0));
+        thetas
+            .iter()
+            .map(|&theta| {
+                if !(at..FRAC_PI_2).contains(&theta) {
+                    h = None;
+                }
+                if let Some(mut current) = h {
+                    let steps = ((theta - at).to_degrees().ceil() as usize).max(1);
+                    for k in 1..=steps {
+                        let t = at + (theta - at) * k as f64 / steps as f64;
+                        // Off the axis, the paraxial chief ray's height starts the search.
+                        let start = if at == 0.0 && k == 1 {
+                            -m.b / m.a * t.tan()
+                        } else {
+                            current
+                        };
+                        match self.chief_height(t, start) {
+                            Some(next) => current = next,
+                            None => {
+                                h = None;
+                                break;
+                            }
+                        }
+                    }
+                    if h.is_some() {
+                        h = Some(current);
+                    }
+                    at = theta;
+                }
+                let direction = DVec3::new(theta.sin(), 0.0, theta.cos());
+                h.map(|h| self.ray_through_front_plane(h, direction))
+            })
+            .collect()
     }
 
     /// The ray of direction `direction` that crosses the front vertex's plane at height `h`
@@ -444,22 +474,26 @@ impl Prescription {
         (g.abs() <= 1e-9 * scale).then_some(h)
     }
 
-    /// Where the chief ray at `theta` radians off the axis meets a film `film` mm behind the
-    /// rear vertex: its distance from the axis, mm (on the side the light travels toward,
-    /// the image being inverted); apertures ignored.
-    pub fn image_height(&self, theta: f64, film: f64) -> Option<f64> {
-        if theta == 0.0 {
-            return Some(0.0);
-        }
-        let chief = self.chief_ray(theta)?;
-        let out = self
-            .trace_range(chief, 0, self.surfaces.len(), false)
-            .ok()?;
+    /// Where the chief rays at `thetas` (increasing, radians) meet a film `film` mm behind
+    /// the rear vertex: their distances from the axis, mm (on the side the light travels
+    /// toward, the image being inverted); apertures ignored.
+    pub fn image_heights(&self, thetas: &[f64], film: f64) -> Vec<Option<f64>> {
         let z = self.rear_vertex() + film;
-        if out.direction.z <= 0.0 {
-            return None;
-        }
-        Some(out.origin.x + (z - out.origin.z) * out.direction.x / out.direction.z)
+        self.chief_rays(thetas)
+            .into_iter()
+            .map(|chief| {
+                let out = self
+                    .trace_range(chief?, 0, self.surfaces.len(), false)
+                    .ok()?;
+                (out.direction.z > 0.0)
+                    .then(|| out.origin.x + (z - out.origin.z) * out.direction.x / out.direction.z)
+            })
+            .collect()
+    }
+
+    /// [`Prescription::image_heights`] at one angle.
+    pub fn image_height(&self, theta: f64, film: f64) -> Option<f64> {
+        self.image_heights(&[theta], film).pop().flatten()
     }
 
     /// How far back along `direction` from the front plane a ray starts: in front of the

@@ -103,8 +103,8 @@ pub fn parse_spec(spec: &str) -> Result<Lens, LensError> {
     let (name, params) = spec.trim().split_once(':').unwrap_or((spec.trim(), ""));
     if name == "prescription" {
         return Err(err(
-            "lens prescriptions are read by `fisheye lens info` so far; rendering through \
-             them, and `lens project`/`unproject`, are not there yet"
+            "a lens prescription's camera depends on the image's size: \
+             lens::glass::camera_for makes it"
                 .into(),
         ));
     }

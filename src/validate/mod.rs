@@ -31,8 +31,9 @@ use crate::bench::Machine;
 use crate::compare::{supersample_factor, supersampled};
 use crate::error::Result;
 use crate::gpu::GpuContext;
+use crate::lens::glass::camera_for;
 use crate::lens::gpu::DirectionSource;
-use crate::lens::{CalibratedModel, ImageSize, LensCamera, PRESETS, parse_spec};
+use crate::lens::{CalibratedModel, ImageSize, LensCamera, PRESETS};
 use crate::scene::Camera;
 use crate::scene::builtin::{GridCorner, grid_corners};
 use crate::trace::{GpuScene, RenderOptions, TracePass};
@@ -300,7 +301,7 @@ pub fn default_lenses() -> Result<Vec<LensToValidate>> {
         .map(|(spec, (w, h))| {
             Ok(LensToValidate {
                 name: spec.to_string(),
-                camera: LensCamera::new(parse_spec(spec)?, ImageSize::new(w, h)?),
+                camera: camera_for(spec, ImageSize::new(w, h)?)?,
             })
         })
         .collect()

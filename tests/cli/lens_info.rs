@@ -111,13 +111,39 @@ fn a_models_field_and_image_circle() {
     );
     assert!((info["image_circle_px"].as_f64().unwrap() - circle * 500.0).abs() < 1e-9);
     assert!(info["efl_mm"].is_null() && info["f_number"].is_null());
-    // Rendering through a prescription is not there yet, and says so.
-    let never = std::env::temp_dir().join("fisheye-never-written.png");
-    let never = never.to_str().unwrap();
-    let out = fisheye(&["render", "--lens", "prescription:x.dat", "-o", never], "");
-    let message = String::from_utf8_lossy(&out.stderr);
-    assert!(
-        !out.status.success() && message.contains("lens info"),
-        "{message}"
-    );
+}
+
+/// `--lens prescription:...` renders through the lens's chief rays (fitted as Kannala–Brandt,
+/// see `lens info`): with the default sensor the image circle spans the image's width, so the
+/// middle row is covered to both edges and the corners are not; a direction projects where
+/// `lens project` says, upright.
+#[test]
+fn a_prescription_renders_through_its_chief_rays() {
+    let dir = std::env::temp_dir().join(format!("fisheye-glass-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let out = dir.join("glass.png");
+    let spec = format!("prescription:{}", repo("lenses/fisheye-10mm.dat"));
+    let args = ["render", "--lens", &spec, "--size", "160x120", "--spp", "1"];
+    stdout(&fisheye(
+        &[
+            &args[..],
+            &["--outputs", "mask", "-o", out.to_str().unwrap()],
+        ]
+        .concat(),
+        "",
+    ));
+    let bytes = std::fs::read(dir.join("glass.mask.npy")).unwrap();
+    let mask: Vec<u8> = npyz::NpyFile::new(&bytes[..]).unwrap().into_vec().unwrap();
+    let at = |x: usize, y: usize| mask[y * 160 + x];
+    assert_eq!((at(0, 60), at(159, 60), at(80, 0)), (1, 1, 1));
+    assert_eq!((at(0, 0), at(159, 119)), (0, 0));
+    // Straight ahead lands at the centre; 60° to the right, right of it on the middle row.
+    let text = stdout(&fisheye(
+        &["lens", "project", "--lens", &spec, "--size", "160x120"],
+        "0 0 1\n0.8660254 0 0.5\n",
+    ));
+    let lines: Vec<Vec<f64>> = text.lines().map(super::numbers).collect();
+    assert_eq!(lines[0], [80.0, 60.0]);
+    assert!(lines[1][0] > 100.0 && lines[1][1] == 60.0, "{text}");
+    std::fs::remove_dir_all(&dir).unwrap();
 }

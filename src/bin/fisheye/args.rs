@@ -8,8 +8,9 @@ use clap::ValueEnum;
 use fisheye_rt::bvh::BvhQuality;
 use fisheye_rt::cube::CubeMethod;
 use fisheye_rt::lens::calib::{self, CalibFormat};
+use fisheye_rt::lens::glass::camera_for;
 use fisheye_rt::lens::gpu::DirectionSource;
-use fisheye_rt::lens::{DirectionFormula, ImageSize, LensCamera, parse_spec};
+use fisheye_rt::lens::{DirectionFormula, ImageSize, LensCamera};
 use fisheye_rt::raster::RasterMethod;
 use fisheye_rt::renderer;
 use fisheye_rt::scene::Scene;
@@ -264,7 +265,7 @@ impl CalibArgs {
                 let Some(spec) = lens else {
                     bail!("give a lens: --lens SPEC or --calib FILE");
                 };
-                LensCamera::new(parse_spec(spec)?, size)
+                camera_for(spec, size)?
             }
         };
         // Warned about only where the image reaches past the clip: where the turn ends the

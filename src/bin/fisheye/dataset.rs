@@ -10,7 +10,8 @@ use fisheye_rt::dataset::trajectory::{self, TrajectoryFormat};
 use fisheye_rt::dataset::{ArrayFile, Dataset, Shard, Submission};
 use fisheye_rt::gpu::GpuContext;
 use fisheye_rt::lens::calib;
-use fisheye_rt::lens::{ImageSize, LensCamera, parse_spec};
+use fisheye_rt::lens::glass::camera_for;
+use fisheye_rt::lens::{ImageSize, LensCamera};
 use fisheye_rt::pose::parse_transform;
 use fisheye_rt::trace::{Channel, ColourFile, Display, RenderOptions, Sampling};
 use glam::DAffine3;
@@ -71,7 +72,8 @@ pub(crate) struct RenderArgs {
     #[arg(long, default_value = "identity", allow_hyphen_values = true)]
     t_scene_world: String,
     /// Rays per pixel, as `render --spp` takes them: N (a square, 1 to 256, box-filtered) or
-    /// auto[:THRESHOLD[:MAX]] (adaptive sampling); ground truth is the centre ray's.
+    /// auto, auto:THRESHOLD or auto:THRESHOLD:MAX (adaptive sampling); ground truth is the
+    /// centre ray's.
     #[arg(long, default_value = "16")]
     spp: Sampling,
     /// Deepest reflection/refraction bounce (0 to 8).
@@ -180,10 +182,7 @@ fn render(args: &RenderArgs) -> Result<()> {
                 (camera, c.body_from_camera)
             })
             .collect(),
-        (None, Some(spec)) => vec![(
-            LensCamera::new(parse_spec(spec)?, args.size),
-            DAffine3::IDENTITY,
-        )],
+        (None, Some(spec)) => vec![(camera_for(spec, args.size)?, DAffine3::IDENTITY)],
         (None, None) => bail!("give the cameras: --rig CALIBRATION or --lens SPEC"),
     };
     let format = args.trajectory_format.map(|f| match f {

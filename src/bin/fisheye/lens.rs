@@ -10,12 +10,11 @@ use fisheye_rt::demo::LensDemo;
 use fisheye_rt::gpu::{GpuContext, Queries};
 use fisheye_rt::lens::calib::{self, CalibFormat, Calibration};
 use fisheye_rt::lens::fit::calibrated_equivalent;
-use fisheye_rt::lens::glass::GlassLens;
+use fisheye_rt::lens::glass::{GlassLens, camera_for};
 use fisheye_rt::lens::gpu::DirectionSource;
 use fisheye_rt::lens::points;
 use fisheye_rt::lens::{
-    CalibratedLens, CalibratedModel, ImageSize, LensCamera, LensModel, PRESET_FOV_DEGREES, PRESETS,
-    parse_spec,
+    CalibratedLens, CalibratedModel, ImageSize, LensModel, PRESET_FOV_DEGREES, PRESETS, parse_spec,
 };
 use fisheye_rt::report;
 use fisheye_rt::trace::{save_png, write_file};
@@ -91,6 +90,21 @@ pub(crate) fn info(spec: &str, size: ImageSize, json: bool) -> Result<()> {
     let (values, text) = if GlassLens::is_spec(spec) {
         let glass = GlassLens::parse(spec)?;
         let f = glass.figures();
+        let fitted = glass.fitted(size);
+        let kb = fitted
+            .as_ref()
+            .ok()
+            .and_then(|f| f.camera.lens.calibrated())
+            .map(|c| c.model().parameters());
+        let fit_note = match &fitted {
+            Ok(f) => format!(
+                "the chief rays fitted at {size}, within {:.3} px over {:.2}°: what --lens \
+                 renders",
+                f.residual_px,
+                f.fov().to_degrees()
+            ),
+            Err(e) => format!("no fit: {e}"),
+        };
         let p = &glass.prescription;
         // Millimetres on the film per pixel.
         let pitch = glass.sensor_mm / width;
@@ -110,6 +124,12 @@ pub(crate) fn info(spec: &str, size: ImageSize, json: bool) -> Result<()> {
             "pixel_um": pitch * 1e3,
             "efl_px": f.efl_mm / pitch,
             "image_circle_px": f.image_circle_mm / pitch,
+            "kannala_brandt": fitted.as_ref().ok().map(|f| serde_json::json!({
+                "parameters": kb.iter().flatten().map(|(k, v)| (k.to_string(), serde_json::json!(v)))
+                    .collect::<serde_json::Map<String, serde_json::Value>>(),
+                "residual_px": f.residual_px,
+                "fov_deg": f.fov().to_degrees(),
+            })),
         });
         let text = [
             format!(
@@ -152,6 +172,15 @@ pub(crate) fn info(spec: &str, size: ImageSize, json: bool) -> Result<()> {
                     f.efl_mm / pitch,
                     f.image_circle_mm / pitch
                 ),
+            ),
+            row(
+                "kannala-brandt",
+                kb.iter()
+                    .flatten()
+                    .map(|(k, v)| format!("{k}={v:.6}"))
+                    .collect::<Vec<_>>()
+                    .join(","),
+                &fit_note,
             ),
         ]
         .join("\n");
@@ -397,7 +426,7 @@ pub(crate) fn demo(lenses: Vec<String>, size: ImageSize, out: PathBuf) -> Result
     // Check every spec before starting the GPU.
     let cameras = lenses
         .iter()
-        .map(|spec| Ok((spec, LensCamera::new(parse_spec(spec)?, size))))
+        .map(|spec| Ok((spec, camera_for(spec, size)?)))
         .collect::<Result<Vec<_>>>()?;
     fisheye_rt::trace::check_writable_folder(&out)?;
     let ctx = GpuContext::new()?;

@@ -5,7 +5,7 @@ use std::path::PathBuf;
 use anyhow::{Context, Result, bail};
 use fisheye_rt::bench::PathKind;
 use fisheye_rt::gpu::GpuContext;
-use fisheye_rt::lens::{LensCamera, parse_spec};
+use fisheye_rt::lens::glass::camera_for;
 use fisheye_rt::renderer::{self, SceneSet, Setup};
 use fisheye_rt::report::{self, LensRun, Study};
 use fisheye_rt::scene::Scene;
@@ -82,7 +82,7 @@ pub(crate) fn prepare(args: &StudyArgs, command: &str) -> Result<Prepared> {
             .map(|spec| {
                 Ok(LensRun {
                     name: spec.clone(),
-                    camera: LensCamera::new(parse_spec(spec)?, args.size),
+                    camera: camera_for(spec, args.size)?,
                 })
             })
             .collect::<Result<Vec<_>>>()?,
@@ -92,7 +92,7 @@ pub(crate) fn prepare(args: &StudyArgs, command: &str) -> Result<Prepared> {
     if !args.no_pinhole {
         lenses.push(LensRun {
             name: args.pinhole.clone(),
-            camera: LensCamera::new(parse_spec(&args.pinhole)?, size),
+            camera: camera_for(&args.pinhole, size)?,
         });
     }
     if let Some(&bad) = args.cube_size.iter().find(|&&s| s == 0) {
