@@ -145,5 +145,29 @@ fn a_prescription_renders_through_its_chief_rays() {
     let lines: Vec<Vec<f64>> = text.lines().map(super::numbers).collect();
     assert_eq!(lines[0], [80.0, 60.0]);
     assert!(lines[1][0] > 100.0 && lines[1][1] == 60.0, "{text}");
+
+    // From glass to calibration: the calibration file `lens convert` writes maps directions
+    // as the prescription does (within the fit's field; the file holds no field).
+    let file = dir.join("glass.yaml");
+    let convert = ["lens", "convert", "--lens", &spec, "--size", "160x120"];
+    let said = stdout(&fisheye(
+        &[
+            &convert[..],
+            &["--format", "opencv-yaml", "-o", file.to_str().unwrap()],
+        ]
+        .concat(),
+        "",
+    ));
+    assert!(said.contains("largest radial residual"), "{said}");
+    let points = "0 0 1\n0.8660254 0 0.5\n0.3 -0.6 0.74\n";
+    let from_file = stdout(&fisheye(
+        &["lens", "project", "--calib", file.to_str().unwrap()],
+        points,
+    ));
+    let from_glass = stdout(&fisheye(
+        &["lens", "project", "--lens", &spec, "--size", "160x120"],
+        points,
+    ));
+    assert_eq!(from_file, from_glass);
     std::fs::remove_dir_all(&dir).unwrap();
 }

@@ -360,9 +360,22 @@ pub(crate) fn fit(args: &CameraArgs) -> Result<()> {
 
 pub(crate) fn convert(args: &CameraArgs, format: CalibFormat, out: &Path) -> Result<()> {
     let camera = args.camera()?;
-    let lens = match camera.lens.calibrated() {
-        Some(lens) => *lens,
-        None => {
+    let glass = args.lens.as_deref().filter(|s| GlassLens::is_spec(s));
+    let lens = match (camera.lens.calibrated(), glass) {
+        (Some(lens), Some(spec)) => {
+            // A prescription goes as its chief rays' fitted model, without the lens's field.
+            let fitted = GlassLens::parse(spec)?.fitted(camera.size)?;
+            println!(
+                "{spec}: its chief rays fitted as {}, largest radial residual {:.2e} px; the \
+                 {:.1}° field of view is not written (the formats hold none)",
+                camera.lens,
+                fitted.residual_px,
+                fitted.fov().to_degrees()
+            );
+            CalibratedLens::new(lens.model(), lens.intrinsics())?
+        }
+        (Some(lens), None) => *lens,
+        (None, _) => {
             // A classic lens goes as its calibrated equivalent: exact, or fitted.
             let equivalent = calibrated_equivalent(&camera)?;
             let model = fisheye_rt::lens::Lens::Calibrated(equivalent.lens);
