@@ -111,7 +111,7 @@ struct Lens {
 impl Lens {
     /// A lens from its spec (see `fisheye lens list`: `"samyang-7.5mm"`,
     /// `"equisolid:f=0.6,fov=180"`, `"kb:fx=...,k1=..."`, or
-    /// `"prescription:FILE[,sensor=MM][,fstop=N]"` for a lens's glass, through its chief
+    /// `"prescription:FILE[,sensor=MM][,fstop=N][,focus=METRES]"` for a lens's glass, through its chief
     /// rays) at `size = (width, height)`.
     #[staticmethod]
     fn from_spec(spec: &str, size: (u32, u32)) -> PyResult<Self> {

@@ -1,10 +1,11 @@
-//! A lens prescription on a camera: the spec `prescription:FILE[,sensor=MM][,fstop=N]` and
+//! A lens prescription on a camera: the spec `prescription:FILE[,sensor=MM][,fstop=N][,focus=METRES]` and
 //! the figures `fisheye lens info` prints for it (see [`super::prescription`] for the glass).
 //!
 //! `sensor` is the image's width on the film in millimetres (pixels are square); by default
 //! the image circle's diameter, so that the circle spans the image's width. `fstop` stops the
-//! aperture down to that f-number (not below the lens's own). The film sits at the paraxial
-//! focus for light from infinity.
+//! aperture down to that f-number (not below the lens's own). `focus` is the distance in
+//! metres from the front vertex to the plane in focus, where the film sits at the paraxial
+//! image of its axial point; by default infinity (the film at the back focal length).
 
 use std::path::Path;
 
@@ -24,6 +25,9 @@ pub struct GlassLens {
     pub prescription: Prescription,
     /// The image's width on the film, mm.
     pub sensor_mm: f64,
+    /// The film's distance behind the rear vertex, mm: the back focal length (focus at
+    /// infinity) unless the spec's `focus` says otherwise.
+    pub film_mm: f64,
 }
 
 /// A prescription's chief-ray mapping fitted as a Kannala–Brandt model at an image size.
@@ -81,7 +85,7 @@ impl GlassLens {
         spec.trim_start().starts_with(PREFIX)
     }
 
-    /// Reads `prescription:FILE[,sensor=MM][,fstop=N]`, loading FILE.
+    /// Reads `prescription:FILE[,sensor=MM][,fstop=N][,focus=METRES]`, loading FILE.
     pub fn parse(spec: &str) -> Result<Self, LensError> {
         let err = |reason: String| LensError::Spec {
             spec: spec.to_string(),
@@ -96,7 +100,7 @@ impl GlassLens {
         if file.is_empty() {
             return Err(err("give the prescription's file: prescription:FILE".into()));
         }
-        let (mut sensor, mut fstop) = (None, None);
+        let (mut sensor, mut fstop, mut focus) = (None, None, None);
         for pair in parts.map(str::trim).filter(|p| !p.is_empty()) {
             let (key, value) = pair
                 .split_once('=')
@@ -110,15 +114,11 @@ impl GlassLens {
             let slot = match key.trim() {
                 "sensor" => &mut sensor,
                 "fstop" => &mut fstop,
-                "focus" => {
-                    return Err(err(
-                        "focus is not supported yet: the film sits at the focus for infinity"
-                            .into(),
-                    ));
-                }
+                "focus" => &mut focus,
                 other => {
                     return Err(err(format!(
-                        "unknown key {other:?}; a prescription takes sensor=MM and fstop=N"
+                        "unknown key {other:?}; a prescription takes sensor=MM, fstop=N and \
+                         focus=METRES"
                     )));
                 }
             };
@@ -136,9 +136,18 @@ impl GlassLens {
             }
             prescription = prescription.with_stop_scaled(own / wanted);
         }
+        let film_mm = match focus {
+            None => prescription.bfl(),
+            Some(metres) => prescription.focus_distance(metres * 1e3).ok_or_else(|| {
+                err(format!(
+                    "focus = {metres} m: too close for this lens to focus (its image is \
+                     virtual)"
+                ))
+            })?,
+        };
         let sensor_mm = match sensor {
             Some(mm) => mm,
-            None => image_circle(&prescription).ok_or_else(|| {
+            None => image_circle(&prescription, film_mm).ok_or_else(|| {
                 err(
                     "no chief ray reaches the film, so the image circle, the default sensor \
                      width, is unknown: give sensor=MM"
@@ -149,22 +158,33 @@ impl GlassLens {
         Ok(Self {
             prescription,
             sensor_mm,
+            film_mm,
         })
     }
 
     /// The chief-ray mapping at `size` as Kannala–Brandt's `θ(1 + k1θ² + … + k4θ⁸)`, fitted
     /// by least squares to the traced chief rays at 512 angles out to the edge of the field
-    /// (or of the chief rays, where they end first), with the paraxial focal length in pixels
-    /// as its own (the mapping's slope at the axis): where the chief ray of a direction lands
-    /// on the film, read out upright.
+    /// (or of the chief rays, where they end first), with the mapping's slope at the axis in
+    /// pixels as its focal length (the paraxial one where the film is at the focus for
+    /// infinity): where the chief ray of a direction lands on the film, read out upright.
     pub fn fitted(&self, size: ImageSize) -> Result<Fitted, LensError> {
         let p = &self.prescription;
         let pitch = self.sensor_mm / f64::from(size.width);
-        let (efl, edge) = (p.efl(), p.half_field());
+        let edge = p.half_field();
+        // The mapping's slope at the axis, from a chief ray 1e-5 rad off it (r = f tan θ
+        // there to 1e-10).
+        let tiny = 1e-5;
+        let slope = p
+            .image_height(tiny, self.film_mm)
+            .map(|r| r / tiny.tan())
+            .ok_or_else(|| LensError::Spec {
+                spec: "prescription".into(),
+                reason: "no chief ray near the axis reaches the film".into(),
+            })?;
         let angles: Vec<f64> = (1..=512).map(|k| edge * f64::from(k) / 512.0).collect();
         let traced: Vec<(f64, f64)> = angles
             .iter()
-            .zip(p.image_heights(&angles, p.bfl()))
+            .zip(p.image_heights(&angles, self.film_mm))
             .map_while(|(&t, r)| Some((t, r?)))
             .collect();
         let Some(&(widest, _)) = traced.last() else {
@@ -175,9 +195,9 @@ impl GlassLens {
         };
         let used: Vec<f64> = traced.iter().map(|s| s.0).collect();
         let k = super::fit::fit_kb(&used, |t| {
-            traced.iter().find(|s| s.0 == t).map(|s| s.1 / efl)
+            traced.iter().find(|s| s.0 == t).map(|s| s.1 / slope)
         });
-        let f = efl / pitch;
+        let f = slope / pitch;
         let intrinsics = Intrinsics {
             fx: f,
             fy: f,
@@ -214,19 +234,19 @@ impl GlassLens {
             pupil_radius_mm,
             pupil_position_mm,
             fov_deg: 2.0 * p.half_field().to_degrees(),
-            image_circle_mm: image_circle(p).unwrap_or(f64::NAN),
+            image_circle_mm: image_circle(p, self.film_mm).unwrap_or(f64::NAN),
         }
     }
 }
 
 /// The image circle's diameter, mm: twice the farthest the chief ray lands from the axis on
-/// the film (at the focus for infinity), over 256 angles out to the edge of the field any ray
+/// a film `film` mm behind the rear vertex, over 256 angles out to the edge of the field any ray
 /// gets through (a chief ray may fail before that edge, reflected inside the glass, where
 /// rays off the stop's centre still pass).
-fn image_circle(p: &Prescription) -> Option<f64> {
+fn image_circle(p: &Prescription, film: f64) -> Option<f64> {
     let edge = p.half_field();
     let angles: Vec<f64> = (1..=256).map(|k| edge * f64::from(k) / 256.0).collect();
-    p.image_heights(&angles, p.bfl())
+    p.image_heights(&angles, film)
         .into_iter()
         .flatten()
         .map(f64::abs)

@@ -360,6 +360,19 @@ impl Prescription {
         -m.a / m.c
     }
 
+    /// Where the film goes to focus an axial point `distance` mm in front of the front vertex:
+    /// its distance behind the rear vertex, mm (paraxial: the image of the point through the
+    /// ray-transfer matrix); `None` where the image is virtual (the point is too close).
+    pub fn focus_distance(&self, distance: f64) -> Option<f64> {
+        let m = self.abcd(self.surfaces.len());
+        // A ray from the axis point with slope u reaches the front plane at height d·u, and
+        // leaves at height (a d + b) u with reduced slope (c d + d') u: it meets the axis
+        // again -(a d + b) / (c d + d') behind the rear vertex.
+        let (y, u) = (m.a * distance + m.b, m.c * distance + m.d);
+        let z = -y / u;
+        (z.is_finite() && z > 0.0).then_some(z)
+    }
+
     /// The entrance pupil (the stop as seen from the front, paraxially): its radius and its
     /// axial position, mm from the front vertex.
     pub fn entrance_pupil(&self) -> (f64, f64) {

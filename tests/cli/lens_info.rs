@@ -61,7 +61,7 @@ fn a_singlets_figures_are_the_thick_lens_ones() {
 
     for (bad, wanted) in [
         (format!("{spec},fstop=1"), "opens to f/"),
-        (format!("{spec},focus=2"), "focus"),
+        (format!("{spec},focus=0.001"), "too close"),
         (format!("{spec},iso=100"), "unknown key \"iso\""),
         (format!("{spec},sensor=-3"), "above 0"),
         ("prescription:".to_string(), "give the prescription's file"),

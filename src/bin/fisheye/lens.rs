@@ -53,11 +53,11 @@ pub(crate) enum LensCommand {
         out: PathBuf,
     },
     /// Print a lens's figures: its field of view and image circle for any spec; for a
-    /// prescription (`prescription:FILE[,sensor=MM][,fstop=N]`) also its paraxial focal
+    /// prescription (`prescription:FILE[,sensor=MM][,fstop=N][,focus=METRES]`) also its paraxial focal
     /// lengths (effective, and back from the rear vertex), f-number, entrance pupil and
     /// sensor.
     Info {
-        /// The lens spec (see `fisheye lens list`), or `prescription:FILE[,sensor=MM][,fstop=N]`
+        /// The lens spec (see `fisheye lens list`), or `prescription:FILE[,sensor=MM][,fstop=N][,focus=METRES]`
         /// for a table of glass surfaces in pbrt's format.
         spec: String,
         /// Image size in pixels, WIDTHxHEIGHT, for the figures in pixels.
@@ -119,6 +119,7 @@ pub(crate) fn info(spec: &str, size: ImageSize, json: bool) -> Result<()> {
             "entrance_pupil_position_mm": f.pupil_position_mm,
             "fov_deg": f.fov_deg,
             "image_circle_mm": f.image_circle_mm,
+            "film_mm": glass.film_mm,
             "sensor_mm": glass.sensor_mm,
             "size": size.to_string(),
             "pixel_um": pitch * 1e3,
@@ -159,6 +160,11 @@ pub(crate) fn info(spec: &str, size: ImageSize, json: bool) -> Result<()> {
                 "the full field any ray gets through",
             ),
             row("image_circle_mm", format!("{:.4}", f.image_circle_mm), ""),
+            row(
+                "film_mm",
+                format!("{:.4}", glass.film_mm),
+                "the film behind the rear vertex, at the focus",
+            ),
             row(
                 "sensor_mm",
                 format!("{:.4}", glass.sensor_mm),

@@ -104,6 +104,43 @@ fn a_collimated_paraxial_bundle_focuses_at_the_back_focal_length() {
     }
 }
 
+/// Focused at a finite distance, rays from the axial point there (near the axis, where
+/// paraxial optics holds) cross the axis at the film the ray-transfer matrix puts behind
+/// the rear vertex, within 1e-6 mm; the film moves back as the point comes closer (for the
+/// double Gauss at 1 m by about f² / (d − f) ≈ 2.6 mm), and reaches the back focal length at
+/// infinity.
+#[test]
+fn focusing_moves_the_film_to_the_image_of_the_point() {
+    for name in ["fisheye-10mm.dat", "dgauss-50mm.dat"] {
+        let lens = shipped(name);
+        let mut last = lens.bfl();
+        for distance in [1e4, 1e3, 300.0] {
+            let film = lens.focus_distance(distance).unwrap();
+            assert!(film > last, "{name} at {distance} mm: {film} mm");
+            last = film;
+            let focus = lens.rear_vertex() + film;
+            // Rays meeting the front at 1e-5 and 3e-5 of the pupil's radius.
+            for height in [1e-5, 3e-5] {
+                let slope = height * lens.entrance_pupil().0 / distance;
+                let ray = Ray {
+                    origin: DVec3::new(0.0, 0.0, -distance),
+                    direction: DVec3::new(slope, 0.0, 1.0).normalize(),
+                };
+                let out = lens.trace(ray).unwrap();
+                let crossing = out.origin.z - out.origin.x * out.direction.z / out.direction.x;
+                assert!(
+                    (crossing - focus).abs() < 1e-6,
+                    "{name}: {crossing} vs {focus}"
+                );
+            }
+        }
+        assert!((lens.focus_distance(1e12).unwrap() - lens.bfl()).abs() < 1e-6);
+    }
+    let extension =
+        shipped("dgauss-50mm.dat").focus_distance(1e3).unwrap() - shipped("dgauss-50mm.dat").bfl();
+    assert!((2.0..3.2).contains(&extension), "{extension} mm");
+}
+
 /// The published figures: the fisheye's 10 mm focal length (scaled from 100 mm) and its
 /// 155.9° field; the double Gauss's 50 mm at f/2.
 #[test]
