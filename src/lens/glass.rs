@@ -28,6 +28,9 @@ pub struct GlassLens {
     /// The film's distance behind the rear vertex, mm: the back focal length (focus at
     /// infinity) unless the spec's `focus` says otherwise.
     pub film_mm: f64,
+    /// Half the field of view any ray gets through, radians
+    /// ([`Prescription::half_field`], found once: it traces thousands of rays).
+    pub half_field: f64,
 }
 
 /// A prescription's chief-ray mapping fitted as a Kannala–Brandt model at an image size.
@@ -145,9 +148,10 @@ impl GlassLens {
                 ))
             })?,
         };
+        let half_field = prescription.half_field();
         let sensor_mm = match sensor {
             Some(mm) => mm,
-            None => image_circle(&prescription, film_mm).ok_or_else(|| {
+            None => image_circle(&prescription, film_mm, half_field).ok_or_else(|| {
                 err(
                     "no chief ray reaches the film, so the image circle, the default sensor \
                      width, is unknown: give sensor=MM"
@@ -159,6 +163,7 @@ impl GlassLens {
             prescription,
             sensor_mm,
             film_mm,
+            half_field,
         })
     }
 
@@ -170,7 +175,7 @@ impl GlassLens {
     pub fn fitted(&self, size: ImageSize) -> Result<Fitted, LensError> {
         let p = &self.prescription;
         let pitch = self.sensor_mm / f64::from(size.width);
-        let edge = p.half_field();
+        let edge = self.half_field;
         // The mapping's slope at the axis, from a chief ray 1e-5 rad off it (r = f tan θ
         // there to 1e-10).
         let tiny = 1e-5;
@@ -233,18 +238,17 @@ impl GlassLens {
             f_number: p.f_number(),
             pupil_radius_mm,
             pupil_position_mm,
-            fov_deg: 2.0 * p.half_field().to_degrees(),
-            image_circle_mm: image_circle(p, self.film_mm).unwrap_or(f64::NAN),
+            fov_deg: 2.0 * self.half_field.to_degrees(),
+            image_circle_mm: image_circle(p, self.film_mm, self.half_field).unwrap_or(f64::NAN),
         }
     }
 }
 
 /// The image circle's diameter, mm: twice the farthest the chief ray lands from the axis on
-/// a film `film` mm behind the rear vertex, over 256 angles out to the edge of the field any ray
-/// gets through (a chief ray may fail before that edge, reflected inside the glass, where
+/// a film `film` mm behind the rear vertex, over 256 angles out to `edge` (half the field any
+/// ray gets through; a chief ray may fail before that edge, reflected inside the glass, where
 /// rays off the stop's centre still pass).
-fn image_circle(p: &Prescription, film: f64) -> Option<f64> {
-    let edge = p.half_field();
+fn image_circle(p: &Prescription, film: f64, edge: f64) -> Option<f64> {
     let angles: Vec<f64> = (1..=256).map(|k| edge * f64::from(k) / 256.0).collect();
     p.image_heights(&angles, film)
         .into_iter()

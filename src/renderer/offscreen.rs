@@ -300,7 +300,8 @@ pub struct Offscreen {
     setup: Setup,
     passes: Vec<Pass>,
     queries: Option<Queries>,
-    /// The rays of a uniformly sampled frame: the pixels the lens gives a ray, times spp.
+    /// The rays of a uniformly sampled frame: the pixels the lens gives a ray, times spp (0
+    /// for other paths, which count their own or none).
     uniform_rays: u64,
 }
 
@@ -371,7 +372,12 @@ impl Offscreen {
         let path = Path::new(ctx, camera, scene, rays, cube.as_ref())?;
         let passes = setup.passes(ground_truth);
         let queries = Queries::new(ctx, passes.len() as u32);
-        let covered = camera.directions().iter().filter(|d| d.is_some()).count() as u64;
+        // Only a uniformly traced frame's rays are counted from the lens (an f64 evaluation
+        // a pixel, once).
+        let covered = match &path {
+            Path::Direct(_) => camera.directions().iter().filter(|d| d.is_some()).count(),
+            _ => 0,
+        } as u64;
         Ok(Self {
             path,
             setup,
