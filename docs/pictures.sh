@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Re-makes the pictures of the README and the book (docs/src/images/): three renders, an
-# adaptive render beside its spp map, the speed-against-error plot of results/lavapipe/, and
-# the strip the README opens with. Run from
+# adaptive render beside its spp map, three renders through lens prescriptions, the
+# speed-against-error plot of results/lavapipe/, and the strip the README opens with. Run from
 # anywhere after `cargo build --release`; about a minute on lavapipe. Needs python3 with
 # Pillow (`.ci/install-lavapipe` installs it). Each picture is kept under 300 KB.
 set -euo pipefail
@@ -32,6 +32,32 @@ pair.alpha_composite(rays, (room.width + 8, 0))
 pair.convert("RGB").save(f"{out}/adaptive.png", optimize=True)
 PY
 rm -f "$out/adaptive-room.png" "$out/adaptive-room.spp.png"
+# Real glass: Muller's fisheye through its fitted model (an ideal lens of the same mapping),
+# the same lens traced through its glass (vignetting, the image circle), and the double Gauss
+# wide open at f/2 focused at 2 m (depth of field), side by side.
+"$fisheye" render --lens prescription:lenses/fisheye-10mm.dat,rays=fit --size 400x300 --spp 16 \
+  -o "$out/glass-fit.png"
+"$fisheye" render --lens prescription:lenses/fisheye-10mm.dat --size 400x300 --spp 64 \
+  -o "$out/glass-fisheye.png"
+"$fisheye" render --lens prescription:lenses/dgauss-50mm.dat,sensor=30,focus=2 --size 400x300 \
+  --spp 64 -o "$out/glass-dgauss.png"
+python3 - "$out" <<'PY'
+import sys
+from PIL import Image
+
+out = sys.argv[1]
+tiles = [Image.open(f"{out}/glass-{n}.png").convert("RGBA") for n in ("fit", "fisheye", "dgauss")]
+row = Image.new("RGBA", (sum(t.width for t in tiles) + 8 * (len(tiles) - 1), 300), "white")
+x = 0
+for t in tiles:
+    row.alpha_composite(t, (x, 0))
+    x += t.width + 8
+row = row.convert("RGB").resize((row.width * 2 // 3, 200), Image.LANCZOS)
+row.quantize(colors=256, method=Image.Quantize.MEDIANCUT, dither=Image.Dither.FLOYDSTEINBERG).save(
+    f"{out}/glass.png", optimize=True
+)
+PY
+rm -f "$out"/glass-fit.png "$out"/glass-fisheye.png "$out"/glass-dgauss.png
 python3 - "$out" <<'PY'
 import sys
 from PIL import Image

@@ -15,7 +15,7 @@ use crate::split::SceneArrays;
 const SCENE_ARRAYS: &str = "scene_arrays";
 
 /// Every WGSL file of the project, by name (its file stem under `wgsl/`).
-pub const FILES: [(&str, &str); 29] = [
+pub const FILES: [(&str, &str); 31] = [
     ("math", include_str!("../wgsl/math.wgsl")),
     ("calibrated", include_str!("../wgsl/calibrated.wgsl")),
     ("triangles", include_str!("../wgsl/triangles.wgsl")),
@@ -32,6 +32,8 @@ pub const FILES: [(&str, &str); 29] = [
     ("adaptive_args", include_str!("../wgsl/adaptive_args.wgsl")),
     ("cast", include_str!("../wgsl/cast.wgsl")),
     ("lens", include_str!("../wgsl/lens.wgsl")),
+    ("glass", include_str!("../wgsl/glass.wgsl")),
+    ("glass_probe", include_str!("../wgsl/glass_probe.wgsl")),
     ("primary", include_str!("../wgsl/primary.wgsl")),
     ("lens_rays", include_str!("../wgsl/lens_rays.wgsl")),
     ("lens_points", include_str!("../wgsl/lens_points.wgsl")),

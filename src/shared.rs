@@ -63,6 +63,8 @@ pub const SURFACE_GLASS: u32 = 2;
 
 /// The WGSL id of a light kind: `LIGHT_POINT`, `LIGHT_DIRECTIONAL`.
 pub const LIGHT_KINDS: [(&str, u32); 2] = [("LIGHT_POINT", 0), ("LIGHT_DIRECTIONAL", 1)];
+/// The GPU glass's most surfaces and its exit pupil's radial bins (`lens::glass_gpu`).
+pub const GLASS_SIZES: [(&str, u32); 2] = [("GLASS_SURFACES", 32), ("PUPIL_BINS", 64)];
 
 /// The WGSL id of the stable direction formula (`DirectionFormula::Stable`), for the
 /// `DIRECTION_FORMULA` override.
@@ -312,6 +314,7 @@ pub fn wgsl_constants() -> Vec<(String, u32)> {
     ]
     .into_iter()
     .chain(LIGHT_KINDS)
+    .chain(GLASS_SIZES)
     .map(|(n, v)| (n.to_string(), v))
     .collect();
     out.extend(LensKind::ALL.iter().map(|k| (k.const_name(), *k as u32)));

@@ -48,12 +48,12 @@ struct AdaptiveParams {
 }
 
 // Per pixel: x the rays its colour took (the spp map), y what its centre ray saw (KEY_*).
-@group(0) @binding(6) var<storage, read_write> state: array<vec2<u32>>;
+@group(0) @binding(7) var<storage, read_write> state: array<vec2<u32>>;
 // The list's length (ADAPTIVE_COUNT) and the part of it to trace (ADAPTIVE_FIRST to
 // ADAPTIVE_END, set by `adaptive_args.wgsl`), then the list of pixel indices from
 // ADAPTIVE_HEADER on.
-@group(0) @binding(7) var<storage, read_write> work: array<atomic<u32>>;
-@group(0) @binding(8) var<uniform> adaptive: AdaptiveParams;
+@group(0) @binding(8) var<storage, read_write> work: array<atomic<u32>>;
+@group(0) @binding(9) var<uniform> adaptive: AdaptiveParams;
 
 // What `trace_list` does with the pixels listed: a pipeline for each (the modes' kernels
 // differ in size, and one kernel holding all four would be as slow as the largest).

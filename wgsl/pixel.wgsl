@@ -1,11 +1,17 @@
 // What every per-pixel tracing kernel shares (`trace.wgsl`, `adaptive.wgsl`): the frame, the
 // outputs, and a pixel's supersampled colour. Group 0's bindings 2 to 5; the lens and the
-// direction table (bindings 0 and 1) come from `primary.wgsl`.
+// direction table (bindings 0 and 1) come from `primary.wgsl`, the glass (binding 6, zero
+// without) from `glass.wgsl`.
 #import primary
 #import sampling
+#import glass
 #import shade
 
 override SAMPLES_PER_SIDE: u32 = 1u;
+// Whether the colour is traced through a prescription's glass (`glass`), sample by sample,
+// and in how many channels apart (3 where it disperses: a ray each for red, green and blue).
+override GLASS: bool = false;
+override GLASS_CHANNELS: u32 = 1u;
 
 // Mirrors `fisheye_rt::trace::Frame`: the camera-to-world rotation's columns (camera x right,
 // y down, z forward) and the eye. The scene is uploaded relative to its own camera, so the eye
@@ -77,6 +83,32 @@ fn samples(pixel: vec2<u32>, index: u32, side: u32) -> Sampled {
 // The pixel's SAMPLES_PER_SIDE² samples: their mean radiance, and the share with a ray (w).
 fn supersampled(pixel: vec2<u32>, index: u32) -> vec4<f32> {
     return samples(pixel, index, SAMPLES_PER_SIDE).colour;
+}
+
+// Pixel `pixel`'s image irradiance through the glass: the mean over its SAMPLES_PER_SIDE²
+// film samples of their rays' radiance times their weights (zero where blocked), so that
+// vignetting darkens and an out-of-focus point spreads as the glass makes them. Where the
+// glass disperses, each sample traces red, green and blue apart, each giving its channel.
+fn through_glass(pixel: vec2<u32>, index: u32) -> vec3<f32> {
+    let side = SAMPLES_PER_SIDE;
+    let centre = 0.5 * vec2<f32>(f32(lens.width), f32(lens.height));
+    var sum = vec3<f32>(0.0);
+    for (var k = 0u; k < side * side; k++) {
+        let p = vec2<f32>(pixel) + sample_offset(index, k, side) - centre;
+        let u = pupil_offset(index, k, side);
+        for (var c = 0u; c < GLASS_CHANNELS; c++) {
+            // One channel of three, or green's indices for all.
+            let s = glass_sample(p, u, select(1u, c, GLASS_CHANNELS == 3u));
+            if s.weight > 0.0 {
+                let ray = Ray(frame.eye.xyz + world(s.origin), world(s.direction), 0.0, 3.0e38);
+                let radiance = s.weight * shade(ray).colour;
+                // Channel c's part alone, or every channel without dispersion.
+                let part = vec3<u32>(0u, 1u, 2u) == vec3<u32>(c) | vec3<bool>(GLASS_CHANNELS == 1u);
+                sum += select(vec3<f32>(0.0), radiance, part);
+            }
+        }
+    }
+    return sum / f32(side * side);
 }
 
 // The ground truth of a primary hit: normal and distance, zero on a miss.

@@ -4,7 +4,9 @@
 //
 // With SAMPLES_PER_SIDE = s > 1 the colour is the mean radiance of s² jittered stratified
 // samples inside the pixel (a box filter), and w the share of them the lens covers; the
-// ground truth (geometry, id) stays the single ray through the pixel's centre.
+// ground truth (geometry, id) stays the single ray through the pixel's centre. With GLASS the
+// colour is traced through a prescription's surfaces instead (`through_glass`), and the
+// ground truth is its fitted model's centre ray.
 #import pixel
 
 @compute @workgroup_size(WORKGROUP_2D, WORKGROUP_2D)
@@ -19,7 +21,7 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     let ray = primary_ray(pixel);
     if ray.w == 0.0 {
         colour_out[stored] = vec4<f32>(0.0);
-        if SAMPLES_PER_SIDE > 1u {
+        if SAMPLES_PER_SIDE > 1u && !GLASS {
             colour_out[stored] = supersampled(pixel, index);
         }
         geometry_out[stored] = vec4<f32>(0.0);
@@ -28,7 +30,11 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     }
     let centre = from_eye(ray.xyz);
     var traced: Traced;
-    if SAMPLES_PER_SIDE > 1u {
+    if GLASS {
+        // The glass makes the colour; the fitted model's centre ray, the ground truth.
+        traced = first_hit(centre);
+        colour_out[stored] = vec4<f32>(through_glass(pixel, index), 1.0);
+    } else if SAMPLES_PER_SIDE > 1u {
         // The samples make the colour; the centre gives the ground truth, its hit alone.
         traced = first_hit(centre);
         colour_out[stored] = supersampled(pixel, index);

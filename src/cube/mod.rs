@@ -210,6 +210,13 @@ impl CubeMap {
         scene: &GpuScene,
         settings: &CubeSettings,
     ) -> Result<Self> {
+        if camera.glass.is_some() {
+            return Err(Error::Option(
+                "a cube map resamples by direction and cannot trace a prescription's glass: \
+                 give rays=fit in the lens spec to render its fitted model through a cube map"
+                    .into(),
+            ));
+        }
         let size = settings.size;
         let max = ctx.device.limits().max_texture_dimension_2d;
         if size == 0 || bordered(size) > max {

@@ -23,6 +23,7 @@
 
 use glam::{DVec2, DVec3};
 
+use super::glass_gpu::GlassParams;
 use super::model::Lens;
 use crate::error::LensError;
 
@@ -134,6 +135,10 @@ pub struct LensCamera {
     pub size: ImageSize,
     /// How directions are constructed.
     pub formula: DirectionFormula,
+    /// A prescription's glass that direct tracing renders the colour through, sample by
+    /// sample ([`super::glass_gpu`]); `lens` is then its chief rays' fitted mapping, which
+    /// the mask, projection and ground truth follow.
+    pub glass: Option<GlassParams>,
 }
 
 impl LensCamera {
@@ -144,6 +149,15 @@ impl LensCamera {
             lens: lens.into(),
             size,
             formula: DirectionFormula::Stable,
+            glass: None,
+        }
+    }
+
+    /// The same camera rendering its colour through `glass`.
+    pub fn with_glass(self, glass: GlassParams) -> Self {
+        Self {
+            glass: Some(glass),
+            ..self
         }
     }
 
@@ -163,6 +177,7 @@ impl LensCamera {
         Ok(Self {
             lens,
             size,
+            glass: self.glass.map(|g| g.scaled(factor)),
             ..*self
         })
     }

@@ -1,16 +1,24 @@
-//! A lens prescription on a camera: the spec `prescription:FILE[,sensor=MM][,fstop=N][,focus=METRES]` and
-//! the figures `fisheye lens info` prints for it (see [`super::prescription`] for the glass).
+//! A lens prescription on a camera: the spec
+//! `prescription:FILE[,sensor=MM][,fstop=N][,focus=METRES][,rays=glass|fit]` and the figures
+//! `fisheye lens info` prints for it (see [`super::prescription`] for the glass).
 //!
 //! `sensor` is the image's width on the film in millimetres (pixels are square); by default
 //! the image circle's diameter, so that the circle spans the image's width. `fstop` stops the
 //! aperture down to that f-number (not below the lens's own). `focus` is the distance in
 //! metres from the front vertex to the plane in focus, where the film sits at the paraxial
 //! image of its axial point; by default infinity (the film at the back focal length).
+//!
+//! `rays` says how direct tracing renders the colour: `glass` (the default) traces every
+//! sample through the surfaces from its place on the film ([`super::glass_gpu`]: vignetting,
+//! depth of field), `fit` through the chief rays' fitted model, a mapping like any other lens
+//! (cheaper; what cube maps use either way). Projection, unprojection and the ground-truth
+//! arrays follow the fitted model: the chief rays.
 
 use std::path::Path;
 
 use super::calibrated::{CalibratedLens, CalibratedModel, Intrinsics};
 use super::camera::{ImageSize, LensCamera};
+use super::glass_gpu::GlassParams;
 use super::prescription::Prescription;
 use super::spec::parse_spec;
 use crate::error::LensError;
@@ -31,6 +39,9 @@ pub struct GlassLens {
     /// Half the field of view any ray gets through, radians
     /// ([`Prescription::half_field`], found once: it traces thousands of rays).
     pub half_field: f64,
+    /// Whether direct tracing renders through the glass (`rays=glass`, the default) or
+    /// through the fitted model (`rays=fit`).
+    pub through_glass: bool,
 }
 
 /// A prescription's chief-ray mapping fitted as a Kannala–Brandt model at an image size.
@@ -53,10 +64,22 @@ impl Fitted {
 }
 
 /// The camera of `spec` at `size`: a prescription's fitted chief-ray mapping
-/// ([`GlassLens::fitted`]), any other spec's lens ([`parse_spec`]).
+/// ([`GlassLens::fitted`]) with its glass unless the spec says `rays=fit`, any other spec's
+/// lens ([`parse_spec`]).
 pub fn camera_for(spec: &str, size: ImageSize) -> Result<LensCamera, LensError> {
     if GlassLens::is_spec(spec) {
-        Ok(GlassLens::parse(spec)?.fitted(size)?.camera)
+        let glass = GlassLens::parse(spec)?;
+        let camera = glass.fitted(size)?.camera;
+        if !glass.through_glass {
+            return Ok(camera);
+        }
+        let glass = GlassParams::new(
+            &glass.prescription,
+            glass.film_mm,
+            glass.sensor_mm,
+            (size.width, size.height),
+        )?;
+        Ok(camera.with_glass(glass))
     } else {
         Ok(LensCamera::new(parse_spec(spec)?, size))
     }
@@ -88,7 +111,8 @@ impl GlassLens {
         spec.trim_start().starts_with(PREFIX)
     }
 
-    /// Reads `prescription:FILE[,sensor=MM][,fstop=N][,focus=METRES]`, loading FILE.
+    /// Reads `prescription:FILE[,sensor=MM][,fstop=N][,focus=METRES][,rays=glass|fit]`,
+    /// loading FILE.
     pub fn parse(spec: &str) -> Result<Self, LensError> {
         let err = |reason: String| LensError::Spec {
             spec: spec.to_string(),
@@ -103,11 +127,22 @@ impl GlassLens {
         if file.is_empty() {
             return Err(err("give the prescription's file: prescription:FILE".into()));
         }
-        let (mut sensor, mut fstop, mut focus) = (None, None, None);
+        let (mut sensor, mut fstop, mut focus, mut rays) = (None, None, None, None);
         for pair in parts.map(str::trim).filter(|p| !p.is_empty()) {
             let (key, value) = pair
                 .split_once('=')
                 .ok_or_else(|| err(format!("{pair:?} is not key=value")))?;
+            if key.trim() == "rays" {
+                let through = match value.trim() {
+                    "glass" => true,
+                    "fit" => false,
+                    other => return Err(err(format!("rays = {other:?}: say glass or fit"))),
+                };
+                if rays.replace(through).is_some() {
+                    return Err(err("rays is given twice".into()));
+                }
+                continue;
+            }
             let number: f64 = value
                 .trim()
                 .parse()
@@ -120,8 +155,8 @@ impl GlassLens {
                 "focus" => &mut focus,
                 other => {
                     return Err(err(format!(
-                        "unknown key {other:?}; a prescription takes sensor=MM, fstop=N and \
-                         focus=METRES"
+                        "unknown key {other:?}; a prescription takes sensor=MM, fstop=N, \
+                         focus=METRES and rays=glass|fit"
                     )));
                 }
             };
@@ -164,6 +199,7 @@ impl GlassLens {
             sensor_mm,
             film_mm,
             half_field,
+            through_glass: rays.unwrap_or(true),
         })
     }
 

@@ -330,3 +330,69 @@ impl LensPoints {
         Ok(out)
     }
 }
+
+/// Traces `rays` (lens frame, from the film's side) out through `glass` in `channel` (0 red,
+/// 1 green, 2 blue: the C, d and F lines) with the WGSL twin (`wgsl/glass_probe.wgsl`):
+/// where each leaves the front surface, `None` where the glass blocks it. For tests of the
+/// twin against [`super::prescription::Prescription::trace_from_film`].
+pub fn trace_on_gpu(
+    ctx: &crate::gpu::GpuContext,
+    glass: &super::glass_gpu::GlassParams,
+    rays: &[super::prescription::Ray],
+    channel: u32,
+) -> Result<Vec<Option<super::prescription::Ray>>> {
+    let input: Vec<[f32; 4]> = rays
+        .iter()
+        .flat_map(|r| {
+            let v = |v: DVec3, w: f32| [v.x as f32, v.y as f32, v.z as f32, w];
+            [v(r.origin, channel as f32), v(r.direction, 0.0)]
+        })
+        .collect();
+    let results = ctx.checked("tracing rays through the glass", || {
+        let device = &ctx.device;
+        let pipeline = crate::shader::compute_pipeline(device, "glass_probe", "main", &[], &[]);
+        let usage = wgpu::BufferUsages::STORAGE;
+        let params = crate::gpu::buffer_init(
+            device,
+            "fisheye.glass_probe.glass",
+            bytemuck::bytes_of(glass),
+            wgpu::BufferUsages::UNIFORM,
+        );
+        let input = crate::gpu::buffer_init(
+            device,
+            "fisheye.glass_probe.rays",
+            bytemuck::cast_slice(&input),
+            usage,
+        );
+        let results = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("fisheye.glass_probe.results"),
+            size: input.size(),
+            usage: usage | wgpu::BufferUsages::COPY_SRC,
+            mapped_at_creation: false,
+        });
+        let entries = [(0, &input), (1, &results), (6, &params)].map(|(binding, buffer)| {
+            wgpu::BindGroupEntry {
+                binding,
+                resource: buffer.as_entire_binding(),
+            }
+        });
+        let group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("fisheye.glass_probe"),
+            layout: &pipeline.get_bind_group_layout(0),
+            entries: &entries,
+        });
+        crate::gpu::submit_over_elements(ctx, &pipeline, &group, rays.len());
+        results
+    })?;
+    let out = ctx.read_buffer::<[f32; 4]>(&results)?;
+    let v = |a: [f32; 4]| DVec3::new(a[0].into(), a[1].into(), a[2].into());
+    Ok(out
+        .chunks_exact(2)
+        .map(|pair| {
+            (pair[0][3] == 1.0).then(|| super::prescription::Ray {
+                origin: v(pair[0]),
+                direction: v(pair[1]),
+            })
+        })
+        .collect())
+}

@@ -9,6 +9,7 @@ mod calibrated;
 mod camera;
 pub mod fit;
 pub mod glass;
+pub mod glass_gpu;
 pub mod gpu;
 mod json;
 mod model;

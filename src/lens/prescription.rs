@@ -9,7 +9,8 @@
 //! index aperture` in millimetres (radius of curvature, positive when its centre lies behind
 //! the surface toward the film; axial distance to the next surface; refractive index of the
 //! medium behind the surface, 0 or 1 for air; clear aperture diameter); a radius of 0 is the
-//! aperture stop; `#` starts a comment.
+//! aperture stop; `#` starts a comment. A fifth column, optional, gives the medium's Abbe
+//! number V_d, which makes its index depend on the wavelength ([`Prescription::at_wavelength`]).
 //!
 //! Coordinates: millimetres, z along the optical axis from the front vertex (z = 0) toward
 //! the film, light travelling toward +z.
@@ -25,6 +26,15 @@ use crate::error::LensError;
 /// The most surfaces a prescription may list.
 pub const MAX_SURFACES: usize = 64;
 
+/// The Fraunhofer lines that define a glass's index and Abbe number, nm: C (red, hydrogen),
+/// d (yellow, helium) and F (blue, hydrogen). The renderer's red, green and blue channels are
+/// traced at C, d and F.
+pub const LINE_C_NM: f64 = 656.27;
+/// The d line, nm (see [`LINE_C_NM`]).
+pub const LINE_D_NM: f64 = 587.56;
+/// The F line, nm (see [`LINE_C_NM`]).
+pub const LINE_F_NM: f64 = 486.13;
+
 /// One surface of a prescription.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Surface {
@@ -38,6 +48,9 @@ pub struct Surface {
     pub index: f64,
     /// Clear aperture diameter, mm.
     pub aperture: f64,
+    /// The Abbe number V_d of the medium behind the surface, if the file gives one: its
+    /// dispersion (none without).
+    pub abbe: Option<f64>,
 }
 
 impl Surface {
@@ -149,14 +162,19 @@ impl Prescription {
                 .map(|v| v.parse::<f64>().map_err(|_| v))
                 .collect::<Result<_, _>>()
                 .map_err(|v| bad(number, format!("{v:?} is not a number")))?;
-            let [radius, thickness, index, aperture] = values[..] else {
-                return Err(bad(
-                    number,
-                    format!(
-                        "{} values; a surface is 4: radius thickness index aperture (mm)",
-                        values.len()
-                    ),
-                ));
+            let (radius, thickness, index, aperture, abbe) = match values[..] {
+                [r, t, n, a] => (r, t, n, a, None),
+                [r, t, n, a, v] => (r, t, n, a, Some(v)),
+                _ => {
+                    return Err(bad(
+                        number,
+                        format!(
+                            "{} values; a surface is 4: radius thickness index aperture (mm), \
+                             and optionally the Abbe number",
+                            values.len()
+                        ),
+                    ));
+                }
             };
             if values.iter().any(|v| !v.is_finite()) {
                 return Err(bad(number, "values must be finite".into()));
@@ -185,6 +203,17 @@ impl Prescription {
                     ),
                 ));
             }
+            if let Some(v) = abbe
+                && (medium(index) == 1.0 || v <= 0.0)
+            {
+                return Err(bad(
+                    number,
+                    format!(
+                        "Abbe number {v}: give one above 0, and only for glass (an index above \
+                         1)"
+                    ),
+                ));
+            }
             if surfaces.len() == MAX_SURFACES {
                 return Err(bad(number, format!("more than {MAX_SURFACES} surfaces")));
             }
@@ -193,6 +222,7 @@ impl Prescription {
                 thickness,
                 index: medium(index),
                 aperture,
+                abbe,
             });
             last_line = number;
         }
@@ -276,6 +306,26 @@ impl Prescription {
         *self.vertices.last().expect("a prescription has surfaces")
     }
 
+    /// Whether any medium's index depends on the wavelength (the file gives Abbe numbers).
+    pub fn is_dispersive(&self) -> bool {
+        self.surfaces.iter().any(|s| s.abbe.is_some())
+    }
+
+    /// The same lens at wavelength `nm`: each medium with an Abbe number V_d takes the index
+    /// of Cauchy's two-term law n(λ) = A + B/λ² through its n_d at the d line with
+    /// n_F − n_C = (n_d − 1)/V_d (the Abbe number's definition); others keep theirs.
+    pub fn at_wavelength(&self, nm: f64) -> Self {
+        let mut out = self.clone();
+        for s in &mut out.surfaces {
+            if let Some(v) = s.abbe {
+                let b = (s.index - 1.0) / v / (LINE_F_NM.powi(-2) - LINE_C_NM.powi(-2));
+                let a = s.index - b / (LINE_D_NM * LINE_D_NM);
+                s.index = a + b / (nm * nm);
+            }
+        }
+        out
+    }
+
     /// The same lens with the stop's diameter scaled by `scale` (stopping down below 1).
     pub fn with_stop_scaled(&self, scale: f64) -> Self {
         let mut out = self.clone();
@@ -328,6 +378,42 @@ impl Prescription {
     /// Traces `ray` from in front of the lens through every surface, apertures clipping it.
     pub fn trace(&self, ray: Ray) -> Result<Ray, Blocked> {
         self.trace_range(ray, 0, self.surfaces.len(), true)
+    }
+
+    /// Traces `ray` from behind the lens (the film's side, travelling toward −z) back out
+    /// through every surface, rear to front, apertures clipping it: where it leaves the front
+    /// surface, toward the scene. Light runs the same path the other way (the `wgsl/glass.wgsl`
+    /// twin traces the rays of film pixels so).
+    pub fn trace_from_film(&self, ray: Ray) -> Result<Ray, Blocked> {
+        let mut ray = ray;
+        for (k, s) in self.surfaces.iter().enumerate().rev() {
+            let vertex = DVec3::new(0.0, 0.0, self.vertices[k]);
+            // Mirrored in z, the ray travels toward +z onto a surface of the opposite radius.
+            let flip = DVec3::new(1.0, 1.0, -1.0);
+            let local = (ray.origin - vertex) * flip;
+            let (t, normal) =
+                intersect(local, ray.direction * flip, -s.radius).ok_or(Blocked::Missed(k))?;
+            let hit = (local + t * ray.direction * flip) * flip;
+            if hit.x * hit.x + hit.y * hit.y > 0.25 * s.aperture * s.aperture {
+                return Err(Blocked::Aperture(k));
+            }
+            let direction = if s.is_stop() {
+                ray.direction
+            } else {
+                let before = if k == 0 {
+                    1.0
+                } else {
+                    self.surfaces[k - 1].index
+                };
+                refract(ray.direction, normal * flip, s.index / before)
+                    .ok_or(Blocked::Reflected(k))?
+            };
+            ray = Ray {
+                origin: hit + vertex,
+                direction,
+            };
+        }
+        Ok(ray)
     }
 
     /// The paraxial ray-transfer matrix from the front vertex's plane to surface `to`'s

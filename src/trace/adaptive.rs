@@ -121,6 +121,13 @@ impl AdaptivePass {
                 options.threshold
             )));
         }
+        if camera.glass.is_some() {
+            return Err(Error::Option(
+                "adaptive sampling through a prescription's glass is not built yet: give \
+                 --spp N, or rays=fit in the lens spec for its fitted model"
+                    .into(),
+            ));
+        }
         let trace = TracePass::supersampled(ctx, camera, scene, source, spp)?;
         if trace.bands() > 1 {
             return Err(Error::Limit(format!(
@@ -198,9 +205,9 @@ impl AdaptivePass {
             // Group 0 as wgsl/pixel.wgsl and wgsl/adaptive.wgsl declare it.
             let mut entries = shared_entries().to_vec();
             entries.extend([
-                storage_entry(6, false),
                 storage_entry(7, false),
-                uniform_entry(8),
+                storage_entry(8, false),
+                uniform_entry(9),
             ]);
             let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
                 label: Some("fisheye.adaptive"),

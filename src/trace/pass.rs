@@ -46,6 +46,8 @@ pub struct TracePass {
     /// that share the trace kernel's group 0 (`AdaptivePass`).
     lens: wgpu::Buffer,
     table: wgpu::Buffer,
+    /// The camera's glass (zeros without: `GLASS` is off then).
+    glass: wgpu::Buffer,
     constants: Vec<(&'static str, f64)>,
     samples_per_side: u32,
     camera: LensCamera,
@@ -153,6 +155,7 @@ impl TracePass {
                 None => output("fisheye.trace.no_table", 16, none),
             };
             let lens = params_buffer(device, camera);
+            let glass = glass_buffer(device, camera);
             let bind_groups = (0..frames.len() as u64)
                 .map(|view| {
                     let slot = wgpu::BufferBinding {
@@ -171,6 +174,7 @@ impl TracePass {
                             colour.as_entire_binding(),
                             geometry.as_entire_binding(),
                             ids.as_entire_binding(),
+                            glass.as_entire_binding(),
                         ],
                     )
                 })
@@ -184,6 +188,7 @@ impl TracePass {
                 frame,
                 lens,
                 table,
+                glass,
                 constants,
                 samples_per_side,
                 camera: *camera,
@@ -249,9 +254,9 @@ impl TracePass {
     }
 
     /// Group 0's shared bindings in `wgsl/pixel.wgsl`'s order (lens, table, the first view's
-    /// frame, colour, geometry, ids), for kernels that trace as this pass does. Only for an
-    /// image traced in one band.
-    pub(crate) fn shared_bindings(&self) -> [wgpu::BindingResource<'_>; 6] {
+    /// frame, colour, geometry, ids, glass), for kernels that trace as this pass does. Only
+    /// for an image traced in one band.
+    pub(crate) fn shared_bindings(&self) -> [wgpu::BindingResource<'_>; 7] {
         [
             self.lens.as_entire_binding(),
             self.table.as_entire_binding(),
@@ -263,6 +268,7 @@ impl TracePass {
             self.colour.as_entire_binding(),
             self.geometry.as_entire_binding(),
             self.ids.as_entire_binding(),
+            self.glass.as_entire_binding(),
         ]
     }
 
@@ -385,8 +391,8 @@ impl TracePass {
 
 /// Group 0's entries that every kernel tracing a pixel binds, as `wgsl/primary.wgsl` and
 /// `wgsl/pixel.wgsl` declare them: the lens and the direction table, the frame, the colour,
-/// geometry and id outputs ([`TracePass::shared_bindings`] in this order).
-pub(crate) fn shared_entries() -> [wgpu::BindGroupLayoutEntry; 6] {
+/// geometry and id outputs, the glass ([`TracePass::shared_bindings`] in this order).
+pub(crate) fn shared_entries() -> [wgpu::BindGroupLayoutEntry; 7] {
     [
         uniform_entry(0),
         storage_entry(1, true),
@@ -394,7 +400,19 @@ pub(crate) fn shared_entries() -> [wgpu::BindGroupLayoutEntry; 6] {
         storage_entry(3, false),
         storage_entry(4, false),
         storage_entry(5, false),
+        uniform_entry(6),
     ]
+}
+
+/// The uniform of `camera`'s glass, zeros where it has none (`GLASS` is off then).
+fn glass_buffer(device: &wgpu::Device, camera: &LensCamera) -> wgpu::Buffer {
+    let params = camera.glass.unwrap_or_else(bytemuck::Zeroable::zeroed);
+    crate::gpu::buffer_init(
+        device,
+        "fisheye.trace.glass",
+        bytemuck::bytes_of(&params),
+        wgpu::BufferUsages::UNIFORM,
+    )
 }
 
 /// The overrides of a kernel that traces `camera`'s rays in `scene` as the trace kernel does.
@@ -412,6 +430,11 @@ fn trace_constants(
         (
             "HAS_TRANSLUCENT",
             f64::from(u8::from(scene.features.translucent)),
+        ),
+        ("GLASS", f64::from(u8::from(camera.glass.is_some()))),
+        (
+            "GLASS_CHANNELS",
+            f64::from(camera.glass.map_or(1, |g| g.counts[2])),
         ),
     ]);
     constants

@@ -64,6 +64,7 @@ fn a_singlets_figures_are_the_thick_lens_ones() {
         (format!("{spec},focus=0.001"), "too close"),
         (format!("{spec},iso=100"), "unknown key \"iso\""),
         (format!("{spec},sensor=-3"), "above 0"),
+        (format!("{spec},rays=chief"), "say glass or fit"),
         ("prescription:".to_string(), "give the prescription's file"),
         (
             format!("prescription:{}/none.dat", dir.display()),
@@ -113,12 +114,14 @@ fn a_models_field_and_image_circle() {
     assert!(info["efl_mm"].is_null() && info["f_number"].is_null());
 }
 
-/// `--lens prescription:...` renders through the lens's chief rays (fitted as Kannala–Brandt,
-/// see `lens info`): with the default sensor the image circle spans the image's width, so the
-/// middle row is covered to both edges and the corners are not; a direction projects where
-/// `lens project` says, upright.
+/// `--lens prescription:...` renders the colour through the glass, and its mask, projection
+/// and calibration follow its chief rays (fitted as Kannala–Brandt, see `lens info`): with the
+/// default sensor the image circle spans the image's width, so the middle row is covered to
+/// both edges and the corners are not; a direction projects where `lens project` says,
+/// upright. What cannot trace the glass says so: a cube map and adaptive sampling (until they
+/// do), pointing to `rays=fit`, with which they render the fitted model.
 #[test]
-fn a_prescription_renders_through_its_chief_rays() {
+fn a_prescription_renders_through_its_glass_and_maps_by_its_chief_rays() {
     let dir = std::env::temp_dir().join(format!("fisheye-glass-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let out = dir.join("glass.png");
@@ -137,6 +140,31 @@ fn a_prescription_renders_through_its_chief_rays() {
     let at = |x: usize, y: usize| mask[y * 160 + x];
     assert_eq!((at(0, 60), at(159, 60), at(80, 0)), (1, 1, 1));
     assert_eq!((at(0, 0), at(159, 119)), (0, 0));
+    for (extra, wanted) in [
+        (
+            &["--method", "cube-rt"][..],
+            "cannot trace a prescription's glass",
+        ),
+        (
+            &["--spp", "auto"][..],
+            "adaptive sampling through a prescription's glass",
+        ),
+    ] {
+        let spec_args = ["render", "--lens", &spec, "--size", "32x24"];
+        let bad = [&spec_args[..], extra, &["-o", out.to_str().unwrap()]].concat();
+        let said = fisheye(&bad, "");
+        let message = String::from_utf8_lossy(&said.stderr);
+        assert!(
+            !said.status.success() && message.contains(wanted) && message.contains("rays=fit"),
+            "{extra:?}: {message}"
+        );
+        let fit = format!("{spec},rays=fit");
+        let fitted = [&["render", "--lens", &fit, "--size", "32x24"][..], extra].concat();
+        stdout(&fisheye(
+            &[&fitted[..], &["-o", out.to_str().unwrap()]].concat(),
+            "",
+        ));
+    }
     // Straight ahead lands at the centre; 60° to the right, right of it on the middle row.
     let text = stdout(&fisheye(
         &["lens", "project", "--lens", &spec, "--size", "160x120"],

@@ -190,6 +190,20 @@ pub(crate) fn render(args: &RenderArgs) -> Result<()> {
         "lens: {} at {}; compiling the kernels...",
         camera.lens, camera.size
     );
+    if let Some(glass) = &camera.glass {
+        println!(
+            "glass: each sample traced through the prescription's {} surfaces from its place on \
+             the film (vignetting, depth of field); the mask, projection and ground truth \
+             follow the fitted chief rays above",
+            glass.counts[0]
+        );
+        if args.spp.options(false).0 < 16 {
+            eprintln!(
+                "warning: through glass each sample sees one point of the exit pupil: give \
+                 --spp 64 or so for a smooth picture"
+            );
+        }
+    }
     let renderer = Offscreen::with_directions(
         &ctx,
         &camera,

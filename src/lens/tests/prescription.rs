@@ -264,6 +264,9 @@ fn bad_prescriptions_name_their_line() {
         ("0 1 0 10\n50 2 1.5 nan\n", 2, "finite"),
         ("# nothing\n0 1 0 10\n", 2, "no refracting surface"),
         ("0 1 0 10\n50 2 1.5 30\n", 2, "through air"),
+        ("0 1 0 10 40\n50 2 1.5 30\n-50 0 1 30\n", 1, "only for glass"),
+        ("0 1 0 10\n50 2 1.5 30 -3\n-50 0 1 30\n", 2, "above 0"),
+        ("0 1 0 10\n50 2 1.5 30 40 1\n", 2, "6 values"),
     ] {
         let message = Prescription::parse(text, "my.dat").unwrap_err().to_string();
         assert!(
@@ -314,4 +317,59 @@ fn the_fitted_camera_follows_the_chief_rays() {
     let d = DVec3::new(edge.sin(), 0.0, edge.cos());
     let x = fitted.camera.project(d).map(|p| p.x);
     assert!(x.is_some_and(|x| (x - 1024.0).abs() < 1.0), "{x:?}");
+}
+
+/// Light runs a path both ways: a ray traced from the object side through either shipped
+/// lens, turned round at the film, traces back out along the line it came in on (to 1e-9 mm
+/// and 1e-12 of a unit direction), and one clipped going in is clipped coming back.
+#[test]
+fn tracing_from_the_film_retraces_the_light() {
+    for name in ["fisheye-10mm.dat", "dgauss-50mm.dat"] {
+        let lens = shipped(name);
+        // Rays about the chief rays of 20 angles, shifted across the pupil and out of the
+        // meridional plane.
+        let thetas: Vec<f64> = (0..20)
+            .map(|k| 0.9 * lens.half_field() * f64::from(k) / 20.0)
+            .collect();
+        let chiefs = lens.chief_rays(&thetas);
+        let pupil = lens.entrance_pupil().0;
+        let (mut through, mut clipped) = (0, 0);
+        for i in 0..400 {
+            let chief = chiefs[i % 20].expect("a chief ray inside the field");
+            let direction = chief.direction;
+            let h = 3.0 * pupil * ((i / 20) as f64 / 19.0 - 0.5);
+            let across = DVec3::new(direction.z, 0.3, -direction.x).normalize();
+            let ray = Ray {
+                origin: chief.origin + h * across,
+                direction,
+            };
+            let Ok(out) = lens.trace(ray) else {
+                // Reversed from behind the rear surface, the same path is blocked too.
+                clipped += 1;
+                continue;
+            };
+            let back = lens
+                .trace_from_film(Ray {
+                    origin: out.origin + out.direction,
+                    direction: -out.direction,
+                })
+                .unwrap_or_else(|why| panic!("{name}: ray {i} blocked coming back: {why:?}"));
+            through += 1;
+            // The returning ray lies on the incoming line, reversed.
+            let offset = back.origin - ray.origin;
+            let off_line = (offset - offset.dot(direction) * direction).length();
+            assert!(
+                off_line < 1e-9,
+                "{name}: ray {i} returns {off_line:e} mm off its line"
+            );
+            assert!(
+                (back.direction + direction).length() < 1e-12,
+                "{name}: ray {i}"
+            );
+        }
+        assert!(
+            through > 100 && clipped > 20,
+            "{name}: {through} through, {clipped} clipped"
+        );
+    }
 }

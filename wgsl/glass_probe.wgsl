@@ -1,0 +1,23 @@
+// Traces arbitrary rays from the film's side out through a prescription, one invocation per
+// ray in WORKGROUP_1D-wide groups: the GPU twin held to `Prescription::trace_from_film` by
+// the tests.
+// Binding 6: the glass (`glass.wgsl`).
+#import glass
+
+// Per ray: its origin (w: the channel, 0 red, 1 green, 2 blue), then its unit direction
+// (lens frame, mm).
+@group(0) @binding(0) var<storage, read> rays: array<vec4<f32>>;
+// Per ray: where it leaves the front surface (w = 1 if it got through, else 0), then its
+// direction there.
+@group(0) @binding(1) var<storage, read_write> results: array<vec4<f32>>;
+
+@compute @workgroup_size(WORKGROUP_1D)
+fn main(@builtin(global_invocation_id) id: vec3<u32>) {
+    let i = id.x;
+    if 2u * i + 1u >= arrayLength(&rays) {
+        return;
+    }
+    let out = glass_trace(rays[2u * i].xyz, rays[2u * i + 1u].xyz, u32(rays[2u * i].w));
+    results[2u * i] = vec4<f32>(out.origin, select(0.0, 1.0, out.passed));
+    results[2u * i + 1u] = vec4<f32>(out.direction, 0.0);
+}
