@@ -339,3 +339,55 @@ fn banded_frames_are_timed_whole() {
     assert!(banded.colour == whole.colour && banded.ids == whole.ids);
     assert!(banded.counts().1 > 1000, "the grid is in view");
 }
+
+/// A prescription's glass is timed beside its fitted model (`rays=fit`): the glass runs the
+/// uniform direct setups, its cube-map setup is skipped and listed saying why, and the fitted
+/// model runs every setup, so a frame through the glass and one through its model stand in the
+/// same report.
+#[test]
+fn a_prescriptions_glass_is_timed_beside_its_fitted_model() {
+    let scene = builtin::scene("default").unwrap();
+    let size = fisheye_rt::lens::ImageSize::new(32, 24).unwrap();
+    let spec = format!(
+        "prescription:{}/lenses/fisheye-10mm.dat",
+        env!("CARGO_MANIFEST_DIR")
+    );
+    let lenses = [
+        LensRun {
+            name: "glass".into(),
+            camera: fisheye_rt::lens::glass::camera_for(&spec, size).unwrap(),
+        },
+        LensRun {
+            name: "fit".into(),
+            camera: fisheye_rt::lens::glass::camera_for(&format!("{spec},rays=fit"), size).unwrap(),
+        },
+    ];
+    let cube = Method::Cube(fisheye_rt::cube::CubeMethod::Traced);
+    let all = Setup::all(&[Method::Rt, cube], &[16], &[Sampling::Uniform(4)]);
+    let scenes = SceneSet::new(ctx(), &scene, &RenderOptions::default(), &all).unwrap();
+    let study = study_on(&scene, &scenes, &lenses, &all);
+    let report = report::bench(&study, PathKind::Walk, 2, 1, &mut |_| {}).unwrap();
+    let ran: Vec<(String, String)> = report
+        .entries
+        .iter()
+        .map(|e| (e.lens.clone(), e.setup.clone()))
+        .collect();
+    let pair = |l: &str, s: &str| (l.to_string(), s.to_string());
+    assert_eq!(
+        ran,
+        [
+            pair("glass", "rt@4spp"),
+            pair("fit", "rt@4spp"),
+            pair("fit", "cube-rt@16")
+        ]
+    );
+    assert!(
+        report
+            .skipped
+            .iter()
+            .any(|s| s.starts_with("glass cube-rt@16: ") && s.contains("rays=fit")),
+        "{:?}",
+        report.skipped
+    );
+    assert!(report.entries.iter().all(|e| e.gpu.is_some()));
+}

@@ -111,8 +111,9 @@ struct Lens {
 impl Lens {
     /// A lens from its spec (see `fisheye lens list`: `"samyang-7.5mm"`,
     /// `"equisolid:f=0.6,fov=180"`, `"kb:fx=...,k1=..."`, or
-    /// `"prescription:FILE[,sensor=MM][,fstop=N][,focus=METRES]"` for a lens's glass, through its chief
-    /// rays) at `size = (width, height)`.
+    /// `"prescription:FILE[,sensor=MM][,fstop=N][,focus=METRES][,rays=glass|fit]"` for a
+    /// lens's glass: rendered through its surfaces, mapped by its chief rays) at
+    /// `size = (width, height)`.
     #[staticmethod]
     fn from_spec(spec: &str, size: (u32, u32)) -> PyResult<Self> {
         let size = ImageSize::new(size.0, size.1).map_err(lens_error)?;
@@ -328,9 +329,9 @@ impl Spp {
     }
 }
 
-/// A pass's key: the lens, its size, the sampling (as `--spp` writes it) and whether the
-/// ground truth is traced everywhere.
-type PassKey = (String, u32, u32, String, bool);
+/// A pass's key: the camera (its lens, size and glass, as `Debug` writes them), the sampling
+/// (as `--spp` writes it) and whether the ground truth is traced everywhere.
+type PassKey = (String, String, bool);
 
 /// What a renderer keeps between calls: the scene on the GPU and the passes of each lens and
 /// sampling.
@@ -524,9 +525,7 @@ impl Renderer {
         let State { scene, passes } = &mut *state;
         let (spp, adaptive) = sampling.options(ground_truth);
         let key = (
-            camera.lens.to_string(),
-            camera.size.width,
-            camera.size.height,
+            format!("{camera:?}"),
             sampling.to_string(),
             ground_truth && adaptive.is_some(),
         );

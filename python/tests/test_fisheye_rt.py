@@ -172,8 +172,9 @@ def test_adaptive_sampling_equals_the_commands_and_keeps_exact_ground_truth(tmp_
 
 
 def test_a_prescription_is_a_lens_as_the_command_line_has_it():
-    """Lens.from_spec takes a lens prescription (its chief rays, fitted as Kannala-Brandt
-    at the size): directions land where `fisheye lens project` puts them, to print precision."""
+    """Lens.from_spec takes a lens prescription (mapping by its chief rays, fitted as
+    Kannala-Brandt at the size): directions land where `fisheye lens project` puts them, to
+    print precision."""
     spec = f"prescription:{ROOT / 'lenses' / 'fisheye-10mm.dat'},fstop=5.6"
     lens = fr.Lens.from_spec(spec, size=(320, 240))
     dirs = np.array([[0.0, 0.0, 1.0], [0.5, 0.2, 0.8], [-0.9, 0.1, 0.3]])
@@ -187,6 +188,32 @@ def test_a_prescription_is_a_lens_as_the_command_line_has_it():
     expected = np.array([[float(v) for v in line.split()] for line in out.splitlines()])
     assert np.allclose(pixels, expected, atol=1e-6)
     assert np.allclose(pixels[0], [160.0, 120.0])
+
+
+def test_a_prescription_renders_through_its_glass_as_the_command_does(tmp_path):
+    """Rendering through a prescription traces its glass, as `fisheye render` does (the
+    PNG's pixels, bit for bit); with rays=fit it renders the fitted model instead, whose
+    image the glass's vignetting darkens toward the edge of the circle."""
+    spec = f"prescription:{ROOT / 'lenses' / 'fisheye-10mm.dat'}"
+    out = tmp_path / "glass.png"
+    fisheye("render", "builtin:default", "--lens", spec, "--size", "64x48", "--spp", "16",
+            "-o", str(out))
+    renderer = fr.Renderer(fr.Scene.load("builtin:default"))
+    glass = renderer.render(fr.Lens.from_spec(spec, size=(64, 48)), spp=16,
+                            outputs=["srgb", "colour"])
+    assert np.array_equal(glass["srgb"], np.asarray(Image.open(out).convert("RGBA")))
+    fit = renderer.render(fr.Lens.from_spec(spec + ",rays=fit", size=(64, 48)), spp=16,
+                          outputs=["colour"])
+    ring = lambda c, lo, hi: np.nanmean(c[..., :3][ring_mask(lo, hi)])
+    # The centre alike (within the samples' noise), the rim of the circle far darker.
+    assert abs(ring(glass["colour"], 0, 6) / ring(fit["colour"], 0, 6) - 1) < 0.1
+    assert ring(glass["colour"], 26, 31) < 0.7 * ring(fit["colour"], 26, 31)
+
+
+def ring_mask(lo, hi, size=(64, 48)):
+    y, x = np.mgrid[0:size[1], 0:size[0]]
+    r = np.hypot(x + 0.5 - size[0] / 2, y + 0.5 - size[1] / 2)
+    return (r >= lo) & (r < hi)
 
 
 def test_the_camera_moves_without_uploading_the_scene_again(tmp_path):

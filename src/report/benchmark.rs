@@ -89,83 +89,90 @@ pub fn bench(
         return Err(Error::Scene("a benchmark needs at least one frame".into()));
     }
     let poses = camera_path(study.scene, path, frames)?;
-    let (setups, skipped) = study.runnable();
-    let total = study.lenses.len() * setups.len() * (frames + warmup);
-    let mut done = 0;
-    let mut entries = Vec::new();
+    let (setups, mut skipped) = study.runnable();
+    let mut runs = Vec::new();
     for lens in study.lenses {
         for &setup in &setups {
-            let what = format!("{} {}", lens.name, setup.label());
+            match Study::cannot(lens, &setup) {
+                Some(why) => skipped.push(why),
+                None => runs.push((lens, setup)),
+            }
+        }
+    }
+    let total = runs.len() * (frames + warmup);
+    let mut done = 0;
+    let mut entries = Vec::new();
+    for (lens, setup) in runs {
+        let what = format!("{} {}", lens.name, setup.label());
+        progress(Progress {
+            done,
+            total,
+            what: &what,
+        });
+        let renderer = study.renderer(lens, setup)?;
+        let mut timed = Vec::with_capacity(frames);
+        let mut memory_start = None;
+        // The warm-up frames at the path's first pose, then the path.
+        for k in 0..warmup + frames {
+            if k == warmup {
+                memory_start = Some(Memory::now(study.ctx));
+            }
+            let pose = &poses[k.saturating_sub(warmup)];
+            let time = renderer.frame(study.ctx, study.scenes, pose)?;
+            if k >= warmup {
+                timed.push(time);
+            }
+            done += 1;
             progress(Progress {
                 done,
                 total,
                 what: &what,
             });
-            let renderer = study.renderer(lens, setup)?;
-            let mut timed = Vec::with_capacity(frames);
-            let mut memory_start = None;
-            // The warm-up frames at the path's first pose, then the path.
-            for k in 0..warmup + frames {
-                if k == warmup {
-                    memory_start = Some(Memory::now(study.ctx));
-                }
-                let pose = &poses[k.saturating_sub(warmup)];
-                let time = renderer.frame(study.ctx, study.scenes, pose)?;
-                if k >= warmup {
-                    timed.push(time);
-                }
-                done += 1;
-                progress(Progress {
-                    done,
-                    total,
-                    what: &what,
-                });
-            }
-            let memory_start = memory_start.expect("at least one timed frame");
-            let wall: Vec<f64> = timed.iter().map(|t| t.wall_ms).collect();
-            let gpu: Option<Vec<f64>> = timed.iter().map(FrameTime::gpu_ms).collect();
-            let passes = renderer.passes().to_vec();
-            let pass_median_ms = timed
-                .iter()
-                .map(|t| t.passes_ms.clone())
-                .collect::<Option<Vec<_>>>()
-                .map(|per_frame| {
-                    (0..passes.len())
-                        .map(|p| median(&per_frame.iter().map(|f| f[p]).collect::<Vec<_>>()))
-                        .collect()
-                });
-            let pass_median_ns_per_ray = timed
-                .iter()
-                .map(|t| t.passes_ms.clone().zip(t.passes_rays.clone()))
-                .collect::<Option<Vec<_>>>()
-                .map(|per_frame| {
-                    (0..passes.len())
-                        .map(|p| {
-                            let ns: Vec<f64> = per_frame
-                                .iter()
-                                .filter(|(_, rays)| rays[p] > 0)
-                                .map(|(ms, rays)| ms[p] * 1e6 / rays[p] as f64)
-                                .collect();
-                            (!ns.is_empty()).then(|| median(&ns))
-                        })
-                        .collect()
-                });
-            entries.push(BenchEntry {
-                lens: lens.name.clone(),
-                setup: setup.label(),
-                method: setup.method.name(),
-                cube_size: setup.cube_size(),
-                spp: setup.spp(),
-                passes,
-                gpu: gpu.as_deref().and_then(FrameStats::of),
-                wall: FrameStats::of(&wall).expect("at least one frame"),
-                pass_median_ms,
-                pass_median_ns_per_ray,
-                frames: timed,
-                memory_start,
-                memory_end: Memory::now(study.ctx),
-            });
         }
+        let memory_start = memory_start.expect("at least one timed frame");
+        let wall: Vec<f64> = timed.iter().map(|t| t.wall_ms).collect();
+        let gpu: Option<Vec<f64>> = timed.iter().map(FrameTime::gpu_ms).collect();
+        let passes = renderer.passes().to_vec();
+        let pass_median_ms = timed
+            .iter()
+            .map(|t| t.passes_ms.clone())
+            .collect::<Option<Vec<_>>>()
+            .map(|per_frame| {
+                (0..passes.len())
+                    .map(|p| median(&per_frame.iter().map(|f| f[p]).collect::<Vec<_>>()))
+                    .collect()
+            });
+        let pass_median_ns_per_ray = timed
+            .iter()
+            .map(|t| t.passes_ms.clone().zip(t.passes_rays.clone()))
+            .collect::<Option<Vec<_>>>()
+            .map(|per_frame| {
+                (0..passes.len())
+                    .map(|p| {
+                        let ns: Vec<f64> = per_frame
+                            .iter()
+                            .filter(|(_, rays)| rays[p] > 0)
+                            .map(|(ms, rays)| ms[p] * 1e6 / rays[p] as f64)
+                            .collect();
+                        (!ns.is_empty()).then(|| median(&ns))
+                    })
+                    .collect()
+            });
+        entries.push(BenchEntry {
+            lens: lens.name.clone(),
+            setup: setup.label(),
+            method: setup.method.name(),
+            cube_size: setup.cube_size(),
+            spp: setup.spp(),
+            passes,
+            gpu: gpu.as_deref().and_then(FrameStats::of),
+            wall: FrameStats::of(&wall).expect("at least one frame"),
+            pass_median_ms,
+            pass_median_ns_per_ray,
+            frames: timed,
+            memory_start,
+            memory_end: Memory::now(study.ctx),
+        });
     }
     Ok(BenchReport {
         run: study.run(),

@@ -264,7 +264,11 @@ fn bad_prescriptions_name_their_line() {
         ("0 1 0 10\n50 2 1.5 nan\n", 2, "finite"),
         ("# nothing\n0 1 0 10\n", 2, "no refracting surface"),
         ("0 1 0 10\n50 2 1.5 30\n", 2, "through air"),
-        ("0 1 0 10 40\n50 2 1.5 30\n-50 0 1 30\n", 1, "only for glass"),
+        (
+            "0 1 0 10 40\n50 2 1.5 30\n-50 0 1 30\n",
+            1,
+            "only for glass",
+        ),
         ("0 1 0 10\n50 2 1.5 30 -3\n-50 0 1 30\n", 2, "above 0"),
         ("0 1 0 10\n50 2 1.5 30 40 1\n", 2, "6 values"),
     ] {
