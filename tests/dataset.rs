@@ -441,3 +441,82 @@ fn adaptive_datasets_keep_exact_ground_truth() {
     assert_eq!(plan["render"]["spp"], 4);
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// `--frame-rate` renders frames between the file's stamps: two poses a second apart (a move
+/// of 2 m along x and a quarter turn about z) at 4 Hz give five frames, the middle one at the
+/// midpoint turned 45°, each with its files; the plan records the rate. A rate that is not a
+/// positive number is refused naming the option.
+#[test]
+fn a_frame_rate_renders_poses_between_the_stamps() {
+    let dir = temp_dir("frame-rate");
+    let trajectory = dir.join("two.tum");
+    let half = std::f64::consts::FRAC_PI_4;
+    std::fs::write(
+        &trajectory,
+        format!(
+            "0 0 0 1 0 0 0 1\n1 2 0 1 0 0 {} {}\n",
+            half.sin(),
+            half.cos()
+        ),
+    )
+    .unwrap();
+    let out = dir.join("set");
+    let args = |rate: &str| {
+        let mut command = fisheye();
+        command
+            .args(["dataset", "render", "--lens", "equidistant:f=0.6"])
+            .args(["--size", "32x24", "--spp", "1"])
+            .arg(format!("--frame-rate={rate}"))
+            .arg("--trajectory")
+            .arg(&trajectory)
+            .arg("-o")
+            .arg(&out);
+        command
+    };
+    let said = succeed(&mut args("4"));
+    assert!(
+        said.contains("5 poses") && said.contains("at 4 Hz"),
+        "{said}"
+    );
+    let plan: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("plan.json")).unwrap()).unwrap();
+    assert_eq!(plan["trajectory"]["frame_rate"], 4.0);
+    let frames = plan["frames"].as_array().unwrap();
+    let stamps: Vec<&str> = frames
+        .iter()
+        .map(|f| f["stamp"].as_str().unwrap())
+        .collect();
+    assert_eq!(
+        stamps,
+        ["0.000000", "0.250000", "0.500000", "0.750000", "1.000000"]
+    );
+    let rows: Vec<Vec<f64>> = serde_json::from_value(frames[2]["T_world_body"].clone()).unwrap();
+    let (s, c) = half.sin_cos();
+    let expected = [
+        [c, -s, 0.0, 1.0],
+        [s, c, 0.0, 0.0],
+        [0.0, 0.0, 1.0, 1.0],
+        [0.0, 0.0, 0.0, 1.0],
+    ];
+    for (row, want) in rows.iter().zip(expected) {
+        for (v, w) in row.iter().zip(want) {
+            assert!((v - w).abs() < 1e-12, "{rows:?}");
+        }
+    }
+    for frame in frames {
+        for view in frame["views"].as_array().unwrap() {
+            for file in view["files"].as_object().unwrap().values() {
+                assert!(out.join(file.as_str().unwrap()).is_file(), "{file}");
+            }
+        }
+    }
+    for bad in ["0", "-2", "nan"] {
+        let output = args(bad).output().unwrap();
+        let message = String::from_utf8_lossy(&output.stderr);
+        assert!(
+            !output.status.success() && message.contains("--frame-rate"),
+            "{bad}: {message}"
+        );
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}

@@ -63,9 +63,10 @@ pub struct Dataset {
     pub scene_name: String,
     /// The scene.
     pub scene: Scene,
-    /// The trajectory file as given, its format and its poses.
-    pub trajectory: (PathBuf, TrajectoryFormat),
-    /// The poses `T_world_body`.
+    /// The trajectory file as given, its format, and the frame rate its poses were resampled
+    /// at (`None`: the file's own stamps; see [`super::trajectory::resample`]).
+    pub trajectory: (PathBuf, TrajectoryFormat, Option<f64>),
+    /// The poses `T_world_body`, one a frame.
     pub poses: Vec<Pose>,
     /// The rig's cameras, named `cam0`, `cam1`, ... in order, each with `T_rig_camera`.
     pub cameras: Vec<(LensCamera, DAffine3)>,
@@ -221,6 +222,7 @@ impl Dataset {
             "trajectory": {
                 "file": self.trajectory.0.display().to_string(),
                 "format": self.trajectory.1.name(),
+                "frame_rate": self.trajectory.2,
                 "poses": self.poses.len(),
             },
             "conventions": {

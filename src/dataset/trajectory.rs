@@ -8,11 +8,13 @@
 //!   layout): `timestamp [ns], p_x, p_y, p_z, q_w, q_x, q_y, q_z[, more columns]` separated by
 //!   commas; lines starting with `#` are headers. Note the quaternion's `w` comes first.
 //!
-//! Every pose is rendered as written: no interpolation to another frame rate.
+//! A trajectory is a function of time between its first and last stamps ([`pose_at`]): poses
+//! at other times, as another frame rate needs them ([`resample`]), are interpolated between
+//! the stamps around them, never extrapolated past either end.
 
 use std::path::Path;
 
-use glam::{DAffine3, DVec3};
+use glam::{DAffine3, DQuat, DVec3};
 
 use crate::error::{Error, Result};
 use crate::pose::{rigid, rigid_from_rows, rotation_from_quaternion};
@@ -208,6 +210,85 @@ fn pose(line: &str, format: TrajectoryFormat, index: usize, fps: f64) -> Result<
     })
 }
 
+/// The most frames [`resample`] makes.
+pub const MAX_FRAMES: usize = 10_000_000;
+
+/// The pose at `seconds` (the poses' clock): between the stamps around it, the translation
+/// interpolated linearly and the rotation by spherical linear interpolation (Shoemake,
+/// "Animating Rotation with Quaternion Curves", SIGGRAPH 1985: the shortest arc at constant
+/// angular velocity), exact at the stamps. Continuous, with a velocity that jumps at the
+/// stamps, as the piecewise-constant motion a sampled trajectory implies. `None` before the
+/// first stamp and after the last: poses are never extrapolated.
+pub fn pose_at(poses: &[Pose], seconds: f64) -> Option<DAffine3> {
+    let (first, last) = (poses.first()?, poses.last()?);
+    if !(first.seconds..=last.seconds).contains(&seconds) {
+        return None;
+    }
+    // The first pose after `seconds`: the pose before it and it bracket the time.
+    let after = poses.partition_point(|p| p.seconds <= seconds);
+    if after == poses.len() {
+        return Some(last.world_from_body);
+    }
+    let (a, b) = (&poses[after - 1], &poses[after]);
+    let s = (seconds - a.seconds) / (b.seconds - a.seconds);
+    if s == 0.0 {
+        return Some(a.world_from_body);
+    }
+    let rotation = |t: &DAffine3| DQuat::from_mat3(&t.matrix3).normalize();
+    let (ra, rb) = (rotation(&a.world_from_body), rotation(&b.world_from_body));
+    // q and -q are one rotation: take the nearer, so the arc is the shortest.
+    let rb = if ra.dot(rb) < 0.0 { -rb } else { rb };
+    let translation = a
+        .world_from_body
+        .translation
+        .lerp(b.world_from_body.translation, s);
+    Some(DAffine3::from_rotation_translation(
+        ra.slerp(rb, s).normalize(),
+        translation,
+    ))
+}
+
+/// The poses at `hz` frames a second from the first stamp, up to the last (never past it), by
+/// [`pose_at`]. Frame `k` is at the first stamp plus `k / hz` seconds; its stamp is written in
+/// the file's unit: EuRoC's integer nanoseconds, others' seconds with six decimals.
+pub fn resample(poses: &[Pose], format: TrajectoryFormat, hz: f64) -> Result<Vec<Pose>, String> {
+    if !(hz.is_finite() && hz > 0.0) {
+        return Err(format!("the frame rate {hz} Hz is not a positive number"));
+    }
+    let (Some(first), Some(last)) = (poses.first(), poses.last()) else {
+        return Ok(Vec::new());
+    };
+    // Frames whose times reach the last stamp, allowing for the rounding of k / hz.
+    let span = (last.seconds - first.seconds) * hz;
+    let count = (span * (1.0 + 1e-12)).floor() + 1.0;
+    if count > MAX_FRAMES as f64 {
+        return Err(format!(
+            "{count} frames at {hz} Hz over {:.3} s: at most {MAX_FRAMES}",
+            last.seconds - first.seconds
+        ));
+    }
+    let first_ns: Option<u128> = (format == TrajectoryFormat::Euroc)
+        .then(|| first.stamp.parse().ok())
+        .flatten();
+    (0..count as usize)
+        .map(|k| {
+            let offset = k as f64 / hz;
+            let seconds = (first.seconds + offset).min(last.seconds);
+            let stamp = match first_ns {
+                Some(ns) => (ns + (offset * 1e9).round() as u128).to_string(),
+                None => format!("{seconds:.6}"),
+            };
+            let world_from_body =
+                pose_at(poses, seconds).ok_or_else(|| format!("no pose at {seconds} s"))?;
+            Ok(Pose {
+                stamp,
+                seconds,
+                world_from_body,
+            })
+        })
+        .collect()
+}
+
 /// A time stamp's text, kept for file names: digits with at most one decimal point.
 fn stamp_text(field: &str) -> Result<String, String> {
     let digits = field.chars().filter(char::is_ascii_digit).count();
@@ -315,6 +396,74 @@ mod tests {
             parse("", TrajectoryFormat::Kitti, 0.0)
                 .unwrap_err()
                 .contains("frame rate")
+        );
+    }
+
+    /// Between stamps the pose moves on: halfway between a pose and one turned 90° about z and
+    /// moved by (2, 0, 0), it is turned 45° and moved by (1, 0, 0); at the stamps it is exactly
+    /// theirs; outside them there is none. A turn written with the other sign of quaternion
+    /// takes the short way.
+    #[test]
+    fn poses_between_stamps_are_interpolated_and_never_extrapolated() {
+        let tum = "1.0 0 0 0 0 0 0 1\n\
+                   2.0 2 0 0 0 0 0.7071067811865476 0.7071067811865476\n\
+                   3.0 2 0 0 0 0 -0.7071067811865476 -0.7071067811865476\n";
+        let poses = parse(tum, TrajectoryFormat::Tum, 1.0).unwrap();
+        for p in &poses {
+            assert_eq!(pose_at(&poses, p.seconds), Some(p.world_from_body));
+        }
+        let half = pose_at(&poses, 1.5).unwrap();
+        assert!(half.translation.abs_diff_eq(DVec3::X, 1e-15));
+        let turned = half.transform_vector3(DVec3::X);
+        let eighth = std::f64::consts::FRAC_PI_4;
+        assert!(turned.abs_diff_eq(DVec3::new(eighth.cos(), eighth.sin(), 0.0), 1e-15));
+        // The same rotation written as -q: no turn between the second and third stamps.
+        let still = pose_at(&poses, 2.5).unwrap();
+        assert!(still.abs_diff_eq(poses[1].world_from_body, 1e-15));
+        assert_eq!(pose_at(&poses, 0.999), None);
+        assert_eq!(pose_at(&poses, 3.001), None);
+    }
+
+    /// Resampled at 4 Hz, two seconds of poses give nine frames, a quarter second apart, the
+    /// last at the last stamp and none past it; stamps keep the file's unit (EuRoC's integer
+    /// nanoseconds, counted from its first stamp exactly).
+    #[test]
+    fn resampling_makes_frames_at_the_rate_up_to_the_last_stamp() {
+        let euroc = "1403636579763555584,0,0,0,1,0,0,0\n\
+                     1403636581763555584,4,0,0,1,0,0,0\n";
+        let poses = parse(euroc, TrajectoryFormat::Euroc, 1.0).unwrap();
+        let frames = resample(&poses, TrajectoryFormat::Euroc, 4.0).unwrap();
+        assert_eq!(frames.len(), 9);
+        assert_eq!(frames[1].stamp, "1403636580013555584");
+        assert_eq!(frames[8].stamp, "1403636581763555584");
+        for (k, f) in frames.iter().enumerate() {
+            let x = f.world_from_body.translation.x;
+            assert!((x - k as f64 * 0.5).abs() < 1e-5, "frame {k} at x = {x}");
+        }
+        // 3 Hz over 2 s: 0, 1/3, ..., 2 (seven frames), the last exactly the last stamp's.
+        let tum = "10 0 0 0 0 0 0 1\n12 0 0 6 0 0 0 1\n";
+        let poses = parse(tum, TrajectoryFormat::Tum, 1.0).unwrap();
+        let frames = resample(&poses, TrajectoryFormat::Tum, 3.0).unwrap();
+        let stamps: Vec<&str> = frames.iter().map(|f| f.stamp.as_str()).collect();
+        assert_eq!(stamps[..2], ["10.000000", "10.333333"]);
+        assert_eq!(stamps.last(), Some(&"12.000000"));
+        assert_eq!(frames.len(), 7);
+        // 2.5 Hz: 0, 0.4, ..., 2.0 s: six frames, none past the last stamp.
+        assert_eq!(
+            resample(&poses, TrajectoryFormat::Tum, 2.5).unwrap().len(),
+            6
+        );
+        for bad in [0.0, -1.0, f64::NAN, f64::INFINITY] {
+            assert!(
+                resample(&poses, TrajectoryFormat::Tum, bad)
+                    .unwrap_err()
+                    .contains("Hz")
+            );
+        }
+        assert!(
+            resample(&poses, TrajectoryFormat::Tum, 1e7)
+                .unwrap_err()
+                .contains("at most")
         );
     }
 }

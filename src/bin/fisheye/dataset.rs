@@ -44,9 +44,15 @@ pub(crate) struct RenderArgs {
     gltf_scene: Option<usize>,
     /// The trajectory: poses T_world_body in TUM (`t tx ty tz qx qy qz qw`), KITTI (3×4
     /// matrices) or EuRoC CSV (`t_ns, px, py, pz, qw, qx, qy, qz, ...`), detected from the
-    /// text unless --trajectory-format says. Every pose is rendered, without interpolation.
+    /// text unless --trajectory-format says. Every pose is rendered as written, unless
+    /// --frame-rate asks for frames at other times.
     #[arg(long)]
     trajectory: PathBuf,
+    /// Render frames at this rate (Hz) from the trajectory's first stamp to its last, the poses
+    /// between stamps interpolated (translation linearly, rotation by slerp), never past the
+    /// last stamp; by default one frame a pose of the file.
+    #[arg(long)]
+    frame_rate: Option<f64>,
     /// The trajectory's format, if detection from its text is not wanted.
     #[arg(long, value_enum)]
     trajectory_format: Option<FormatArg>,
@@ -191,6 +197,11 @@ fn render(args: &RenderArgs) -> Result<()> {
         FormatArg::Euroc => TrajectoryFormat::Euroc,
     });
     let (detected, poses) = trajectory::read(&args.trajectory, format, args.fps)?;
+    let poses = match args.frame_rate {
+        Some(hz) => trajectory::resample(&poses, detected, hz)
+            .map_err(|e| anyhow::anyhow!("--frame-rate: {e}"))?,
+        None => poses,
+    };
     let scene = load_scene_with(&args.scene, args.gltf_scene)?;
     let channels: Vec<Channel> = args
         .outputs
@@ -210,7 +221,7 @@ fn render(args: &RenderArgs) -> Result<()> {
             None => args.scene.clone(),
         },
         scene,
-        trajectory: (args.trajectory.clone(), detected),
+        trajectory: (args.trajectory.clone(), detected, args.frame_rate),
         poses,
         cameras,
         scene_from_world,
@@ -238,8 +249,11 @@ fn render(args: &RenderArgs) -> Result<()> {
         ),
     };
     let range = args.shard.poses(dataset.poses.len());
+    let rate = args
+        .frame_rate
+        .map_or(String::new(), |hz| format!(" at {hz} Hz"));
     println!(
-        "dataset: {} poses ({} trajectory {}), {} camera(s); shard {}/{}: poses {}..{}",
+        "dataset: {} poses ({} trajectory {}{rate}), {} camera(s); shard {}/{}: poses {}..{}",
         dataset.poses.len(),
         detected.name(),
         args.trajectory.display(),
