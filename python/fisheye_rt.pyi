@@ -26,8 +26,9 @@ class Lens:
     def from_spec(spec: str, size: Tuple[int, int]) -> "Lens":
         """A lens from its spec (`fisheye lens list`: "samyang-7.5mm",
         "equisolid:f=0.6,fov=180", "kb:fx=...,k1=...", or "prescription:FILE[,sensor=MM]
-        [,fstop=N][,focus=METRES][,rays=glass|fit]" for a lens's glass: rendered through
-        its surfaces, mapped by its chief rays) at size = (width, height)."""
+        [,fstop=N][,focus=METRES][,rays=glass|fit][,model=kb|ds|equidistant]" for a lens's
+        glass: rendered through its surfaces, mapped by its chief rays) at
+        size = (width, height)."""
     @staticmethod
     def from_calibration(path: Union[str, PathLike], camera: int = 0) -> "Lens":
         """Camera `camera` of a calibration file (OpenCV YAML/XML, Kalibr, Basalt), at its

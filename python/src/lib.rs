@@ -111,8 +111,8 @@ struct Lens {
 impl Lens {
     /// A lens from its spec (see `fisheye lens list`: `"samyang-7.5mm"`,
     /// `"equisolid:f=0.6,fov=180"`, `"kb:fx=...,k1=..."`, or
-    /// `"prescription:FILE[,sensor=MM][,fstop=N][,focus=METRES][,rays=glass|fit]"` for a
-    /// lens's glass: rendered through its surfaces, mapped by its chief rays) at
+    /// `"prescription:FILE[,sensor=MM][,fstop=N][,focus=METRES][,rays=glass|fit][,model=kb|ds|equidistant]"`
+    /// for a lens's glass: rendered through its surfaces, mapped by its chief rays) at
     /// `size = (width, height)`.
     #[staticmethod]
     fn from_spec(spec: &str, size: (u32, u32)) -> PyResult<Self> {

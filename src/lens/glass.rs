@@ -1,6 +1,7 @@
 //! A lens prescription on a camera: the spec
-//! `prescription:FILE[,sensor=MM][,fstop=N][,focus=METRES][,rays=glass|fit]` and the figures
-//! `fisheye lens info` prints for it (see [`super::prescription`] for the glass).
+//! `prescription:FILE[,sensor=MM][,fstop=N][,focus=METRES][,rays=glass|fit][,model=kb|ds|equidistant]`
+//! and the figures `fisheye lens info` prints for it (see [`super::prescription`] for the
+//! glass).
 //!
 //! `sensor` is the image's width on the film in millimetres (pixels are square); by default
 //! the image circle's diameter, so that the circle spans the image's width. `fstop` stops the
@@ -12,7 +13,8 @@
 //! sample through the surfaces from its place on the film ([`super::glass_gpu`]: vignetting,
 //! depth of field), `fit` through the chief rays' fitted model, a mapping like any other lens
 //! (cheaper; what cube maps use either way). Projection, unprojection and the ground-truth
-//! arrays follow the fitted model: the chief rays.
+//! arrays follow the fitted model: the chief rays, fitted as `model` says (Kannala–Brandt by
+//! default, the double sphere, or equidistant).
 
 use std::path::Path;
 
@@ -42,6 +44,31 @@ pub struct GlassLens {
     /// Whether direct tracing renders through the glass (`rays=glass`, the default) or
     /// through the fitted model (`rays=fit`).
     pub through_glass: bool,
+    /// The calibrated model the chief rays are fitted as (`model=`; Kannala–Brandt by
+    /// default).
+    pub model: FitModel,
+}
+
+/// The calibrated models a prescription's chief rays are fitted as: `model=kb|ds|equidistant`
+/// in the spec.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum FitModel {
+    /// Kannala–Brandt's `θ(1 + k1θ² + … + k4θ⁸)`, its focal length the mapping's slope at
+    /// the axis.
+    KannalaBrandt,
+    /// Usenko et al.'s double sphere (ξ, α and the focal length by least squares).
+    DoubleSphere,
+    /// `f θ` (Kannala–Brandt without distortion; f by least squares).
+    Equidistant,
+}
+
+impl FitModel {
+    /// Every model with its spec name.
+    pub const ALL: [(&'static str, FitModel); 3] = [
+        ("kb", Self::KannalaBrandt),
+        ("ds", Self::DoubleSphere),
+        ("equidistant", Self::Equidistant),
+    ];
 }
 
 /// A prescription's chief-ray mapping fitted as a Kannala–Brandt model at an image size.
@@ -111,8 +138,8 @@ impl GlassLens {
         spec.trim_start().starts_with(PREFIX)
     }
 
-    /// Reads `prescription:FILE[,sensor=MM][,fstop=N][,focus=METRES][,rays=glass|fit]`,
-    /// loading FILE.
+    /// Reads `prescription:FILE[,sensor=MM][,fstop=N][,focus=METRES][,rays=glass|fit]
+    /// [,model=kb|ds|equidistant]`, loading FILE.
     pub fn parse(spec: &str) -> Result<Self, LensError> {
         let err = |reason: String| LensError::Spec {
             spec: spec.to_string(),
@@ -127,11 +154,22 @@ impl GlassLens {
         if file.is_empty() {
             return Err(err("give the prescription's file: prescription:FILE".into()));
         }
-        let (mut sensor, mut fstop, mut focus, mut rays) = (None, None, None, None);
+        let (mut sensor, mut fstop, mut focus, mut rays, mut model) =
+            (None, None, None, None, None);
         for pair in parts.map(str::trim).filter(|p| !p.is_empty()) {
             let (key, value) = pair
                 .split_once('=')
                 .ok_or_else(|| err(format!("{pair:?} is not key=value")))?;
+            if key.trim() == "model" {
+                let found = FitModel::ALL
+                    .iter()
+                    .find(|(name, _)| *name == value.trim())
+                    .ok_or_else(|| err(format!("model = {value:?}: say kb, ds or equidistant")))?;
+                if model.replace(found.1).is_some() {
+                    return Err(err("model is given twice".into()));
+                }
+                continue;
+            }
             if key.trim() == "rays" {
                 let through = match value.trim() {
                     "glass" => true,
@@ -156,7 +194,7 @@ impl GlassLens {
                 other => {
                     return Err(err(format!(
                         "unknown key {other:?}; a prescription takes sensor=MM, fstop=N, \
-                         focus=METRES and rays=glass|fit"
+                         focus=METRES, rays=glass|fit and model=kb|ds|equidistant"
                     )));
                 }
             };
@@ -200,14 +238,16 @@ impl GlassLens {
             film_mm,
             half_field,
             through_glass: rays.unwrap_or(true),
+            model: model.unwrap_or(FitModel::KannalaBrandt),
         })
     }
 
-    /// The chief-ray mapping at `size` as Kannala–Brandt's `θ(1 + k1θ² + … + k4θ⁸)`, fitted
-    /// by least squares to the traced chief rays at 512 angles out to the edge of the field
-    /// (or of the chief rays, where they end first), with the mapping's slope at the axis in
-    /// pixels as its focal length (the paraxial one where the film is at the focus for
-    /// infinity): where the chief ray of a direction lands on the film, read out upright.
+    /// The chief-ray mapping at `size` as the spec's model ([`FitModel`]: Kannala–Brandt's
+    /// `θ(1 + k1θ² + … + k4θ⁸)` by default), fitted by least squares to the traced chief rays
+    /// at 512 angles out to the edge of the field (or of the chief rays, where they end
+    /// first); Kannala–Brandt's focal length is the mapping's slope at the axis (the paraxial
+    /// one where the film is at the focus for infinity), the others' is fitted: where the
+    /// chief ray of a direction lands on the film, read out upright.
     pub fn fitted(&self, size: ImageSize) -> Result<Fitted, LensError> {
         let p = &self.prescription;
         let pitch = self.sensor_mm / f64::from(size.width);
@@ -234,19 +274,36 @@ impl GlassLens {
                 reason: "no chief ray reaches the film".into(),
             });
         };
-        let used: Vec<f64> = traced.iter().map(|s| s.0).collect();
-        let k = super::fit::fit_kb(&used, |t| {
-            traced.iter().find(|s| s.0 == t).map(|s| s.1 / slope)
-        });
-        let f = slope / pitch;
+        let (model, f_mm) = match self.model {
+            FitModel::KannalaBrandt => {
+                let used: Vec<f64> = traced.iter().map(|s| s.0).collect();
+                let k = super::fit::fit_kb(&used, |t| {
+                    traced.iter().find(|s| s.0 == t).map(|s| s.1 / slope)
+                });
+                (CalibratedModel::KannalaBrandt { k }, slope)
+            }
+            FitModel::Equidistant => {
+                let (num, den) = traced
+                    .iter()
+                    .fold((0.0, 0.0), |(n, d), &(t, r)| (n + r * t, d + t * t));
+                (CalibratedModel::KannalaBrandt { k: [0.0; 4] }, num / den)
+            }
+            FitModel::DoubleSphere => {
+                let (xi, alpha, f) = fit_double_sphere(&traced).ok_or_else(|| LensError::Spec {
+                    spec: "prescription".into(),
+                    reason: "no double sphere holds the chief rays' field".into(),
+                })?;
+                (CalibratedModel::DoubleSphere { xi, alpha }, f)
+            }
+        };
+        let f = f_mm / pitch;
         let intrinsics = Intrinsics {
             fx: f,
             fy: f,
             cx: f64::from(size.width) / 2.0,
             cy: f64::from(size.height) / 2.0,
         };
-        let model = CalibratedModel::KannalaBrandt { k };
-        // The lens's field, or less where the fitted polynomial turns back first.
+        // The lens's field, or less where the fitted model turns back or ends first.
         let whole = CalibratedLens::new(model, intrinsics)?;
         let lens = if widest < whole.theta_max() {
             CalibratedLens::with_fov(model, intrinsics, 2.0 * widest)?
@@ -292,4 +349,46 @@ fn image_circle(p: &Prescription, film: f64, edge: f64) -> Option<f64> {
         .map(f64::abs)
         .reduce(f64::max)
         .map(|r| 2.0 * r)
+}
+
+/// The double sphere (ξ, α, f in mm) whose radius `f·sin θ / (α d + (1 − α)(ξ + cos θ))`,
+/// `d = √(sin²θ + (ξ + cos θ)²)` (Usenko, Demmel and Cremers, 3DV 2018), fits `traced`'s
+/// `(θ, r)` best in least squares: f is linear given (ξ, α), which a grid over their whole
+/// ranges (0.05 and 0.025 apart) finds, then three finer grids about the best refine (to about
+/// 1e-4). `None` where no (ξ, α) reaches every angle.
+fn fit_double_sphere(traced: &[(f64, f64)]) -> Option<(f64, f64, f64)> {
+    // The squared residual with the best f, and that f.
+    let cost = |xi: f64, alpha: f64| -> Option<(f64, f64)> {
+        let unit = Intrinsics {
+            fx: 1.0,
+            fy: 1.0,
+            cx: 0.0,
+            cy: 0.0,
+        };
+        let lens = CalibratedLens::new(CalibratedModel::DoubleSphere { xi, alpha }, unit).ok()?;
+        let (mut rg, mut gg, mut rr) = (0.0, 0.0, 0.0);
+        for &(t, r) in traced {
+            let g = lens.radius(t)?;
+            (rg, gg, rr) = (rg + r * g, gg + g * g, rr + r * r);
+        }
+        Some((rr - rg * rg / gg, rg / gg))
+    };
+    let mut best: Option<(f64, f64, f64, f64)> = None;
+    let (mut centre, mut step, mut steps) = ((0.0, 0.5), (0.05, 0.025), 20);
+    for _ in 0..4 {
+        for i in -steps..=steps {
+            for j in -steps..=steps {
+                let xi = (centre.0 + f64::from(i) * step.0).clamp(-1.0, 1.0);
+                let alpha = (centre.1 + f64::from(j) * step.1).clamp(0.0, 1.0);
+                if let Some((c, f)) = cost(xi, alpha)
+                    && best.is_none_or(|b| c < b.0)
+                {
+                    best = Some((c, xi, alpha, f));
+                }
+            }
+        }
+        let (_, xi, alpha, _) = best?;
+        (centre, step, steps) = ((xi, alpha), (step.0 / 10.0, step.1 / 10.0), 10);
+    }
+    best.map(|(_, xi, alpha, f)| (xi, alpha, f))
 }

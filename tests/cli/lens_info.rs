@@ -65,6 +65,7 @@ fn a_singlets_figures_are_the_thick_lens_ones() {
         (format!("{spec},iso=100"), "unknown key \"iso\""),
         (format!("{spec},sensor=-3"), "above 0"),
         (format!("{spec},rays=chief"), "say glass or fit"),
+        (format!("{spec},model=ucm"), "say kb, ds or equidistant"),
         ("prescription:".to_string(), "give the prescription's file"),
         (
             format!("prescription:{}/none.dat", dir.display()),
@@ -197,5 +198,39 @@ fn a_prescription_renders_through_its_glass_and_maps_by_its_chief_rays() {
         points,
     ));
     assert_eq!(from_file, from_glass);
+
+    // The other models: `lens fit` lists each with its residual, and the double sphere's file
+    // (Basalt's format holds it) projects as the spec with model=ds does.
+    let fits = stdout(&fisheye(
+        &["lens", "fit", "--lens", &spec, "--size", "160x120"],
+        "",
+    ));
+    for name in ["kb ", "ds ", "equidistant "] {
+        assert!(
+            fits.lines()
+                .any(|l| l.starts_with(name) && l.contains(":fx=")),
+            "{fits}"
+        );
+    }
+    let ds = format!("{spec},model=ds");
+    let file = dir.join("glass-ds.json");
+    let convert = ["lens", "convert", "--lens", &ds, "--size", "160x120"];
+    stdout(&fisheye(
+        &[
+            &convert[..],
+            &["--format", "basalt", "-o", file.to_str().unwrap()],
+        ]
+        .concat(),
+        "",
+    ));
+    let from_file = stdout(&fisheye(
+        &["lens", "project", "--calib", file.to_str().unwrap()],
+        points,
+    ));
+    let from_spec = stdout(&fisheye(
+        &["lens", "project", "--lens", &ds, "--size", "160x120"],
+        points,
+    ));
+    assert_eq!(from_file, from_spec);
     std::fs::remove_dir_all(&dir).unwrap();
 }

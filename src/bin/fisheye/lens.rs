@@ -10,7 +10,7 @@ use fisheye_rt::demo::LensDemo;
 use fisheye_rt::gpu::{GpuContext, Queries};
 use fisheye_rt::lens::calib::{self, CalibFormat, Calibration};
 use fisheye_rt::lens::fit::calibrated_equivalent;
-use fisheye_rt::lens::glass::{GlassLens, camera_for};
+use fisheye_rt::lens::glass::{FitModel, GlassLens, camera_for};
 use fisheye_rt::lens::gpu::DirectionSource;
 use fisheye_rt::lens::points;
 use fisheye_rt::lens::{
@@ -360,6 +360,26 @@ pub(crate) fn fit(args: &CameraArgs) -> Result<()> {
             f.rms,
             f.max
         );
+    }
+    // A prescription's chief rays as each calibrated model, as `model=` fits them.
+    if let Some(spec) = args.lens.as_deref().filter(|s| GlassLens::is_spec(s)) {
+        let glass = GlassLens::parse(spec)?;
+        println!(
+            "the traced chief rays fitted as calibrated models (model=NAME in the spec; lens \
+             convert writes them):"
+        );
+        println!("{:<14} {:>12}   model", "model", "max (px)");
+        for (name, model) in FitModel::ALL {
+            let fitted = GlassLens {
+                model,
+                ..glass.clone()
+            }
+            .fitted(camera.size)?;
+            println!(
+                "{name:<14} {:>12.4}   {}",
+                fitted.residual_px, fitted.camera.lens
+            );
+        }
     }
     Ok(())
 }
