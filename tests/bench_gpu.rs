@@ -340,10 +340,10 @@ fn banded_frames_are_timed_whole() {
     assert!(banded.counts().1 > 1000, "the grid is in view");
 }
 
-/// A prescription's glass is timed beside its fitted model (`rays=fit`): the glass runs the
-/// uniform direct setups, its cube-map setup is skipped and listed saying why, and the fitted
-/// model runs every setup, so a frame through the glass and one through its model stand in the
-/// same report.
+/// A prescription's glass is timed and compared beside its fitted model (`rays=fit`): the
+/// glass runs the uniform direct setups, its cube-map setup is skipped and listed saying why,
+/// and the fitted model runs every setup, so a frame through the glass and one through its
+/// model stand in the same reports.
 #[test]
 fn a_prescriptions_glass_is_timed_beside_its_fitted_model() {
     let scene = builtin::scene("default").unwrap();
@@ -390,4 +390,34 @@ fn a_prescriptions_glass_is_timed_beside_its_fitted_model() {
         report.skipped
     );
     assert!(report.entries.iter().all(|e| e.gpu.is_some()));
+
+    // compare runs the same setups against each lens's own many-ray reference (the glass's
+    // traced through the glass), and writes its report and plots with the glass's cube map
+    // left out; the fitted model gets its verdicts, the glass none (it has no cube map).
+    let out = std::env::temp_dir().join("fisheye-test-compare-glass");
+    let _ = std::fs::remove_dir_all(&out);
+    let compared = report::compare(&study, &scene.camera, 1, 16, &out, &mut |_| {}).unwrap();
+    let ran: Vec<(String, String)> = compared
+        .entries
+        .iter()
+        .map(|e| (e.lens.clone(), e.setup.clone()))
+        .collect();
+    assert_eq!(
+        ran,
+        [
+            pair("glass", "rt@4spp"),
+            pair("fit", "rt@4spp"),
+            pair("fit", "cube-rt@16")
+        ]
+    );
+    assert!(
+        compared
+            .skipped
+            .iter()
+            .any(|s| s.starts_with("glass cube-rt@16: "))
+    );
+    assert!(compared.verdicts.iter().all(|v| v.lens == "fit"));
+    assert!(compared.entries.iter().all(|e| e.error.mse > 0.0));
+    assert_eq!(compared.write(&out).unwrap(), None, "plots need a font");
+    assert!(out.join("tradeoff.glass.png").is_file());
 }

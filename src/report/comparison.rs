@@ -160,13 +160,31 @@ pub fn compare(
     out: &Path,
     progress: &mut dyn FnMut(Progress<'_>),
 ) -> Result<CompareReport> {
-    let (setups, skipped) = study.runnable();
+    let (setups, mut skipped) = study.runnable();
     let frames = frames.max(1);
-    let total = study.lenses.len() * (setups.len() * (frames + 1) + 1);
+    // Each lens's setups, less those it cannot run (listed with why).
+    let per_lens: Vec<Vec<Setup>> = study
+        .lenses
+        .iter()
+        .map(|lens| {
+            setups
+                .iter()
+                .filter(|setup| match Study::cannot(lens, setup) {
+                    Some(why) => {
+                        skipped.push(why);
+                        false
+                    }
+                    None => true,
+                })
+                .copied()
+                .collect()
+        })
+        .collect();
+    let total: usize = per_lens.iter().map(|s| s.len() * (frames + 1) + 1).sum();
     let mut done = 0;
     let mut entries = Vec::new();
     let mut verdicts = Vec::new();
-    for lens in study.lenses {
+    for (lens, setups) in study.lenses.iter().zip(&per_lens) {
         let size = lens.camera.size;
         let stem = file_stem(&lens.name);
         let what = format!("{} reference, {reference_spp} rays per pixel", lens.name);
@@ -184,7 +202,7 @@ pub fn compare(
         )?;
         done += 1;
         let first = entries.len();
-        for &setup in &setups {
+        for &setup in setups {
             let what = format!("{} {}", lens.name, setup.label());
             let renderer = study.renderer(lens, setup)?;
             let mut times = Vec::with_capacity(frames);
