@@ -18,6 +18,10 @@
 //! frame (about one ray per pixel each) into the whole adaptive frame; other samplings draw
 //! their whole frame when the camera moves. For tests: `--frames N --screenshot FILE` renders
 //! N frames from the scene's camera, saves the window's last frame as a PNG and exits.
+//!
+//! `--lens prescription:FILE[,...]` renders through a lens's glass (see the book's Lenses
+//! page), which is traced with uniform sampling: an adaptive choice takes its most rays a
+//! pixel, every pixel.
 
 use std::collections::HashSet;
 use std::path::PathBuf;
@@ -26,7 +30,8 @@ use std::time::Instant;
 
 use fisheye_rt::cube::CubeSettings;
 use fisheye_rt::gpu::GpuContext;
-use fisheye_rt::lens::{ImageSize, LensCamera, parse_spec};
+use fisheye_rt::lens::ImageSize;
+use fisheye_rt::lens::glass::camera_for;
 use fisheye_rt::renderer::{Method, Renderer};
 use fisheye_rt::scene::{Camera, Scene};
 use fisheye_rt::trace::{RenderOptions, Sampling};
@@ -216,7 +221,7 @@ impl State {
     fn make_view(&self, lens: &str) -> Result<View, String> {
         let size =
             ImageSize::new(self.config.width, self.config.height).map_err(|e| e.to_string())?;
-        let camera = LensCamera::new(parse_spec(lens).map_err(|e| e.to_string())?, size);
+        let camera = camera_for(lens, size).map_err(|e| e.to_string())?;
         // An sRGB surface encodes what the blit writes, so the renderer hands over radiance;
         // a plain one shows the values as they are, so the renderer encodes them.
         let format = if self.config.format.is_srgb() {
@@ -227,6 +232,8 @@ impl State {
         let method = Method::ALL[self.method];
         let sampling = Sampling::parse(SPP[self.spp]).map_err(|e| e.to_string())?;
         let (spp, adaptive) = sampling.options(false);
+        // The glass is traced by uniform sampling, at the choice's most rays a pixel.
+        let adaptive = adaptive.filter(|_| camera.glass.is_none());
         let options = RenderOptions {
             traversal: method.traversal(),
             spp,
