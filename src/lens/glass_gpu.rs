@@ -85,8 +85,9 @@ impl GlassParams {
         let film_z = p.rear_vertex() + film_mm;
         let reach = 0.5 * pitch * f64::from(width).hypot(f64::from(height));
         let bins = exit_pupil(&channels, film_z, reach);
+        // Each channel's normalisation; without dispersion the one lens's is every channel's.
         let mut scale = [0.0, 0.0, 0.0, METRES_PER_MM as f32];
-        for (c, lens) in channels.iter().cycle().take(3).enumerate() {
+        for (c, lens) in channels.iter().enumerate() {
             let centre = centre_mean(lens, film_z, bins[0]);
             if centre.is_nan() || centre <= 0.0 {
                 return Err(LensError::Spec {
@@ -96,10 +97,8 @@ impl GlassParams {
             }
             scale[c] = (1.0 / centre) as f32;
         }
-        // Without dispersion the one lens is every channel's.
-        if channels.len() == 1 {
-            scale = [scale[0], scale[0], scale[0], scale[3]];
-        }
+        let first = scale[0];
+        scale[channels.len()..3].fill(first);
         let mut out = Self {
             counts: [count as u32, PUPIL_BINS, channels.len() as u32, 0],
             film: [
