@@ -172,6 +172,21 @@ fn the_twin_traces_as_the_reference_does() {
     }
 }
 
+/// The camera of the test scenes: at the origin, looking along +z.
+const AT_ORIGIN: Camera = Camera {
+    position: DVec3::ZERO,
+    look_at: DVec3::Z,
+    up: DVec3::NEG_Y,
+};
+
+/// A material emitting white radiance 1, lit by nothing.
+fn emitter(b: &mut MeshBuilder) -> u32 {
+    b.material(Material {
+        emission: Vec3::ONE,
+        ..Material::diffuse("white", Vec3::ZERO)
+    })
+}
+
 /// A scene of nothing but a sky of radiance 1 (one black triangle far behind the camera, as a
 /// scene needs one), the camera at the origin looking along +z.
 fn sky() -> Scene {
@@ -184,12 +199,7 @@ fn sky() -> Scene {
         Vec2::ONE,
         black,
     );
-    let camera = Camera {
-        position: DVec3::ZERO,
-        look_at: DVec3::Z,
-        up: DVec3::NEG_Y,
-    };
-    b.finish(vec![], Vec3::ONE, Vec3::ZERO, camera)
+    b.finish(vec![], Vec3::ONE, Vec3::ZERO, AT_ORIGIN)
 }
 
 /// Vignetting as the glass makes it: a uniform sky renders, ring by ring, as the relative
@@ -261,10 +271,7 @@ fn vignetting_follows_the_traced_relative_illumination() {
 /// nothing where x > 0: a vertical edge through the image's centre.
 fn edge(distance: f64) -> Scene {
     let mut b = MeshBuilder::new();
-    let white = b.material(Material {
-        emission: Vec3::ONE,
-        ..Material::diffuse("white", Vec3::ZERO)
-    });
+    let white = emitter(&mut b);
     let black = b.material(Material::diffuse("black", Vec3::ZERO));
     let (side, z) = (50.0, distance);
     b.quad(
@@ -281,12 +288,7 @@ fn edge(distance: f64) -> Scene {
         Vec2::ONE,
         black,
     );
-    let camera = Camera {
-        position: DVec3::ZERO,
-        look_at: DVec3::Z,
-        up: DVec3::NEG_Y,
-    };
-    b.finish(vec![], Vec3::ZERO, Vec3::ZERO, camera)
+    b.finish(vec![], Vec3::ZERO, Vec3::ZERO, AT_ORIGIN)
 }
 
 /// The share of a uniform disc of radius 1, centred `t` to the right of a vertical line, that
@@ -488,21 +490,13 @@ fn red_and_blue_images_separate_as_dispersion_predicts() {
     let pitch = f64::from(camera.glass.unwrap().film[2]);
     let theta = 3f64.to_radians();
     let mut b = MeshBuilder::new();
-    let white = b.material(Material {
-        emission: Vec3::ONE,
-        ..Material::diffuse("white", Vec3::ZERO)
-    });
-    let pose = Camera {
-        position: DVec3::ZERO,
-        look_at: DVec3::Z,
-        up: DVec3::NEG_Y,
-    };
-    let r = pose.rotation();
+    let white = emitter(&mut b);
+    let r = AT_ORIGIN.rotation();
     // The camera's right, down and forward in the world; the plane spans x < 1 km · tan 3°.
     let (right, down, forward) = (r.x_axis, r.y_axis, r.z_axis);
     let corner = forward * 1e3 + right * (1e3 * theta.tan() - 500.0) - down * 500.0;
     b.quad(corner, right * 500.0, down * 1e3, Vec2::ONE, white);
-    let scene = b.finish(vec![], Vec3::ZERO, Vec3::ZERO, pose);
+    let scene = b.finish(vec![], Vec3::ZERO, Vec3::ZERO, AT_ORIGIN);
     let options = RenderOptions {
         spp: 64,
         ..Default::default()
