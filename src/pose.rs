@@ -51,6 +51,19 @@ pub fn rigid(rotation: DQuat, translation: DVec3) -> DAffine3 {
     DAffine3::from_rotation_translation(rotation, translation)
 }
 
+/// The rigid transform a share `s` (0 to 1) of the way from `a` to `b`: the translation
+/// interpolated linearly and the rotation by spherical linear interpolation on the shortest
+/// arc (Shoemake, "Animating Rotation with Quaternion Curves", SIGGRAPH 1985: constant angular
+/// velocity about one axis). `wgsl/frame.wgsl` turns a moving camera the same way in f32.
+pub fn interpolate(a: &DAffine3, b: &DAffine3, s: f64) -> DAffine3 {
+    let rotation = |t: &DAffine3| DQuat::from_mat3(&t.matrix3).normalize();
+    let (ra, rb) = (rotation(a), rotation(b));
+    // q and -q are one rotation: take the nearer, so the arc is the shortest.
+    let rb = if ra.dot(rb) < 0.0 { -rb } else { rb };
+    let translation = a.translation.lerp(b.translation, s);
+    DAffine3::from_rotation_translation(ra.slerp(rb, s).normalize(), translation)
+}
+
 /// A rigid transform from the rows of a 3×4 `[R | t]` or 4×4 matrix (the last row then
 /// `0 0 0 1`).
 pub fn rigid_from_rows(rows: &[Vec<f64>]) -> Result<DAffine3, String> {

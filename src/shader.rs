@@ -15,7 +15,7 @@ use crate::split::SceneArrays;
 const SCENE_ARRAYS: &str = "scene_arrays";
 
 /// Every WGSL file of the project, by name (its file stem under `wgsl/`).
-pub const FILES: [(&str, &str); 31] = [
+pub const FILES: [(&str, &str); 32] = [
     ("math", include_str!("../wgsl/math.wgsl")),
     ("calibrated", include_str!("../wgsl/calibrated.wgsl")),
     ("triangles", include_str!("../wgsl/triangles.wgsl")),
@@ -26,6 +26,7 @@ pub const FILES: [(&str, &str); 31] = [
     ("trace", include_str!("../wgsl/trace.wgsl")),
     ("trace_rq", include_str!("../wgsl/trace_rq.wgsl")),
     ("pixel", include_str!("../wgsl/pixel.wgsl")),
+    ("frame", include_str!("../wgsl/frame.wgsl")),
     ("colour", include_str!("../wgsl/colour.wgsl")),
     ("adaptive", include_str!("../wgsl/adaptive.wgsl")),
     ("adaptive_rq", include_str!("../wgsl/adaptive_rq.wgsl")),

@@ -303,6 +303,7 @@ pub fn wgsl_constants() -> Vec<(String, u32)> {
         ("MAX_SHADOW_LAYERS", MAX_SHADOW_LAYERS),
         ("NO_HIT", NO_HIT),
         ("ADAPTIVE_BLOCK", ADAPTIVE_BLOCK),
+        ("MAX_KNOTS", MAX_KNOTS as u32),
         ("ADAPTIVE_HEADER", ADAPTIVE_HEADER),
         ("ADAPTIVE_COUNT", ADAPTIVE_COUNT),
         ("ADAPTIVE_ESTIMATE_SIDE", ADAPTIVE_ESTIMATE_SIDE),
@@ -315,6 +316,7 @@ pub fn wgsl_constants() -> Vec<(String, u32)> {
     .into_iter()
     .chain(LIGHT_KINDS)
     .chain(GLASS_SIZES)
+    .chain(READOUT_ORDERS)
     .map(|(n, v)| (n.to_string(), v))
     .collect();
     out.extend(LensKind::ALL.iter().map(|k| (k.const_name(), *k as u32)));
@@ -379,8 +381,10 @@ pub struct Shading {
     pub max_depth: u32,
 }
 
-/// The camera pose of a frame (80 bytes): the camera-to-world rotation's columns (camera x, y,
-/// z axes in world space) and the eye relative to the scene's origin.
+/// The camera pose of a frame (2,160 bytes): the camera-to-world rotation's columns (camera x,
+/// y, z axes) and the eye; with `MOTION` (a rolling shutter or an exposure, see
+/// `lens::Shutter`), those are the camera's pose in a moving body, and the body's poses at
+/// `knots` (slerp and lerp between them) carry it to the world at each ray's time.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, PartialEq, Pod, Zeroable)]
 pub struct Frame {
@@ -390,12 +394,42 @@ pub struct Frame {
     pub down: [f32; 4],
     /// Camera z (forward).
     pub forward: [f32; 4],
-    /// Eye position relative to the scene's origin (`GpuScene::origin`), xyz.
+    /// Eye position relative to the scene's origin (`GpuScene::origin`), xyz; with `MOTION`,
+    /// relative to the body's origin.
     pub eye: [f32; 4],
     /// The pixel of the first invocation (x, y), for dispatches over a part of the image;
     /// w: the first image row the outputs hold (a band of rows, when the whole image's
     /// outputs exceed one storage binding; 0 otherwise).
     pub offset: [u32; 4],
+    /// With `MOTION`: the knots in use (x, at least 1) and the readout order (y, a
+    /// `READOUT_*` of [`READOUT_ORDERS`]).
+    pub motion: [u32; 4],
+    /// With `MOTION`: seconds between two lines' readouts (x) and the exposure (y, seconds).
+    pub shutter: [f32; 4],
+    /// With `MOTION`: the body's poses, in increasing time.
+    pub knots: [Knot; MAX_KNOTS],
+}
+
+/// The most poses of a moving body one frame holds ([`Frame::knots`]): a readout and exposure
+/// may span that many stamps of a trajectory.
+pub const MAX_KNOTS: usize = 64;
+
+/// The WGSL id of each readout order of a rolling shutter (`lens::Readout`).
+pub const READOUT_ORDERS: [(&str, u32); 4] = [
+    ("READOUT_DOWN", 0),
+    ("READOUT_UP", 1),
+    ("READOUT_RIGHT", 2),
+    ("READOUT_LEFT", 3),
+];
+
+/// A moving body's pose at a time within a frame (32 bytes).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, PartialEq, Pod, Zeroable)]
+pub struct Knot {
+    /// The body-to-world rotation, a unit quaternion (x, y, z, w).
+    pub rotation: [f32; 4],
+    /// The body's origin relative to the scene's (xyz); w: seconds from the frame's stamp.
+    pub position: [f32; 4],
 }
 
 /// Adaptive sampling's settings as `wgsl/adaptive.wgsl` reads them (32 bytes).
@@ -629,6 +663,18 @@ mod tests {
                 ("forward", offset_of!(Frame, forward)),
                 ("eye", offset_of!(Frame, eye)),
                 ("offset", offset_of!(Frame, offset)),
+                ("motion", offset_of!(Frame, motion)),
+                ("shutter", offset_of!(Frame, shutter)),
+                ("knots", offset_of!(Frame, knots)),
+            ],
+        );
+        assert_wgsl_layout(
+            "trace",
+            "Knot",
+            size_of::<Knot>(),
+            &[
+                ("rotation", offset_of!(Knot, rotation)),
+                ("position", offset_of!(Knot, position)),
             ],
         );
     }

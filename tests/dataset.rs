@@ -520,3 +520,94 @@ fn a_frame_rate_renders_poses_between_the_stamps() {
     }
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// `--line-delay` reads a frame's rows over time (Kalibr's convention): under a body turning
+/// 1 rad/s about z, written as three stamps, each row's `direction` array is the lens's ray
+/// turned by the yaw at the frame's stamp plus row × line delay (within f32 rounding, 1e-6),
+/// across the stamp inside the readout. Frames whose readout reaches past the last stamp
+/// are skipped with a warning naming them, and the plan (so the manifest) lists them without
+/// files; a negative delay is refused naming the option.
+#[test]
+fn a_rolling_shutter_times_each_row_and_skips_frames_past_the_last_stamp() {
+    let dir = temp_dir("rolling");
+    let trajectory = dir.join("yaw.tum");
+    let pose = |t: f64| {
+        let (s, c) = (t / 2.0).sin_cos();
+        format!("{t} 0 0 1 0 0 {s} {c}\n")
+    };
+    std::fs::write(&trajectory, [0.0, 0.5, 1.0].map(pose).concat()).unwrap();
+    let out = dir.join("set");
+    let (line_delay, spec) = (0.01, "equidistant:f=0.6");
+    let args = |delay: f64| {
+        let mut command = fisheye();
+        command
+            .args(["dataset", "render", "--lens", spec, "--size", "32x24"])
+            .args(["--spp", "1", "--frame-rate", "5", "--outputs", "direction"])
+            .arg(format!("--line-delay={delay}"))
+            .arg("--trajectory")
+            .arg(&trajectory)
+            .arg("-o")
+            .arg(&out);
+        command
+    };
+    let said = succeed(&mut args(line_delay));
+    // A 24-row readout takes 0.23 s: frames at 0.8 s and 1.0 s reach past 1.0 s.
+    for stem in ["000004_0.800000", "000005_1.000000"] {
+        assert!(
+            said.contains(&format!("warning: frame {stem} is skipped")),
+            "{said}"
+        );
+    }
+    let plan: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("manifest.json")).unwrap()).unwrap();
+    assert_eq!(plan["skipped_frames"], serde_json::json!([4, 5]));
+    assert_eq!(plan["cameras"][0]["shutter"]["line_delay"], line_delay);
+    let frames = plan["frames"].as_array().unwrap();
+    assert!(
+        frames[4]["skipped"]
+            .as_str()
+            .unwrap()
+            .contains("never extrapolated")
+    );
+    assert!(
+        frames[4]["views"][0]["files"]
+            .as_object()
+            .unwrap()
+            .is_empty()
+    );
+    let camera = fisheye_rt::lens::LensCamera::new(
+        fisheye_rt::lens::parse_spec(spec).unwrap(),
+        fisheye_rt::lens::ImageSize::new(32, 24).unwrap(),
+    );
+    for (p, stamp) in [(0, 0.0), (2, 0.4)] {
+        let file = frames[p]["views"][0]["files"]["direction"]
+            .as_str()
+            .unwrap();
+        let bytes = std::fs::read(out.join(file)).unwrap();
+        let directions: Vec<f32> = npyz::NpyFile::new(&bytes[..]).unwrap().into_vec().unwrap();
+        let mut worst = 0.0f64;
+        for y in 0..24 {
+            let yaw = glam::DMat3::from_rotation_z(stamp + f64::from(y) * line_delay);
+            for x in 0..32 {
+                let Some(d) = camera.pixel_direction(x, y) else {
+                    continue;
+                };
+                let i = 3 * (y * 32 + x) as usize;
+                let got = DVec3::new(
+                    f64::from(directions[i]),
+                    f64::from(directions[i + 1]),
+                    f64::from(directions[i + 2]),
+                );
+                worst = worst.max((got - yaw * d).length());
+            }
+        }
+        assert!(worst < 1e-6, "frame {p}: directions off by {worst:e}");
+    }
+    let output = args(-1.0).output().unwrap();
+    let message = String::from_utf8_lossy(&output.stderr);
+    assert!(
+        !output.status.success() && message.contains("--line-delay"),
+        "{message}"
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}

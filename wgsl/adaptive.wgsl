@@ -168,19 +168,20 @@ fn trace_list(
         return;
     }
     if mode == MODE_TRUTH {
-        let hit = first_hit(from_eye(ray.xyz));
+        let hit = first_hit(centre_ray(pixel, ray.xyz));
         geometry_out[index] = geometry_of(hit);
         ids_out[index] = hit.triangle;
         return;
     }
-    let traced = shade(from_eye(ray.xyz));
+    let traced = shade(centre_ray(pixel, ray.xyz));
     colour_out[index] = vec4<f32>(traced.colour, 1.0);
     geometry_out[index] = geometry_of(traced);
     ids_out[index] = traced.triangle;
     state[index] = vec2<u32>(1u, surface_key(traced));
 }
 
-// What a block's corner saw: its key, and its hit's normal and position from the eye.
+// What a block's corner saw: its key, and its hit's normal and position (relative to the
+// scene's origin).
 struct Corner {
     key: u32,
     geometry: vec4<f32>,
@@ -190,7 +191,8 @@ struct Corner {
 fn corner(p: vec2<u32>) -> Corner {
     let i = index_of(p);
     let g = geometry_out[i];
-    return Corner(state[i].y, g, world(primary_ray(p).xyz) * g.w);
+    let ray = centre_ray(p, primary_ray(p).xyz);
+    return Corner(state[i].y, g, ray.origin + ray.dir * g.w);
 }
 
 // Whether two traced, unmasked corners see one smooth stretch of one surface: the same

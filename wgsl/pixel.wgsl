@@ -1,11 +1,12 @@
-// What every per-pixel tracing kernel shares (`trace.wgsl`, `adaptive.wgsl`): the frame, the
-// outputs, and a pixel's supersampled colour. Group 0's bindings 2 to 5; the lens and the
-// direction table (bindings 0 and 1) come from `primary.wgsl`, the glass (binding 6, zero
-// without) from `glass.wgsl`.
+// What every per-pixel tracing kernel shares (`trace.wgsl`, `adaptive.wgsl`): the outputs,
+// and a pixel's supersampled colour. Group 0's bindings 3 to 5; the lens and the direction
+// table (bindings 0 and 1) come from `primary.wgsl`, the frame (binding 2) from `frame.wgsl`,
+// the glass (binding 6, zero without) from `glass.wgsl`.
 #import primary
 #import sampling
 #import glass
 #import shade
+#import frame
 
 override SAMPLES_PER_SIDE: u32 = 1u;
 // Whether the colour is traced through a prescription's glass (`glass`), sample by sample,
@@ -13,36 +14,12 @@ override SAMPLES_PER_SIDE: u32 = 1u;
 override GLASS: bool = false;
 override GLASS_CHANNELS: u32 = 1u;
 
-// Mirrors `fisheye_rt::trace::Frame`: the camera-to-world rotation's columns (camera x right,
-// y down, z forward) and the eye. The scene is uploaded relative to its own camera, so the eye
-// is at the origin unless a camera path moved it.
-struct Frame {
-    right: vec4<f32>,
-    down: vec4<f32>,
-    forward: vec4<f32>,
-    eye: vec4<f32>,
-    // The pixel of the first invocation (xy), for dispatches over a part of the image; w:
-    // the first image row the outputs hold (a band of rows; 0 for a whole image).
-    offset: vec4<u32>,
-}
-
-@group(0) @binding(2) var<uniform> frame: Frame;
 // Linear RGB radiance; w = 1 where the pixel has a ray, all zero where masked.
 @group(0) @binding(3) var<storage, read_write> colour_out: array<vec4<f32>>;
 // World-space shading normal and distance of the primary hit; zero on a miss or mask.
 @group(0) @binding(4) var<storage, read_write> geometry_out: array<vec4<f32>>;
 // Scene triangle of the primary hit; NO_HIT on a miss or mask.
 @group(0) @binding(5) var<storage, read_write> ids_out: array<u32>;
-
-// A camera-space direction in the world.
-fn world(d: vec3<f32>) -> vec3<f32> {
-    return frame.right.xyz * d.x + frame.down.xyz * d.y + frame.forward.xyz * d.z;
-}
-
-// The ray through camera-space direction `d` from the eye.
-fn from_eye(d: vec3<f32>) -> Ray {
-    return Ray(frame.eye.xyz, world(d), 0.0, 3.0e38);
-}
 
 // A pixel's samples: the mean radiance of those that have a ray (a box filter) with the
 // share that do in w, and the mean of the half of them on the strata of one colour of a
@@ -63,7 +40,8 @@ fn samples(pixel: vec2<u32>, index: u32, side: u32) -> Sampled {
         let p = vec2<f32>(pixel) + sample_offset(index, k, side);
         let d = lens_unproject(lens, p);
         if d.w != 0.0 {
-            let c = shade(from_eye(d.xyz)).colour;
+            let at = camera_at(sample_time(pixel, index, k, count));
+            let c = shade(placed_ray(at, vec3<f32>(0.0), d.xyz)).colour;
             sum += c;
             covered += 1u;
             if (k % side + k / side) % 2u == 0u {
@@ -96,11 +74,12 @@ fn through_glass(pixel: vec2<u32>, index: u32) -> vec3<f32> {
     for (var k = 0u; k < side * side; k++) {
         let p = vec2<f32>(pixel) + sample_offset(index, k, side) - centre;
         let u = pupil_offset(index, k, side);
+        let at = camera_at(sample_time(pixel, index, k, side * side));
         for (var c = 0u; c < GLASS_CHANNELS; c++) {
             // One channel of three, or green's indices for all.
             let s = glass_sample(p, u, select(1u, c, GLASS_CHANNELS == 3u));
             if s.weight > 0.0 {
-                let ray = Ray(frame.eye.xyz + world(s.origin), world(s.direction), 0.0, 3.0e38);
+                let ray = placed_ray(at, s.origin, s.direction);
                 let radiance = s.weight * shade(ray).colour;
                 // Channel c's part alone, or every channel without dispersion.
                 let part = vec3<u32>(0u, 1u, 2u) == vec3<u32>(c) | vec3<bool>(GLASS_CHANNELS == 1u);

@@ -28,7 +28,7 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
         ids_out[stored] = NO_HIT;
         return;
     }
-    let centre = from_eye(ray.xyz);
+    let centre = centre_ray(pixel, ray.xyz);
     var traced: Traced;
     if GLASS {
         // The glass makes the colour; the fitted model's centre ray, the ground truth.

@@ -217,6 +217,13 @@ impl CubeMap {
                     .into(),
             ));
         }
+        if camera.shutter.moves() {
+            return Err(Error::Option(
+                "a cube map's faces are each one instant: a rolling shutter or an exposure is \
+                 traced directly (method rt or rq)"
+                    .into(),
+            ));
+        }
         let size = settings.size;
         let max = ctx.device.limits().max_texture_dimension_2d;
         if size == 0 || bordered(size) > max {

@@ -15,12 +15,17 @@
 //! every pose, and the same on every machine. Every file is written to a temporary name and
 //! renamed, so a frame whose files all exist is complete and a rerun skips it.
 
+pub mod readout;
 pub mod trajectory;
 
 #[cfg(feature = "cli")]
+mod files;
+#[cfg(feature = "cli")]
 mod run;
 #[cfg(feature = "cli")]
-pub use run::{ArrayFile, Dataset, Progress, RunReport, Submission, merge};
+pub use files::merge;
+#[cfg(feature = "cli")]
+pub use run::{ArrayFile, Dataset, Progress, RunReport, Submission};
 
 use std::ops::Range;
 

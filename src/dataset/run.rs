@@ -1,6 +1,6 @@
-//! Rendering a dataset: the plan (`plan.json`, what every frame is), the frames of a shard
+//! Rendering a dataset: the plan (`plan.json`, what every frame is) and the frames of a shard
 //! (all cameras of a pose in one submission, files written by a second thread while the next
-//! pose renders), and the merge that checks every file and writes `manifest.json`.
+//! pose renders); the folder's files and the merge are `files`'.
 
 use std::path::{Path, PathBuf};
 use std::sync::mpsc;
@@ -9,6 +9,8 @@ use std::time::Instant;
 use glam::{DAffine3, DVec3};
 use serde_json::{Value, json};
 
+use super::files::{LAYOUT, check_plan, merge, remove_leftovers};
+use super::readout::{Unrenderable, frame_motion};
 use super::trajectory::{Pose, TrajectoryFormat};
 use super::{Shard, camera_from_transform, frame_stem};
 use crate::error::{Error, Result};
@@ -18,17 +20,9 @@ use crate::lens::{CalibratedModel, Lens, LensCamera};
 use crate::pose::rows;
 use crate::scene::Scene;
 use crate::trace::{
-    Channel, ColourFile, Display, FramePass, GpuScene, RenderOptions, RenderOutput, Tone, rotated,
-    write_colour, write_file,
+    Channel, ColourFile, Display, FramePass, GpuScene, Motion, RenderOptions, RenderOutput, Tone,
+    moving_directions, rotated, write_colour, write_file,
 };
-
-/// The plan's file in a dataset's folder: written by every run before it renders, and
-/// compared, so that runs with other settings cannot mix their frames into it.
-const PLAN: &str = "plan.json";
-/// The manifest's file, written by [`merge`] once every frame is complete.
-const MANIFEST: &str = "manifest.json";
-/// What the plan and manifest say they are, for loaders to check.
-const LAYOUT: &str = "fisheye-rt dataset 1";
 
 /// The file format of the ground-truth arrays.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -68,6 +62,10 @@ pub struct Dataset {
     pub trajectory: (PathBuf, TrajectoryFormat, Option<f64>),
     /// The poses `T_world_body`, one a frame.
     pub poses: Vec<Pose>,
+    /// The trajectory's poses as its file gives them: where a camera's shutter spreads a
+    /// frame's rays over time, its motion is interpolated between them
+    /// ([`super::readout::frame_motion`]).
+    pub stamps: Vec<Pose>,
     /// The rig's cameras, named `cam0`, `cam1`, ... in order, each with `T_rig_camera`.
     pub cameras: Vec<(LensCamera, DAffine3)>,
     /// `T_scene_world`.
@@ -102,6 +100,9 @@ pub struct RunReport {
     pub poses: usize,
     /// Poses already complete, skipped.
     pub skipped: usize,
+    /// Poses skipped because a camera's readout or exposure reaches past the trajectory's
+    /// stamps (the plan says which and why).
+    pub outside: usize,
     /// Poses rendered (every camera).
     pub rendered: usize,
     /// Images written (poses rendered × cameras).
@@ -139,6 +140,8 @@ struct Written {
     index: usize,
     camera: usize,
     pose: crate::scene::Camera,
+    /// The camera's motion over the frame, where its shutter spreads the rays over time.
+    motion: Option<Motion>,
     output: RenderOutput,
 }
 
@@ -158,6 +161,49 @@ impl Dataset {
 
     fn lens_camera(&self, c: usize) -> LensCamera {
         self.cameras[c].0
+    }
+
+    /// Camera `c`'s motion over frame `p` (see [`frame_motion`]).
+    fn motion(&self, p: usize, c: usize) -> std::result::Result<Motion, Unrenderable> {
+        frame_motion(
+            &self.stamps,
+            self.poses[p].seconds,
+            &self.cameras[c].0,
+            &self.scene_from_world,
+            self.body_from_rig * self.cameras[c].1,
+        )
+    }
+
+    /// Why each frame is skipped, `None` for those rendered: a frame where some camera's
+    /// readout and exposure reach past the trajectory's ends. Errors where one spans more
+    /// poses than a frame holds.
+    pub fn skipped(&self) -> Result<Vec<Option<String>>> {
+        (0..self.poses.len())
+            .map(|p| {
+                for c in 0..self.cameras.len() {
+                    if !self.cameras[c].0.shutter.moves() {
+                        continue;
+                    }
+                    match self.motion(p, c) {
+                        Ok(_) => {}
+                        Err(Unrenderable::Outside(why)) => {
+                            return Ok(Some(format!("{}: {why}", Self::camera_name(c))));
+                        }
+                        Err(Unrenderable::Crowded(why)) => {
+                            return Err(Error::Dataset {
+                                path: self.trajectory.0.clone(),
+                                message: format!(
+                                    "frame {p} ({}), {}: {why}",
+                                    self.poses[p].stamp,
+                                    Self::camera_name(c)
+                                ),
+                            });
+                        }
+                    }
+                }
+                Ok(None)
+            })
+            .collect()
     }
 
     /// The files of camera `c` at pose `p`, relative to the dataset's folder: the colour
@@ -188,6 +234,7 @@ impl Dataset {
         let cameras: Vec<Value> = (0..self.cameras.len())
             .map(|c| self.camera_json(c))
             .collect::<Result<_>>()?;
+        let skipped = self.skipped()?;
         let frames: Vec<Value> = (0..self.poses.len())
             .map(|p| {
                 let pose = &self.poses[p];
@@ -196,6 +243,7 @@ impl Dataset {
                         let files: serde_json::Map<String, Value> = self
                             .files(p, c)
                             .into_iter()
+                            .filter(|_| skipped[p].is_none())
                             .map(|(what, file)| (what, Value::String(file)))
                             .collect();
                         json!({
@@ -205,14 +253,21 @@ impl Dataset {
                         })
                     })
                     .collect();
-                json!({
+                let mut frame = json!({
                     "index": p,
                     "stamp": pose.stamp,
                     "seconds": pose.seconds,
                     "T_world_body": rows(&pose.world_from_body),
                     "views": views,
-                })
+                });
+                if let Some(why) = &skipped[p] {
+                    frame["skipped"] = json!(why);
+                }
+                frame
             })
+            .collect();
+        let skipped_frames: Vec<usize> = (0..self.poses.len())
+            .filter(|&p| skipped[p].is_some())
             .collect();
         let (file, display) = self.colour;
         let plan = json!({
@@ -259,6 +314,7 @@ impl Dataset {
                 "arrays": self.outputs.1.extension(),
             },
             "cameras": cameras,
+            "skipped_frames": skipped_frames,
             "frames": frames,
         });
         Ok(serde_json::to_string_pretty(&plan).expect("JSON values serialise") + "\n")
@@ -311,6 +367,11 @@ impl Dataset {
                 "distortion_coefficients": distortion,
             },
             "T_rig_camera": rows(&self.cameras[c].1),
+            "shutter": {
+                "line_delay": camera.shutter.line_delay,
+                "exposure_time": camera.shutter.exposure,
+                "readout": camera.shutter.readout.name(),
+            },
         }))
     }
 
@@ -328,20 +389,24 @@ impl Dataset {
         let plan = self.plan()?;
         check_plan(folder, &plan)?;
         let range = shard.poses(self.poses.len());
+        let skipped = self.skipped()?;
         let complete = |p: usize| {
-            (0..self.cameras.len())
-                .flat_map(|c| self.files(p, c))
-                .all(|(_, file)| folder.join(file).is_file())
+            skipped[p].is_some()
+                || (0..self.cameras.len())
+                    .flat_map(|c| self.files(p, c))
+                    .all(|(_, file)| folder.join(file).is_file())
         };
         for c in 0..self.cameras.len() {
             remove_leftovers(&folder.join(Self::camera_name(c)), &range)?;
         }
         let todo: Vec<usize> = range.clone().filter(|&p| !complete(p)).collect();
+        let outside = range.clone().filter(|&p| skipped[p].is_some()).count();
         let skipped = range.len() - todo.len();
         let mut report = RunReport {
             shard: format!("{}/{}", shard.index, shard.count),
             poses: range.len(),
-            skipped,
+            skipped: skipped - outside,
+            outside,
             rendered: 0,
             images: 0,
             rays: 0,
@@ -460,17 +525,40 @@ impl Dataset {
                         Submission::Pose => vec![(0..passes.len()).collect()],
                         Submission::Camera => (0..passes.len()).map(|c| vec![c]).collect(),
                     };
+                    // Cameras whose shutters spread their rays over time move over the frame;
+                    // `skipped` left out the frames where that reaches past the trajectory.
+                    let motions: Vec<Option<Motion>> = (0..self.cameras.len())
+                        .map(|c| {
+                            let moves = self.cameras[c].0.shutter.moves();
+                            moves.then(|| self.motion(p, c).ok()).flatten()
+                        })
+                        .collect();
                     let mut outputs = Vec::with_capacity(passes.len());
                     for group in groups {
                         let t = Instant::now();
-                        ctx.checked("rendering a dataset frame", || {
+                        ctx.checked("rendering a dataset frame", || -> Result<()> {
                             let mut encoder =
                                 ctx.device.create_command_encoder(&Default::default());
                             for &c in &group {
-                                passes[c].encode(&ctx.device, &mut encoder, &gpu_scene, &poses[c]);
+                                let device = &ctx.device;
+                                match &motions[c] {
+                                    Some(motion) => passes[c].encode_motion(
+                                        device,
+                                        &mut encoder,
+                                        &gpu_scene,
+                                        motion,
+                                    )?,
+                                    None => passes[c].encode(
+                                        device,
+                                        &mut encoder,
+                                        &gpu_scene,
+                                        &poses[c],
+                                    ),
+                                }
                             }
                             ctx.queue.submit([encoder.finish()]);
-                        })?;
+                            Ok(())
+                        })??;
                         ctx.wait()?;
                         report.trace_seconds += t.elapsed().as_secs_f64();
                         let t = Instant::now();
@@ -487,6 +575,7 @@ impl Dataset {
                             index: p,
                             camera: c,
                             pose: poses[c],
+                            motion: motions[c].clone(),
                             output,
                         };
                         if sender.send(w).is_err() {
@@ -526,7 +615,12 @@ impl Dataset {
         if channels.is_empty() {
             return Ok(());
         }
-        let directions = rotated(&directions[w.camera], &w.pose);
+        let directions = match &w.motion {
+            Some(motion) => {
+                moving_directions(&self.lens_camera(w.camera), &directions[w.camera], motion)
+            }
+            None => rotated(&directions[w.camera], &w.pose),
+        };
         for (&channel, (_, name)) in channels.iter().zip(&files[1..]) {
             let path = folder.join(name);
             match arrays {
@@ -546,145 +640,4 @@ fn injected_kill() -> Option<usize> {
         .strip_prefix("kill-after-images:")?
         .parse()
         .ok()
-}
-
-/// Writes the plan into `folder`, or checks that the one there is the same.
-fn check_plan(folder: &Path, plan: &str) -> Result<()> {
-    let path = folder.join(PLAN);
-    match std::fs::read(&path) {
-        Ok(existing) if existing == plan.as_bytes() => Ok(()),
-        Ok(existing) => {
-            let line = String::from_utf8_lossy(&existing)
-                .lines()
-                .zip(plan.lines())
-                .position(|(a, b)| a != b)
-                .map_or(String::new(), |l| format!(" (first at line {})", l + 1));
-            Err(Error::Dataset {
-                path,
-                message: format!(
-                    "holds the plan of another dataset{line}: its scene, trajectory, rig or \
-                     settings differ from these. Render into another folder, or remove this \
-                     one to start again"
-                ),
-            })
-        }
-        Err(e) if e.kind() == std::io::ErrorKind::NotFound => write_file(&path, plan.as_bytes()),
-        Err(reason) => Err(Error::Io { path, reason }),
-    }
-}
-
-/// Removes the temporary files (`.NAME.PID.tmp`) a killed run left in `dir` for poses in
-/// `range` (another shard's are its own business: it may be writing them now).
-fn remove_leftovers(dir: &Path, range: &std::ops::Range<usize>) -> Result<()> {
-    let entries = match std::fs::read_dir(dir) {
-        Ok(entries) => entries,
-        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(()),
-        Err(reason) => {
-            return Err(Error::Io {
-                path: dir.to_path_buf(),
-                reason,
-            });
-        }
-    };
-    for entry in entries.flatten() {
-        let name = entry.file_name().to_string_lossy().to_string();
-        let Some(rest) = name.strip_prefix('.').filter(|_| name.ends_with(".tmp")) else {
-            continue;
-        };
-        let index = rest.split('_').next().and_then(|i| i.parse::<usize>().ok());
-        if index.is_some_and(|i| range.contains(&i)) {
-            std::fs::remove_file(entry.path()).map_err(|reason| Error::Io {
-                path: entry.path(),
-                reason,
-            })?;
-        }
-    }
-    Ok(())
-}
-
-/// Checks that every file the plan in `folder` lists exists and writes `manifest.json` (the
-/// plan, which lists every frame's files and poses); the error lists the incomplete poses
-/// by shard-independent ranges.
-pub fn merge(folder: &Path) -> Result<PathBuf> {
-    let plan_path = folder.join(PLAN);
-    let bad = |message: String| Error::Dataset {
-        path: plan_path.clone(),
-        message,
-    };
-    let text = match std::fs::read_to_string(&plan_path) {
-        Ok(text) => text,
-        Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
-            return Err(Error::Dataset {
-                path: folder.to_path_buf(),
-                message: "holds no dataset (no plan.json): `fisheye dataset render` makes one"
-                    .into(),
-            });
-        }
-        Err(reason) => {
-            return Err(Error::Io {
-                path: plan_path,
-                reason,
-            });
-        }
-    };
-    let plan: Value =
-        serde_json::from_str(&text).map_err(|e| bad(format!("not a dataset plan: {e}")))?;
-    if plan["layout"] != LAYOUT {
-        return Err(bad(format!("not a dataset plan of layout {LAYOUT:?}")));
-    }
-    let frames = plan["frames"]
-        .as_array()
-        .ok_or_else(|| bad("no frames list".into()))?;
-    let mut missing: Vec<usize> = Vec::new();
-    for (p, frame) in frames.iter().enumerate() {
-        let files = frame["views"]
-            .as_array()
-            .into_iter()
-            .flatten()
-            .flat_map(|v| v["files"].as_object().into_iter().flatten())
-            .filter_map(|(_, f)| f.as_str());
-        if files.into_iter().any(|f| !folder.join(f).is_file()) {
-            missing.push(p);
-        }
-    }
-    if !missing.is_empty() {
-        return Err(Error::Dataset {
-            path: folder.to_path_buf(),
-            message: format!(
-                "{} of {} poses are incomplete ({}): render their shards (again) and merge then",
-                missing.len(),
-                frames.len(),
-                ranges(&missing)
-            ),
-        });
-    }
-    let path = folder.join(MANIFEST);
-    write_file(&path, text.as_bytes())?;
-    Ok(path)
-}
-
-/// `[0, 1, 2, 5, 7, 8]` as `0-2, 5, 7-8` (at most eight runs, then how many more).
-fn ranges(indices: &[usize]) -> String {
-    let mut runs: Vec<(usize, usize)> = Vec::new();
-    for &i in indices {
-        match runs.last_mut() {
-            Some((_, end)) if *end + 1 == i => *end = i,
-            _ => runs.push((i, i)),
-        }
-    }
-    let mut text: Vec<String> = runs
-        .iter()
-        .take(8)
-        .map(|&(a, b)| {
-            if a == b {
-                a.to_string()
-            } else {
-                format!("{a}-{b}")
-            }
-        })
-        .collect();
-    if runs.len() > 8 {
-        text.push(format!("and {} more runs", runs.len() - 8));
-    }
-    text.join(", ")
 }

@@ -14,10 +14,10 @@
 
 use std::path::Path;
 
-use glam::{DAffine3, DQuat, DVec3};
+use glam::{DAffine3, DVec3};
 
 use crate::error::{Error, Result};
-use crate::pose::{rigid, rigid_from_rows, rotation_from_quaternion};
+use crate::pose::{interpolate, rigid, rigid_from_rows, rotation_from_quaternion};
 
 /// A trajectory file format.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -214,9 +214,9 @@ fn pose(line: &str, format: TrajectoryFormat, index: usize, fps: f64) -> Result<
 pub const MAX_FRAMES: usize = 10_000_000;
 
 /// The pose at `seconds` (the poses' clock): between the stamps around it, the translation
-/// interpolated linearly and the rotation by spherical linear interpolation (Shoemake,
-/// "Animating Rotation with Quaternion Curves", SIGGRAPH 1985: the shortest arc at constant
-/// angular velocity), exact at the stamps. Continuous, with a velocity that jumps at the
+/// interpolated linearly and the rotation by spherical linear interpolation
+/// ([`crate::pose::interpolate`]: the shortest arc at constant angular velocity), exact at
+/// the stamps. Continuous, with a velocity that jumps at the
 /// stamps, as the piecewise-constant motion a sampled trajectory implies. `None` before the
 /// first stamp and after the last: poses are never extrapolated.
 pub fn pose_at(poses: &[Pose], seconds: f64) -> Option<DAffine3> {
@@ -234,18 +234,7 @@ pub fn pose_at(poses: &[Pose], seconds: f64) -> Option<DAffine3> {
     if s == 0.0 {
         return Some(a.world_from_body);
     }
-    let rotation = |t: &DAffine3| DQuat::from_mat3(&t.matrix3).normalize();
-    let (ra, rb) = (rotation(&a.world_from_body), rotation(&b.world_from_body));
-    // q and -q are one rotation: take the nearer, so the arc is the shortest.
-    let rb = if ra.dot(rb) < 0.0 { -rb } else { rb };
-    let translation = a
-        .world_from_body
-        .translation
-        .lerp(b.world_from_body.translation, s);
-    Some(DAffine3::from_rotation_translation(
-        ra.slerp(rb, s).normalize(),
-        translation,
-    ))
+    Some(interpolate(&a.world_from_body, &b.world_from_body, s))
 }
 
 /// The poses at `hz` frames a second from the first stamp, up to the last (never past it), by

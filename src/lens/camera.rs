@@ -139,6 +139,9 @@ pub struct LensCamera {
     /// sample ([`super::glass_gpu`]); `lens` is then its chief rays' fitted mapping, which
     /// the mask, projection and ground truth follow.
     pub glass: Option<GlassParams>,
+    /// When the pixels see the scene: a global shutter at the frame's stamp by default, or
+    /// a rolling shutter and an exposure (see [`super::Shutter`]).
+    pub shutter: super::Shutter,
 }
 
 impl LensCamera {
@@ -150,6 +153,7 @@ impl LensCamera {
             size,
             formula: DirectionFormula::Stable,
             glass: None,
+            shutter: super::Shutter::GLOBAL,
         }
     }
 
@@ -161,8 +165,14 @@ impl LensCamera {
         }
     }
 
+    /// The same camera with `shutter`.
+    pub fn with_shutter(self, shutter: super::Shutter) -> Self {
+        Self { shutter, ..self }
+    }
+
     /// The same lens on an image `factor` times larger each way: the same field, with
-    /// `factor²` times the pixels (a calibrated lens's intrinsics scale with it).
+    /// `factor²` times the pixels (a calibrated lens's intrinsics scale with it) and the
+    /// same readout time (a line delay `factor` times shorter).
     pub fn scaled(&self, factor: u32) -> Result<Self, LensError> {
         let size = ImageSize::new(
             self.size.width.saturating_mul(factor),
@@ -178,6 +188,11 @@ impl LensCamera {
             lens,
             size,
             glass: self.glass.map(|g| g.scaled(factor)),
+            // As many lines again in the same readout.
+            shutter: super::Shutter {
+                line_delay: self.shutter.line_delay / f64::from(factor),
+                ..self.shutter
+            },
             ..*self
         })
     }

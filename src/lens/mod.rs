@@ -15,12 +15,14 @@ mod json;
 mod model;
 pub mod points;
 pub mod prescription;
+mod shutter;
 mod spec;
 
 pub use calibrated::{CalibratedLens, CalibratedModel, Intrinsics, newton_bound, solve};
 pub use camera::{DirectionFormula, ImageSize, LensCamera, MAX_IMAGE_SIDE};
 pub(crate) use model::Family;
 pub use model::{ClassicLens, Lens, LensModel};
+pub use shutter::{Readout, Shutter};
 pub use spec::{PRESET_FOV_DEGREES, PRESETS, Preset, parse_spec};
 
 #[cfg(test)]

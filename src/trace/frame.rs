@@ -2,7 +2,9 @@
 //! sampling ([`AdaptivePass`]), behind one type for the callers that take either and only
 //! want frames and their outputs: [`super::render`], `dataset render`, the Python package.
 
-use super::{AdaptivePass, AdaptiveSpans, GpuScene, RenderOptions, RenderOutput, TracePass};
+use super::{
+    AdaptivePass, AdaptiveSpans, GpuScene, Motion, RenderOptions, RenderOutput, TracePass,
+};
 use crate::error::Result;
 use crate::gpu::GpuContext;
 use crate::lens::LensCamera;
@@ -52,6 +54,25 @@ impl FramePass {
         pose: &Camera,
     ) {
         self.trace_pass().encode_pose(device, encoder, scene, pose);
+        self.encode_passes(encoder, scene);
+    }
+
+    /// Records a frame seen by a camera moving by `motion` (see
+    /// [`TracePass::encode_motion`]).
+    pub fn encode_motion(
+        &self,
+        device: &wgpu::Device,
+        encoder: &mut wgpu::CommandEncoder,
+        scene: &GpuScene,
+        motion: &Motion,
+    ) -> Result<()> {
+        self.trace_pass()
+            .encode_motion(device, encoder, scene, motion)?;
+        self.encode_passes(encoder, scene);
+        Ok(())
+    }
+
+    fn encode_passes(&self, encoder: &mut wgpu::CommandEncoder, scene: &GpuScene) {
         match self {
             FramePass::Uniform(pass) => pass.encode(encoder, scene, None),
             FramePass::Adaptive(pass) => pass.encode(encoder, scene, AdaptiveSpans::default()),

@@ -408,13 +408,16 @@ pub(super) fn view_frame(origin: DVec3, eye: DVec3, rotation: DMat3, offset: [u3
         let v = v.as_vec3();
         [v.x, v.y, v.z, 0.0]
     };
-    Frame {
-        right: col(rotation.x_axis),
-        down: col(rotation.y_axis),
-        forward: col(rotation.z_axis),
-        eye: col(eye - origin),
-        offset: [offset[0], offset[1], 0, 0],
-    }
+    let mut frame: Frame = bytemuck::Zeroable::zeroed();
+    frame.right = col(rotation.x_axis);
+    frame.down = col(rotation.y_axis);
+    frame.forward = col(rotation.z_axis);
+    frame.eye = col(eye - origin);
+    frame.offset = [offset[0], offset[1], 0, 0];
+    // One knot at rest: a kernel that moves its camera keeps it still.
+    frame.motion = [1, 0, 0, 0];
+    frame.knots[0].rotation = [0.0, 0.0, 0.0, 1.0];
+    frame
 }
 
 /// The frame of `pose` for a scene uploaded relative to `origin`.

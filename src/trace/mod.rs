@@ -11,6 +11,7 @@ pub mod cpu;
 mod display;
 mod frame;
 mod gpu_scene;
+mod motion;
 mod options;
 mod output;
 mod pass;
@@ -27,6 +28,7 @@ pub use display::{
 };
 pub use frame::FramePass;
 pub use gpu_scene::{GpuScene, SceneBytes, gpu_lights, shading_vertices};
+pub use motion::{Motion, moving_directions};
 pub use options::{Adaptive, RenderOptions, Sampling, Traversal, surface_constants, surface_id};
 pub use output::{Channel, RenderOutput, Values};
 pub use pass::TracePass;

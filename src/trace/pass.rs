@@ -4,7 +4,7 @@
 
 use super::gpu_scene::{frame_for, view_frame};
 use super::options::surface_constants;
-use super::{GpuScene, RenderOutput, sampling};
+use super::{GpuScene, Motion, RenderOutput, sampling};
 use crate::error::{Error, Result};
 use crate::gpu::{GpuContext, bind_group, dispatch_over_image, storage_entry, uniform_entry};
 use crate::lens::LensCamera;
@@ -14,9 +14,9 @@ use crate::shader;
 use crate::shared::Frame;
 use glam::{DMat3, DVec3};
 
-/// Bytes between the frame uniforms of a [`TracePass`]'s views: wgpu's default (and largest)
-/// `min_uniform_buffer_offset_alignment`.
-const FRAME_SLOT: u64 = 256;
+/// Bytes between the frame uniforms of a [`TracePass`]'s views: the frame rounded up to
+/// wgpu's default (and largest) `min_uniform_buffer_offset_alignment`, 256.
+const FRAME_SLOT: u64 = size_of::<Frame>().div_ceil(256) as u64 * 256;
 
 /// `frame` for each band of output rows `(first row, rows)`: its dispatch starts at the
 /// band's first row, and its outputs hold rows from there on (one band from row 0: the frame
@@ -24,9 +24,10 @@ const FRAME_SLOT: u64 = 256;
 fn band_frames(bands: &[(u32, u32)], frame: Frame) -> Vec<Frame> {
     bands
         .iter()
-        .map(|&(first, _)| Frame {
-            offset: [0, first, 0, first],
-            ..frame
+        .map(|&(first, _)| {
+            let mut band = frame;
+            band.offset = [0, first, 0, first];
+            band
         })
         .collect()
 }
@@ -228,8 +229,8 @@ impl TracePass {
     }
 
     /// Records a move of the camera to `pose` into `encoder`, for the frames recorded after
-    /// it: a copy of the 80-byte frame from a new buffer, so frames recorded into one encoder
-    /// may each have their own pose (see [`TracePass::set_pose`] for precision).
+    /// it: a copy of the frame from a new buffer, so frames recorded into one encoder may each
+    /// have their own pose (see [`TracePass::set_pose`] for precision).
     pub fn encode_pose(
         &self,
         device: &wgpu::Device,
@@ -237,7 +238,31 @@ impl TracePass {
         scene: &GpuScene,
         pose: &Camera,
     ) {
-        let slots = frame_slots(&band_frames(&self.bands, frame_for(scene.origin, pose)));
+        self.encode_frame(device, encoder, frame_for(scene.origin, pose));
+    }
+
+    /// As [`TracePass::encode_pose`] for a camera moving by `motion` while the frame is read
+    /// out and exposed, as the camera's [`crate::lens::Shutter`] says (at the stamp for a
+    /// global shutter exposed for an instant). Errors where the motion's knots are bad.
+    pub fn encode_motion(
+        &self,
+        device: &wgpu::Device,
+        encoder: &mut wgpu::CommandEncoder,
+        scene: &GpuScene,
+        motion: &Motion,
+    ) -> Result<()> {
+        let frame = motion.frame(scene.origin, &self.camera.shutter)?;
+        self.encode_frame(device, encoder, frame);
+        Ok(())
+    }
+
+    fn encode_frame(
+        &self,
+        device: &wgpu::Device,
+        encoder: &mut wgpu::CommandEncoder,
+        frame: Frame,
+    ) {
+        let slots = frame_slots(&band_frames(&self.bands, frame));
         let staging = crate::gpu::buffer_init(
             device,
             "fisheye.trace.pose",
@@ -432,6 +457,7 @@ fn trace_constants(
             f64::from(u8::from(scene.features.translucent)),
         ),
         ("GLASS", f64::from(u8::from(camera.glass.is_some()))),
+        ("MOTION", f64::from(u8::from(camera.shutter.moves()))),
         (
             "GLASS_CHANNELS",
             f64::from(camera.glass.map_or(1, |g| g.counts[2])),

@@ -11,7 +11,7 @@ use fisheye_rt::dataset::{ArrayFile, Dataset, Shard, Submission};
 use fisheye_rt::gpu::GpuContext;
 use fisheye_rt::lens::calib;
 use fisheye_rt::lens::glass::camera_for;
-use fisheye_rt::lens::{ImageSize, LensCamera};
+use fisheye_rt::lens::{ImageSize, LensCamera, Readout, Shutter};
 use fisheye_rt::pose::parse_transform;
 use fisheye_rt::trace::{Channel, ColourFile, Display, RenderOptions, Sampling};
 use glam::DAffine3;
@@ -53,6 +53,19 @@ pub(crate) struct RenderArgs {
     /// last stamp; by default one frame a pose of the file.
     #[arg(long)]
     frame_rate: Option<f64>,
+    /// A rolling shutter: seconds between two lines' readouts (Kalibr's line_delay: line v at
+    /// the frame's stamp + v·line_delay), for every camera; every primary ray, and the ground
+    /// truth, takes its line's pose. Frames whose readout reaches past the trajectory's last
+    /// stamp are skipped, with a warning, and the plan says so.
+    #[arg(long, default_value_t = 0.0)]
+    line_delay: f64,
+    /// Motion blur: seconds each line is exposed, centred on its time; a pixel's samples are
+    /// spread over it (stratified with their positions). 0: an instant.
+    #[arg(long, default_value_t = 0.0)]
+    exposure_time: f64,
+    /// The order a rolling shutter reads lines in.
+    #[arg(long, default_value = "top-to-bottom")]
+    readout: Readout,
     /// The trajectory's format, if detection from its text is not wanted.
     #[arg(long, value_enum)]
     trajectory_format: Option<FormatArg>,
@@ -191,16 +204,22 @@ fn render(args: &RenderArgs) -> Result<()> {
         (None, Some(spec)) => vec![(camera_for(spec, args.size)?, DAffine3::IDENTITY)],
         (None, None) => bail!("give the cameras: --rig CALIBRATION or --lens SPEC"),
     };
+    let shutter = Shutter::new(args.line_delay, args.exposure_time, args.readout)
+        .map_err(|e| anyhow::anyhow!("--line-delay/--exposure-time: {e}"))?;
+    let cameras: Vec<(LensCamera, DAffine3)> = cameras
+        .into_iter()
+        .map(|(camera, pose)| (camera.with_shutter(shutter), pose))
+        .collect();
     let format = args.trajectory_format.map(|f| match f {
         FormatArg::Tum => TrajectoryFormat::Tum,
         FormatArg::Kitti => TrajectoryFormat::Kitti,
         FormatArg::Euroc => TrajectoryFormat::Euroc,
     });
-    let (detected, poses) = trajectory::read(&args.trajectory, format, args.fps)?;
+    let (detected, stamps) = trajectory::read(&args.trajectory, format, args.fps)?;
     let poses = match args.frame_rate {
-        Some(hz) => trajectory::resample(&poses, detected, hz)
+        Some(hz) => trajectory::resample(&stamps, detected, hz)
             .map_err(|e| anyhow::anyhow!("--frame-rate: {e}"))?,
-        None => poses,
+        None => stamps.clone(),
     };
     let scene = load_scene_with(&args.scene, args.gltf_scene)?;
     let channels: Vec<Channel> = args
@@ -223,6 +242,7 @@ fn render(args: &RenderArgs) -> Result<()> {
         scene,
         trajectory: (args.trajectory.clone(), detected, args.frame_rate),
         poses,
+        stamps,
         cameras,
         scene_from_world,
         body_from_rig,
@@ -263,6 +283,12 @@ fn render(args: &RenderArgs) -> Result<()> {
         range.start,
         range.end
     );
+    for (p, why) in dataset.skipped()?.iter().enumerate() {
+        if let Some(why) = why.as_ref().filter(|_| range.contains(&p)) {
+            let stem = fisheye_rt::dataset::frame_stem(p, &dataset.poses[p].stamp);
+            eprintln!("warning: frame {stem} is skipped: {why}");
+        }
+    }
     let ctx = GpuContext::new()?;
     println!("adapter: {}", ctx.adapter_name());
     let loaded = started.elapsed().as_secs_f64();
@@ -306,6 +332,13 @@ fn render(args: &RenderArgs) -> Result<()> {
         println!(
             "all {} poses of the shard were already complete",
             report.poses
+        );
+    }
+    if report.outside > 0 {
+        println!(
+            "{} frames skipped: their readout or exposure reach past the trajectory's stamps \
+             (plan.json's skipped_frames)",
+            report.outside
         );
     }
     if args.shard == Shard::ALL {
