@@ -252,7 +252,11 @@ fn written_files_read_back() {
         "ucm:fx=300,cx=255.5,cy=255.5,alpha=1",
     ]) {
         let lens = *parse_spec(spec).unwrap().calibrated().unwrap();
-        let calibration = Calibration { lens, size };
+        let calibration = Calibration {
+            lens,
+            size,
+            line_delay: 0.0,
+        };
         for (name, format) in CalibFormat::ALL {
             let written = calib::write(&calibration, format);
             assert_eq!(
@@ -437,6 +441,7 @@ fn classic_lenses_convert_to_their_calibrated_equivalents() {
             &Calibration {
                 lens: equivalent.lens,
                 size,
+                line_delay: 0.0,
             },
             CalibFormat::Basalt,
         );
@@ -520,7 +525,11 @@ fn written_files_read_back_in_the_tools_own_readers() {
     let mut checked = 0;
     for spec in CalibratedModel::EXAMPLES {
         let lens = *parse_spec(spec).unwrap().calibrated().unwrap();
-        let calibration = Calibration { lens, size };
+        let calibration = Calibration {
+            lens,
+            size,
+            line_delay: 0.0,
+        };
         for (format, script) in [
             (CalibFormat::Kalibr, kalibr_script),
             (CalibFormat::Basalt, basalt_script),
@@ -570,4 +579,55 @@ fn written_files_read_back_in_the_tools_own_readers() {
     }
     assert!(checked >= 8, "{checked} files checked");
     std::fs::remove_dir_all(dir).unwrap();
+}
+
+/// A rolling shutter's `line_delay` (seconds, as Kalibr's rolling-shutter models write it)
+/// is read from a camchain, written back (a float to PyYAML, the value read), and refused
+/// where it is not a number of seconds of 0 or more; the formats without the key refuse to
+/// drop it. A camchain without it is a global shutter.
+#[test]
+fn a_camchains_line_delay_reads_and_writes_back() {
+    let camchain = |line_delay: &str| {
+        format!(
+            "cam0:\n  camera_model: pinhole\n  intrinsics: [190.9, 190.9, 254.9, 256.9]\n  \
+             distortion_model: equidistant\n  distortion_coeffs: [0.0035, 0.0007, -0.002, 0.0002]\n  \
+             resolution: [512, 512]\n{line_delay}"
+        )
+    };
+    let rolling = only(&camchain("  line_delay: 2.9e-05\n"), CalibFormat::Kalibr);
+    assert_eq!(rolling[0].line_delay, 2.9e-5);
+    assert_eq!(only(&camchain(""), CalibFormat::Kalibr)[0].line_delay, 0.0);
+    let written = calib::write(&rolling[0], CalibFormat::Kalibr).unwrap();
+    assert!(written.contains("line_delay: 2.9e-5\n"), "{written}");
+    assert_eq!(only(&written, CalibFormat::Kalibr), rolling);
+    let dir = std::env::temp_dir().join(format!("fisheye-line-delay-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let file = dir.join("camchain.yaml");
+    std::fs::write(&file, &written).unwrap();
+    let output = std::process::Command::new("python3")
+        .args([
+            "-c",
+            "import sys, yaml\nd = yaml.safe_load(open(sys.argv[1]))['cam0']['line_delay']\n\
+             print(type(d).__name__, repr(d))",
+        ])
+        .arg(&file)
+        .output()
+        .unwrap();
+    assert_eq!(
+        String::from_utf8_lossy(&output.stdout).trim(),
+        "float 2.9e-05"
+    );
+    std::fs::remove_dir_all(dir).unwrap();
+    for format in [CalibFormat::Basalt, CalibFormat::OpenCvYaml] {
+        let error = calib::write(&rolling[0], format).unwrap_err().to_string();
+        assert!(error.contains("line_delay"), "{error}");
+    }
+    for bad in ["-1e-5", "fast"] {
+        let error = calib::parse(
+            &camchain(&format!("  line_delay: {bad}\n")),
+            CalibFormat::Kalibr,
+        )
+        .unwrap_err();
+        assert!(error.contains("line_delay"), "{bad}: {error}");
+    }
 }

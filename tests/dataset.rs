@@ -526,7 +526,8 @@ fn a_frame_rate_renders_poses_between_the_stamps() {
 /// turned by the yaw at the frame's stamp plus row × line delay (within f32 rounding, 1e-6),
 /// across the stamp inside the readout. Frames whose readout reaches past the last stamp
 /// are skipped with a warning naming them, and the plan (so the manifest) lists them without
-/// files; a negative delay is refused naming the option.
+/// files; a negative delay is refused naming the option. A rig's camchain gives its camera's
+/// line delay unless `--line-delay` overrides it.
 #[test]
 fn a_rolling_shutter_times_each_row_and_skips_frames_past_the_last_stamp() {
     let dir = temp_dir("rolling");
@@ -609,5 +610,38 @@ fn a_rolling_shutter_times_each_row_and_skips_frames_past_the_last_stamp() {
         !output.status.success() && message.contains("--line-delay"),
         "{message}"
     );
+    // A camchain's line_delay is its camera's, unless --line-delay overrides it.
+    let rig = small_rig(&dir);
+    let text = std::fs::read_to_string(&rig).unwrap();
+    std::fs::write(
+        &rig,
+        text.replacen("cam0:\n", "cam0:\n  line_delay: 1.0e-4\n", 1),
+    )
+    .unwrap();
+    for (given, cam0, skipped) in [(None, 1e-4, 1), (Some("--line-delay=0"), 0.0, 0)] {
+        let out = dir.join(format!("rig-{cam0}"));
+        let mut command = fisheye();
+        command
+            .args([
+                "dataset",
+                "render",
+                "--rig",
+                &rig,
+                "--t-scene-world",
+                "z-up",
+            ])
+            .args(["--spp", "1", "--frame-rate", "2", "--trajectory"])
+            .arg(&trajectory)
+            .args(given)
+            .arg("-o")
+            .arg(&out);
+        succeed(&mut command);
+        let plan: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(out.join("plan.json")).unwrap()).unwrap();
+        assert_eq!(plan["cameras"][0]["shutter"]["line_delay"], cam0);
+        assert_eq!(plan["cameras"][1]["shutter"]["line_delay"], 0.0);
+        let listed = plan["skipped_frames"].as_array().unwrap().len();
+        assert_eq!(listed, skipped, "{given:?}");
+    }
     std::fs::remove_dir_all(&dir).unwrap();
 }

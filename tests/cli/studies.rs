@@ -347,6 +347,7 @@ fn validate_reports_and_fails_loudly() {
             _ => unreachable!("{spec} is calibrated"),
         },
         size: ImageSize::new(512, 512).unwrap(),
+        line_delay: 0.0,
     };
     let file = dir.join("ds.json");
     let text =

@@ -10,7 +10,7 @@ use fisheye_rt::cube::CubeMethod;
 use fisheye_rt::lens::calib::{self, CalibFormat};
 use fisheye_rt::lens::glass::camera_for;
 use fisheye_rt::lens::gpu::DirectionSource;
-use fisheye_rt::lens::{DirectionFormula, ImageSize, LensCamera};
+use fisheye_rt::lens::{DirectionFormula, ImageSize, LensCamera, Shutter};
 use fisheye_rt::raster::RasterMethod;
 use fisheye_rt::renderer;
 use fisheye_rt::scene::Scene;
@@ -259,7 +259,10 @@ impl CalibArgs {
                         self.calib_camera
                     );
                 };
-                LensCamera::new(c.lens, c.size)
+                LensCamera::new(c.lens, c.size).with_shutter(Shutter {
+                    line_delay: c.line_delay,
+                    ..Shutter::GLOBAL
+                })
             }
             None => {
                 let Some(spec) = lens else {

@@ -54,11 +54,12 @@ pub(crate) struct RenderArgs {
     #[arg(long)]
     frame_rate: Option<f64>,
     /// A rolling shutter: seconds between two lines' readouts (Kalibr's line_delay: line v at
-    /// the frame's stamp + v·line_delay), for every camera; every primary ray, and the ground
-    /// truth, takes its line's pose. Frames whose readout reaches past the trajectory's last
-    /// stamp are skipped, with a warning, and the plan says so.
-    #[arg(long, default_value_t = 0.0)]
-    line_delay: f64,
+    /// the frame's stamp + v·line_delay), for every camera, over any line_delay of the rig's
+    /// camchain; every primary ray, and the ground truth, takes its line's pose. Frames whose
+    /// readout reaches past the trajectory's last stamp are skipped, with a warning, and the
+    /// plan says so.
+    #[arg(long)]
+    line_delay: Option<f64>,
     /// Motion blur: seconds each line is exposed, centred on its time; a pixel's samples are
     /// spread over it (stratified with their positions). 0: an instant.
     #[arg(long, default_value_t = 0.0)]
@@ -198,18 +199,27 @@ fn render(args: &RenderArgs) -> Result<()> {
             .into_iter()
             .map(|c| {
                 let camera = LensCamera::new(c.calibration.lens, c.calibration.size);
+                let camera = camera.with_shutter(Shutter {
+                    line_delay: c.calibration.line_delay,
+                    ..Shutter::GLOBAL
+                });
                 (camera, c.body_from_camera)
             })
             .collect(),
         (None, Some(spec)) => vec![(camera_for(spec, args.size)?, DAffine3::IDENTITY)],
         (None, None) => bail!("give the cameras: --rig CALIBRATION or --lens SPEC"),
     };
-    let shutter = Shutter::new(args.line_delay, args.exposure_time, args.readout)
-        .map_err(|e| anyhow::anyhow!("--line-delay/--exposure-time: {e}"))?;
+    // --line-delay overrides a camchain's line_delay; the exposure and readout are the same
+    // for every camera.
     let cameras: Vec<(LensCamera, DAffine3)> = cameras
         .into_iter()
-        .map(|(camera, pose)| (camera.with_shutter(shutter), pose))
-        .collect();
+        .map(|(camera, pose)| {
+            let line_delay = args.line_delay.unwrap_or(camera.shutter.line_delay);
+            let shutter = Shutter::new(line_delay, args.exposure_time, args.readout)
+                .map_err(|e| anyhow::anyhow!("--line-delay/--exposure-time: {e}"))?;
+            Ok((camera.with_shutter(shutter), pose))
+        })
+        .collect::<Result<_>>()?;
     let format = args.trajectory_format.map(|f| match f {
         FormatArg::Tum => TrajectoryFormat::Tum,
         FormatArg::Kitti => TrajectoryFormat::Kitti,

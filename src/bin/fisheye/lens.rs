@@ -432,6 +432,7 @@ pub(crate) fn convert(args: &CameraArgs, format: CalibFormat, out: &Path) -> Res
         &Calibration {
             lens,
             size: camera.size,
+            line_delay: camera.shutter.line_delay,
         },
         format,
     )?;

@@ -10,6 +10,9 @@ pub struct Calibration {
     pub lens: CalibratedLens,
     /// The calibration's image size.
     pub size: ImageSize,
+    /// Seconds between two rows' readouts of a rolling shutter (Kalibr's `line_delay`, which
+    /// only its camchains hold); 0 for a global shutter.
+    pub line_delay: f64,
 }
 
 /// A calibration file format.

@@ -127,7 +127,11 @@ pub(super) fn opencv(get: impl Fn(&str) -> Option<Node>) -> Result<Calibration, 
         }
     };
     let lens = CalibratedLens::new(model, intrinsics).map_err(|e| e.to_string())?;
-    Ok(Calibration { lens, size })
+    Ok(Calibration {
+        lens,
+        size,
+        line_delay: 0.0,
+    })
 }
 
 pub(super) fn opencv_intrinsics(fx: f64, fy: f64, cx: f64, cy: f64) -> Intrinsics {
@@ -166,6 +170,18 @@ pub(super) fn kalibr(camera: &Yaml) -> Result<Calibration, String> {
             .iter()
             .map(|v| yaml_number(v).ok_or_else(|| format!("{key} holds a non-number")))
             .collect()
+    };
+    // A rolling shutter's line delay, seconds (Kalibr's rolling-shutter models write it).
+    let line_delay = match &camera["line_delay"] {
+        Yaml::BadValue | Yaml::Null => 0.0,
+        v => match yaml_number(v) {
+            Some(d) if d.is_finite() && d >= 0.0 => d,
+            _ => {
+                return Err(format!(
+                    "line_delay {v:?} is not a number of seconds of 0 or more"
+                ));
+            }
+        },
     };
     let resolution = list("resolution")?;
     let [w, h] = resolution[..] else {
@@ -260,7 +276,11 @@ pub(super) fn kalibr(camera: &Yaml) -> Result<Calibration, String> {
         (other, _) => return Err(format!("unknown camera_model {other:?}")),
     };
     let lens = CalibratedLens::new(model, intrinsics).map_err(|e| e.to_string())?;
-    Ok(Calibration { lens, size })
+    Ok(Calibration {
+        lens,
+        size,
+        line_delay,
+    })
 }
 
 /// One camera of a Basalt calibration.
@@ -305,5 +325,9 @@ pub(super) fn basalt(camera: &Json, resolution: Option<&Json>) -> Result<Calibra
         other => return Err(format!("camera_type {other:?} is not supported")),
     };
     let lens = CalibratedLens::new(model, intrinsics).map_err(|e| e.to_string())?;
-    Ok(Calibration { lens, size })
+    Ok(Calibration {
+        lens,
+        size,
+        line_delay: 0.0,
+    })
 }

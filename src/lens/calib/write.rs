@@ -10,7 +10,8 @@
 //! - **Kalibr** camchain YAML: per camera `camera_model` (`pinhole`, `omni` (Mei's unified
 //!   model, intrinsics `[xi, fu, fv, pu, pv]`), `ds` (`[xi, alpha, fu, fv, pu, pv]`), `eucm`
 //!   (`[alpha, beta, fu, fv, pu, pv]`)), `distortion_model` (`equidistant` (Kannala–Brandt),
-//!   `radtan`, `fov`, `none`), `intrinsics`, `distortion_coeffs` and `resolution`.
+//!   `radtan`, `fov`, `none`), `intrinsics`, `distortion_coeffs` and `resolution`, and a
+//!   rolling shutter's `line_delay` (seconds) where it has one.
 //! - **Basalt** calibration JSON: `value0.intrinsics[i].camera_type` (`kb4`, `ds`, `eucm`,
 //!   `ucm`, `fov`, `pinhole`) with named `intrinsics`, and `value0.resolution[i]`.
 //!
@@ -42,6 +43,12 @@ pub fn write(calibration: &Calibration, format: CalibFormat) -> Result<String, L
         format: format.name(),
         model: model.name(),
     };
+    if calibration.line_delay > 0.0 && format != CalibFormat::Kalibr {
+        return Err(LensError::Unsupported {
+            format: format.name(),
+            model: "a rolling shutter (line_delay: only Kalibr camchains hold one)",
+        });
+    }
     if lens.max_fov().is_some() {
         return Err(LensError::Unsupported {
             format: format.name(),
@@ -117,9 +124,13 @@ pub fn write(calibration: &Calibration, format: CalibFormat) -> Result<String, L
                 }
                 _ => return Err(unsupported()),
             };
+            let line_delay = match calibration.line_delay {
+                d if d > 0.0 => format!("  line_delay: {}\n", float_text(d)),
+                _ => String::new(),
+            };
             Ok(format!(
                 "cam0:\n  camera_model: {camera_model}\n  intrinsics: [{}]\n  distortion_model: \
-                 {distortion}\n  distortion_coeffs: [{}]\n  resolution: [{w}, {h}]\n",
+                 {distortion}\n  distortion_coeffs: [{}]\n  resolution: [{w}, {h}]\n{line_delay}",
                 join(&intrinsics).join(", "),
                 join(&coeffs).join(", ")
             ))
