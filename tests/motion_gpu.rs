@@ -83,7 +83,7 @@ fn a_rolling_shutter_turns_each_line_by_its_time() {
                         (i % size.width as usize) as u32,
                         (i / size.width as usize) as u32,
                     );
-                    let t = shutter.line_time(size, x, y);
+                    let t = rolling.line_time(x, y);
                     (t - f64::from(line) * 1e-3).abs() < 1e-9
                 })
                 .collect();
@@ -227,7 +227,7 @@ fn an_exposure_smears_an_edge_by_the_distance_it_moves() {
     for line_delay in [0.0, 2e-4] {
         let exposed =
             still.with_shutter(Shutter::new(line_delay, exposure, Readout::TopToBottom).unwrap());
-        let (first, last) = exposed.shutter.span(size);
+        let (first, last) = exposed.exposure_span();
         let motion = Motion {
             knots: vec![(first, slide(first)), (last, slide(last))],
             body_from_camera: DAffine3::from_mat3(scene.camera.rotation()),

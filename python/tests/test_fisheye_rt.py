@@ -397,3 +397,37 @@ def test_gltf_written_by_trimesh_renders_as_its_obj(tmp_path, obj):
     assert hit.mean() > 0.02  # something is in view (the Buddha covers 4%)
     assert np.max(np.abs(a[hit] - b[hit]) / a[hit]) < 1e-5
     assert np.mean(np.abs(x - y)[..., :3]) < 2.0  # of 255
+
+
+def test_flow_files_read_back_in_opencv_and_as_kitti_stores_them(tmp_path):
+    """`dataset render --outputs flow --flow-format flo` writes what `cv2.readOpticalFlow`
+    reads as the NPY flow (unknown flow above Middlebury's 1e9), and `--flow-format kitti` a
+    16-bit PNG that `cv2.imread` reads as KITTI's devkit stores it: (u·64 + 2^15, v·64 + 2^15,
+    valid) in RGB, to 1/64 px."""
+    common = [
+        "dataset", "render", "--trajectory", str(ROOT / "scenes/dataset/room-loop.tum"),
+        "--t-scene-world", "z-up", "--lens", "equidistant:f=0.6", "--size", "48x36",
+        "--spp", "1", "--outputs", "flow",
+    ]
+    sets = {}
+    for kind in ["arrays", "flo", "kitti"]:
+        sets[kind] = tmp_path / kind
+        fisheye(*common, "--flow-format", kind, "-o", str(sets[kind]))
+    stem = "cam0/000003_0.3"
+    flow = np.load(sets["arrays"] / f"{stem}.flow.npy")
+    valid = np.load(sets["arrays"] / f"{stem}.flow_valid.npy")
+    known = ~np.isnan(flow[..., 0])
+    assert known.sum() > 500 and valid.sum() > 0.8 * known.sum()
+
+    flo = cv2.readOpticalFlow(str(sets["flo"] / f"{stem}.flow.flo"))
+    assert flo.shape == flow.shape and flo.dtype == np.float32
+    assert np.array_equal(flo[known], flow[known])
+    assert np.all(flo[~known] > 1e9)
+
+    bgr = cv2.imread(str(sets["kitti"] / f"{stem}.flow.png"), cv2.IMREAD_UNCHANGED)
+    assert bgr.dtype == np.uint16 and bgr.shape == flow.shape[:2] + (3,)
+    u = (bgr[..., 2].astype(np.float64) - 2**15) / 64.0
+    v = (bgr[..., 1].astype(np.float64) - 2**15) / 64.0
+    assert np.max(np.abs(u[known] - flow[known][:, 0])) <= 1 / 128 + 1e-9
+    assert np.max(np.abs(v[known] - flow[known][:, 1])) <= 1 / 128 + 1e-9
+    assert np.array_equal(bgr[..., 0], valid.astype(np.uint16) * known)

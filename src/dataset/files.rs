@@ -1,6 +1,6 @@
-//! A dataset's folder on disk: the plan written once and checked by every run, the
-//! temporary files killed runs leave, and the merge that checks every file of the plan and
-//! writes `manifest.json`.
+//! A dataset's folder on disk: the arrays' format, the plan written once and checked by every
+//! run, the temporary files killed runs leave, and the merge that checks every file of the
+//! plan and writes `manifest.json`.
 
 use std::path::{Path, PathBuf};
 
@@ -8,6 +8,24 @@ use serde_json::Value;
 
 use crate::error::{Error, Result};
 use crate::trace::write_file;
+
+/// The file format of the ground-truth arrays.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ArrayFile {
+    /// NumPy `.npy`.
+    Npy,
+    /// OpenEXR `.exr`.
+    Exr,
+}
+
+impl ArrayFile {
+    pub(super) fn extension(self) -> &'static str {
+        match self {
+            Self::Npy => "npy",
+            Self::Exr => "exr",
+        }
+    }
+}
 
 /// The plan's file in a dataset's folder: written by every run before it renders, and
 /// compared, so that runs with other settings cannot mix their frames into it.

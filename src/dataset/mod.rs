@@ -15,17 +15,22 @@
 //! every pose, and the same on every machine. Every file is written to a temporary name and
 //! renamed, so a frame whose files all exist is complete and a rerun skips it.
 
+pub mod flow;
 pub mod readout;
 pub mod trajectory;
 
+#[cfg(feature = "cli")]
+mod between;
 #[cfg(feature = "cli")]
 mod files;
 #[cfg(feature = "cli")]
 mod run;
 #[cfg(feature = "cli")]
-pub use files::merge;
+pub use between::{Between, FlowFile};
 #[cfg(feature = "cli")]
-pub use run::{ArrayFile, Dataset, Progress, RunReport, Submission};
+pub use files::{ArrayFile, merge};
+#[cfg(feature = "cli")]
+pub use run::{Dataset, Progress, RunReport, Submission};
 
 use std::ops::Range;
 

@@ -21,7 +21,7 @@ pub enum Unrenderable {
 
 /// The motion of `camera` (at `body_from_camera` on the body) over the frame at `seconds`:
 /// the body's poses `T_scene_world · T_world_body(t)` at the start and end of the camera's
-/// readout and exposure ([`crate::lens::Shutter::span`]) and at every stamp of `trajectory`
+/// readout and exposure ([`LensCamera::exposure_span`]) and at every stamp of `trajectory`
 /// between them, times counted from `seconds`. A camera whose rays are all at the stamp
 /// gets the one pose there.
 pub fn frame_motion(
@@ -31,7 +31,7 @@ pub fn frame_motion(
     scene_from_world: &DAffine3,
     body_from_camera: DAffine3,
 ) -> Result<Motion, Unrenderable> {
-    let (first, last) = camera.shutter.span(camera.size);
+    let (first, last) = camera.exposure_span();
     let body = |t: f64| pose_at(trajectory, seconds + t).map(|p| *scene_from_world * p);
     let (Some(start), Some(end)) = (body(first), body(last)) else {
         let (a, b) = (
@@ -107,7 +107,7 @@ mod tests {
             assert!((t - w).abs() < 1e-12, "{times:?}");
         }
         for line in 0..11 {
-            let t = rolling.shutter.line_time(rolling.size, 0, line);
+            let t = rolling.line_time(0, line);
             let truth = pose_at(&trajectory, 0.6 + t).unwrap() * offset;
             assert!(motion.camera_at(t).abs_diff_eq(truth, 1e-12), "line {line}");
         }

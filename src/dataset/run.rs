@@ -7,40 +7,24 @@ use std::sync::mpsc;
 use std::time::Instant;
 
 use glam::{DAffine3, DVec3};
-use serde_json::{Value, json};
 
-use super::files::{LAYOUT, check_plan, merge, remove_leftovers};
+mod plan;
+
+use super::between::{Between, FlowFile};
+use super::files::{ArrayFile, check_plan, merge, remove_leftovers};
+use super::flow::Seen;
 use super::readout::{Unrenderable, frame_motion};
 use super::trajectory::{Pose, TrajectoryFormat};
 use super::{Shard, camera_from_transform, frame_stem};
 use crate::error::{Error, Result};
 use crate::gpu::GpuContext;
+use crate::lens::LensCamera;
 use crate::lens::gpu::DirectionSource;
-use crate::lens::{CalibratedModel, Lens, LensCamera};
-use crate::pose::rows;
 use crate::scene::Scene;
 use crate::trace::{
-    Channel, ColourFile, Display, FramePass, GpuScene, Motion, RenderOptions, RenderOutput, Tone,
+    Channel, ColourFile, Display, FramePass, GpuScene, Motion, RenderOptions, RenderOutput,
     moving_directions, rotated, write_colour, write_file,
 };
-
-/// The file format of the ground-truth arrays.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum ArrayFile {
-    /// NumPy `.npy`.
-    Npy,
-    /// OpenEXR `.exr`.
-    Exr,
-}
-
-impl ArrayFile {
-    fn extension(self) -> &'static str {
-        match self {
-            Self::Npy => "npy",
-            Self::Exr => "exr",
-        }
-    }
-}
 
 /// How a pose's cameras are submitted to the GPU.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -78,6 +62,9 @@ pub struct Dataset {
     pub colour: (ColourFile, Display),
     /// The ground truth written beside each image, and in what format.
     pub outputs: (Vec<Channel>, ArrayFile),
+    /// The ground truth between a frame and its neighbours (optical and scene flow), and
+    /// the files optical flow is written in.
+    pub between: (Vec<Between>, FlowFile),
 }
 
 /// Progress of a run: frames (poses) done of the shard's, and how many were already complete.
@@ -226,153 +213,28 @@ impl Dataset {
                 .iter()
                 .map(|ch| (ch.name().to_string(), format!("{stem}.{}.{ext}", ch.name()))),
         );
+        for b in &self.between.0 {
+            files.extend(b.files(&stem, self.outputs.1, self.between.1));
+        }
         files
     }
 
-    /// The plan: everything the dataset is, frame by frame, as JSON (deterministic bytes).
-    pub fn plan(&self) -> Result<String> {
-        let cameras: Vec<Value> = (0..self.cameras.len())
-            .map(|c| self.camera_json(c))
-            .collect::<Result<_>>()?;
-        let skipped = self.skipped()?;
-        let frames: Vec<Value> = (0..self.poses.len())
-            .map(|p| {
-                let pose = &self.poses[p];
-                let views: Vec<Value> = (0..self.cameras.len())
-                    .map(|c| {
-                        let files: serde_json::Map<String, Value> = self
-                            .files(p, c)
-                            .into_iter()
-                            .filter(|_| skipped[p].is_none())
-                            .map(|(what, file)| (what, Value::String(file)))
-                            .collect();
-                        json!({
-                            "camera": Self::camera_name(c),
-                            "T_scene_camera": rows(&self.scene_from_camera(p, c)),
-                            "files": files,
-                        })
-                    })
-                    .collect();
-                let mut frame = json!({
-                    "index": p,
-                    "stamp": pose.stamp,
-                    "seconds": pose.seconds,
-                    "T_world_body": rows(&pose.world_from_body),
-                    "views": views,
-                });
-                if let Some(why) = &skipped[p] {
-                    frame["skipped"] = json!(why);
+    /// The frames to trace for `todo`'s: each, and where flow is written its neighbours
+    /// (another shard's, or already complete) that are not skipped, in order, with whether
+    /// to write it.
+    fn traced(&self, todo: &[usize], skipped: &[Option<String>]) -> Vec<(usize, bool)> {
+        let reach = usize::from(!self.between.0.is_empty());
+        let mut frames = std::collections::BTreeMap::new();
+        for &p in todo {
+            let first = p.saturating_sub(reach);
+            let around = &skipped[first..=(p + reach).min(self.poses.len() - 1)];
+            for (q, why) in (first..).zip(around) {
+                if why.is_none() {
+                    *frames.entry(q).or_insert(false) |= q == p;
                 }
-                frame
-            })
-            .collect();
-        let skipped_frames: Vec<usize> = (0..self.poses.len())
-            .filter(|&p| skipped[p].is_some())
-            .collect();
-        let (file, display) = self.colour;
-        let plan = json!({
-            "layout": LAYOUT,
-            "tool": format!("fisheye-rt {}", env!("CARGO_PKG_VERSION")),
-            "scene": self.scene_name,
-            "trajectory": {
-                "file": self.trajectory.0.display().to_string(),
-                "format": self.trajectory.1.name(),
-                "frame_rate": self.trajectory.2,
-                "poses": self.poses.len(),
-            },
-            "conventions": {
-                "transforms": "T_a_b maps coordinates in frame b to frame a, as 4x4 row-major \
-                               matrices; T_scene_camera = T_scene_world T_world_body T_body_rig \
-                               T_rig_camera",
-                "camera": "OpenCV: x right, y down, z forward",
-                "pixels": "intrinsics put the top-left pixel's corner at (0, 0) (this \
-                           project's convention); opencv.camera_matrix puts its centre there",
-                "arrays": "range: metres to the first hit along the pixel centre's ray (0 where \
-                           none); normal: world unit normal; id: scene triangle (4294967295 for \
-                           none); direction: world unit ray; mask: 1 where the lens has a ray",
-            },
-            "T_scene_world": rows(&self.scene_from_world),
-            "T_body_rig": rows(&self.body_from_rig),
-            "render": {
-                "method": "rt",
-                "spp": self.options.spp,
-                "sampling": self.options.sampling().to_string(),
-                "max_depth": self.options.max_depth,
-                "bvh": self.options.bvh.name(),
-                "colour": match file {
-                    ColourFile::Png8 => "8-bit sRGB PNG",
-                    ColourFile::Png16 => "16-bit sRGB PNG",
-                    ColourFile::ExrHalf => "half-float linear OpenEXR",
-                    ColourFile::ExrFloat => "float linear OpenEXR",
-                },
-                "exposure": display.exposure,
-                "tone": match display.tone {
-                    Tone::Aces => "aces",
-                    Tone::Clamp => "clamp",
-                },
-                "outputs": self.outputs.0.iter().map(|c| c.name()).collect::<Vec<_>>(),
-                "arrays": self.outputs.1.extension(),
-            },
-            "cameras": cameras,
-            "skipped_frames": skipped_frames,
-            "frames": frames,
-        });
-        Ok(serde_json::to_string_pretty(&plan).expect("JSON values serialise") + "\n")
-    }
-
-    /// A camera's calibration in the project's and OpenCV's conventions, and its rig pose.
-    fn camera_json(&self, c: usize) -> Result<Value> {
-        let camera = self.lens_camera(c);
-        let (lens, equivalent) = match camera.lens {
-            Lens::Calibrated(lens) => (lens, Value::Null),
-            Lens::Classic(_) => {
-                let e = crate::lens::fit::calibrated_equivalent(&camera)?;
-                let note = json!({
-                    "lens": camera.lens.to_string(),
-                    "exact": e.exact,
-                    "residual_px": e.residual_px,
-                });
-                (e.lens, note)
             }
-        };
-        let i = lens.intrinsics();
-        let model = lens.model();
-        let parameters: serde_json::Map<String, Value> = model
-            .parameters()
-            .into_iter()
-            .map(|(k, v)| (k.to_string(), json!(v)))
-            .collect();
-        let (cv_model, distortion) = match model {
-            CalibratedModel::KannalaBrandt { k } => (json!("cv::fisheye"), json!(k)),
-            CalibratedModel::RadTan { k, p } => (
-                json!("cv::calibrateCamera"),
-                json!([k[0], k[1], p[0], p[1], k[2]]),
-            ),
-            _ => (Value::Null, Value::Null),
-        };
-        let (cx, cy) = (i.cx - 0.5, i.cy - 0.5);
-        Ok(json!({
-            "name": Self::camera_name(c),
-            "width": camera.size.width,
-            "height": camera.size.height,
-            "lens": camera.lens.to_string(),
-            "model": model.name(),
-            "intrinsics": {"fx": i.fx, "fy": i.fy, "cx": i.cx, "cy": i.cy},
-            "parameters": parameters,
-            "max_fov_degrees": lens.max_fov().map(f64::to_degrees),
-            "calibrated_equivalent_of": equivalent,
-            "opencv": {
-                "model": cv_model,
-                "camera_matrix": [[i.fx, 0.0, cx], [0.0, i.fy, cy], [0.0, 0.0, 1.0]],
-                "distortion_coefficients": distortion,
-            },
-            "T_rig_camera": rows(&self.cameras[c].1),
-            "shutter": {
-                "line_delay": camera.shutter.line_delay,
-                "exposure_time": camera.shutter.exposure,
-                "readout": camera.shutter.readout.name(),
-            },
-        }))
+        }
+        frames.into_iter().collect()
     }
 
     /// Renders the poses of `shard` into `folder`: writes (or checks) the plan, skips the
@@ -389,9 +251,9 @@ impl Dataset {
         let plan = self.plan()?;
         check_plan(folder, &plan)?;
         let range = shard.poses(self.poses.len());
-        let skipped = self.skipped()?;
+        let reasons = self.skipped()?;
         let complete = |p: usize| {
-            skipped[p].is_some()
+            reasons[p].is_some()
                 || (0..self.cameras.len())
                     .flat_map(|c| self.files(p, c))
                     .all(|(_, file)| folder.join(file).is_file())
@@ -400,7 +262,7 @@ impl Dataset {
             remove_leftovers(&folder.join(Self::camera_name(c)), &range)?;
         }
         let todo: Vec<usize> = range.clone().filter(|&p| !complete(p)).collect();
-        let outside = range.clone().filter(|&p| skipped[p].is_some()).count();
+        let outside = range.clone().filter(|&p| reasons[p].is_some()).count();
         let skipped = range.len() - todo.len();
         let mut report = RunReport {
             shard: format!("{}/{}", shard.index, shard.count),
@@ -423,7 +285,8 @@ impl Dataset {
             skipped,
         });
         if !todo.is_empty() {
-            self.render_poses(ctx, folder, &todo, submission, &mut report, &mut |done| {
+            let frames = self.traced(&todo, &reasons);
+            self.render_poses(ctx, folder, &frames, submission, &mut report, &mut |done| {
                 progress(Progress {
                     done: skipped + done,
                     total: range.len(),
@@ -447,7 +310,7 @@ impl Dataset {
         &self,
         ctx: &GpuContext,
         folder: &Path,
-        todo: &[usize],
+        frames: &[(usize, bool)],
         submission: Submission,
         report: &mut RunReport,
         progress: &mut dyn FnMut(usize),
@@ -491,33 +354,75 @@ impl Dataset {
         ctx.wait()?;
         report.compile_seconds = t.elapsed().as_secs_f64();
         let started = Instant::now();
-        let (sender, receiver) = mpsc::sync_channel::<Written>(2 * self.cameras.len());
+        // Each traced frame's views, and whether to write them (a neighbour traced for flow
+        // alone is not).
+        let (sender, receiver) = mpsc::sync_channel::<(bool, Vec<Written>)>(2);
         std::thread::scope(|scope| -> Result<()> {
             let writer = scope.spawn(|| -> Result<f64> {
                 let mut seconds = 0.0;
                 let kill_after = injected_kill();
                 // The cameras' rays in their own frames, once: each pose only turns them.
-                let directions: Vec<Vec<Option<DVec3>>> = if self.outputs.0.is_empty() {
-                    Vec::new()
-                } else {
-                    lens_cameras.iter().map(LensCamera::directions).collect()
-                };
-                for (written, w) in receiver.into_iter().enumerate() {
-                    let t = Instant::now();
-                    self.write(folder, &directions, &w)?;
-                    seconds += t.elapsed().as_secs_f64();
-                    if kill_after == Some(written + 1) {
-                        // SAFETY: kill(2) on this process with SIGKILL takes no pointers and
-                        // does not return; it is the kill this fault stands for.
-                        unsafe {
-                            libc::kill(libc::getpid(), libc::SIGKILL);
+                let directions: Vec<Vec<Option<DVec3>>> =
+                    if self.outputs.0.is_empty() && self.between.0.is_empty() {
+                        Vec::new()
+                    } else {
+                        lens_cameras.iter().map(LensCamera::directions).collect()
+                    };
+                let mut images = 0;
+                let mut write = |frames: &[&(bool, Vec<Written>)], k: usize| -> Result<()> {
+                    let (wanted, views) = frames[k];
+                    if !wanted {
+                        return Ok(());
+                    }
+                    // The neighbours, where they are the frames just before and after.
+                    let index = views[0].index;
+                    let beside = |j: Option<usize>, at: usize| {
+                        j.and_then(|j| frames.get(j)).filter(|f| f.1[0].index == at)
+                    };
+                    let previous = beside(k.checked_sub(1), index.wrapping_sub(1));
+                    let next = beside(Some(k + 1), index + 1);
+                    for (c, w) in views.iter().enumerate() {
+                        let t = Instant::now();
+                        let around = (previous.map(|f| &f.1[c]), next.map(|f| &f.1[c]));
+                        self.write(folder, &directions, w, around)?;
+                        seconds += t.elapsed().as_secs_f64();
+                        images += 1;
+                        if kill_after == Some(images) {
+                            // SAFETY: kill(2) on this process with SIGKILL takes no pointers
+                            // and does not return; it is the kill this fault stands for.
+                            unsafe {
+                                libc::kill(libc::getpid(), libc::SIGKILL);
+                            }
                         }
                     }
+                    Ok(())
+                };
+                // Without flow a frame is written as it comes; with flow once the next has
+                // come (or there is none), its neighbours held beside it.
+                let mut window: std::collections::VecDeque<(bool, Vec<Written>)> =
+                    Default::default();
+                for frame in receiver {
+                    window.push_back(frame);
+                    if self.between.0.is_empty() {
+                        write(&[&window[0]], 0)?;
+                        window.clear();
+                    } else if window.len() >= 2 {
+                        let held: Vec<_> = window.iter().collect();
+                        write(&held, held.len() - 2)?;
+                        if window.len() == 3 {
+                            window.pop_front();
+                        }
+                    }
+                }
+                if !window.is_empty() {
+                    let held: Vec<_> = window.iter().collect();
+                    write(&held, held.len() - 1)?;
                 }
                 Ok(seconds)
             });
             let rendered = (|| -> Result<()> {
-                for (done, &p) in todo.iter().enumerate() {
+                let mut done = 0;
+                for &(p, wanted) in frames {
                     let poses: Vec<crate::scene::Camera> = (0..self.cameras.len())
                         .map(|c| camera_from_transform(&self.scene_from_camera(p, c)))
                         .collect();
@@ -569,22 +474,27 @@ impl Dataset {
                         }
                         report.readback_seconds += t.elapsed().as_secs_f64();
                     }
-                    for (c, output) in outputs.into_iter().enumerate() {
-                        report.images += 1;
-                        let w = Written {
+                    let views: Vec<Written> = outputs
+                        .into_iter()
+                        .enumerate()
+                        .map(|(c, output)| Written {
                             index: p,
                             camera: c,
                             pose: poses[c],
                             motion: motions[c].clone(),
                             output,
-                        };
-                        if sender.send(w).is_err() {
-                            // The writer stopped on an error, which its join reports.
-                            return Ok(());
-                        }
+                        })
+                        .collect();
+                    if sender.send((wanted, views)).is_err() {
+                        // The writer stopped on an error, which its join reports.
+                        return Ok(());
                     }
-                    report.rendered += 1;
-                    progress(done + 1);
+                    if wanted {
+                        report.images += self.cameras.len();
+                        report.rendered += 1;
+                        done += 1;
+                        progress(done);
+                    }
                 }
                 Ok(())
             })();
@@ -599,8 +509,15 @@ impl Dataset {
     }
 
     /// Writes one camera's files of one pose (the names [`Dataset::files`] gives), each to a
-    /// temporary name renamed into place; `directions` holds each camera's camera-frame rays.
-    fn write(&self, folder: &Path, directions: &[Vec<Option<DVec3>>], w: &Written) -> Result<()> {
+    /// temporary name renamed into place; `directions` holds each camera's camera-frame rays,
+    /// `around` its views of the previous and next frames where they were traced.
+    fn write(
+        &self,
+        folder: &Path,
+        directions: &[Vec<Option<DVec3>>],
+        w: &Written,
+        around: (Option<&Written>, Option<&Written>),
+    ) -> Result<()> {
         let files = self.files(w.index, w.camera);
         let (file, display) = self.colour;
         let out = &w.output;
@@ -612,21 +529,59 @@ impl Dataset {
             file,
         )?;
         let (channels, arrays) = &self.outputs;
-        if channels.is_empty() {
+        let camera_rays = directions;
+        if !channels.is_empty() {
+            let directions = match &w.motion {
+                Some(motion) => {
+                    moving_directions(&self.lens_camera(w.camera), &directions[w.camera], motion)
+                }
+                None => rotated(&directions[w.camera], &w.pose),
+            };
+            for (&channel, (_, name)) in channels.iter().zip(&files[1..]) {
+                let path = folder.join(name);
+                match arrays {
+                    ArrayFile::Npy => out.write_npy(channel, &directions, &path)?,
+                    ArrayFile::Exr => out.write_exr(channel, &directions, &path)?,
+                }
+            }
+        }
+        if self.between.0.is_empty() {
             return Ok(());
         }
-        let directions = match &w.motion {
-            Some(motion) => {
-                moving_directions(&self.lens_camera(w.camera), &directions[w.camera], motion)
-            }
-            None => rotated(&directions[w.camera], &w.pose),
-        };
-        for (&channel, (_, name)) in channels.iter().zip(&files[1..]) {
-            let path = folder.join(name);
-            match arrays {
-                ArrayFile::Npy => out.write_npy(channel, &directions, &path)?,
-                ArrayFile::Exr => out.write_exr(channel, &directions, &path)?,
-            }
+        // Flow: each view as it moved over its frame (still where its shutter is global).
+        let camera = self.lens_camera(w.camera);
+        let motion = |w: &Written| w.motion.clone().unwrap_or_else(|| Motion::still(&w.pose));
+        let motions = [Some(w), around.0, around.1].map(|w| w.map(motion));
+        fn seen<'a>(
+            camera: &'a LensCamera,
+            motion: Option<&'a Motion>,
+            w: Option<&'a Written>,
+            rays: &'a [Vec<Option<DVec3>>],
+        ) -> Option<Seen<'a>> {
+            let w = w?;
+            Some(Seen {
+                camera,
+                motion: motion?,
+                output: &w.output,
+                directions: &rays[w.camera],
+            })
+        }
+        let seen = |k: usize, w| seen(&camera, motions[k].as_ref(), w, camera_rays);
+        let this = seen(0, Some(w));
+        let (previous, next) = (seen(1, around.0), seen(2, around.1));
+        let mut rest = &files[1 + channels.len()..];
+        for b in &self.between.0 {
+            let count = b.files("", *arrays, self.between.1).len();
+            let this = this.as_ref().expect("the frame itself");
+            let neighbours = (previous.as_ref(), next.as_ref());
+            b.write(
+                folder,
+                &rest[..count],
+                this,
+                neighbours,
+                (*arrays, self.between.1),
+            )?;
+            rest = &rest[count..];
         }
         Ok(())
     }

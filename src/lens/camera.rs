@@ -170,6 +170,39 @@ impl LensCamera {
         Self { shutter, ..self }
     }
 
+    /// Pixel `(x, y)`'s line time, seconds from the frame's stamp: its line's number in the
+    /// shutter's readout order times the line delay (the f64 twin of `line_time` in
+    /// `wgsl/frame.wgsl`).
+    pub fn line_time(&self, x: u32, y: u32) -> f64 {
+        self.time_at(DVec2::new(f64::from(x) + 0.5, f64::from(y) + 0.5))
+    }
+
+    /// The time, seconds from the frame's stamp, at which the sensor reads a continuous
+    /// position (the top-left corner at (0, 0)): Kalibr's `line_delay · v` for the OpenCV row
+    /// coordinate v, in readout order; a pixel centre's is its line's
+    /// ([`LensCamera::line_time`]).
+    pub fn time_at(&self, p: DVec2) -> f64 {
+        let (w, h) = (f64::from(self.size.width), f64::from(self.size.height));
+        let line = match self.shutter.readout {
+            super::Readout::TopToBottom => p.y - 0.5,
+            super::Readout::BottomToTop => h - 0.5 - p.y,
+            super::Readout::LeftToRight => p.x - 0.5,
+            super::Readout::RightToLeft => w - 0.5 - p.x,
+        };
+        line * self.shutter.line_delay
+    }
+
+    /// The earliest and latest times, seconds from the frame's stamp, at which any pixel is
+    /// exposed: from the first line's exposure's start to the last's end.
+    pub fn exposure_span(&self) -> (f64, f64) {
+        let lines = match self.shutter.readout {
+            super::Readout::TopToBottom | super::Readout::BottomToTop => self.size.height,
+            super::Readout::LeftToRight | super::Readout::RightToLeft => self.size.width,
+        };
+        let half = 0.5 * self.shutter.exposure;
+        (-half, f64::from(lines - 1) * self.shutter.line_delay + half)
+    }
+
     /// The same lens on an image `factor` times larger each way: the same field, with
     /// `factor²` times the pixels (a calibrated lens's intrinsics scale with it) and the
     /// same readout time (a line delay `factor` times shorter).

@@ -6,8 +6,6 @@
 //! a row read top to bottom unless [`Readout`] says otherwise, and each line's exposure is
 //! centred on its time. `wgsl/frame.wgsl` gives each primary ray its time this way.
 
-use crate::lens::ImageSize;
-
 /// The order lines are read in.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum Readout {
@@ -101,53 +99,34 @@ impl Shutter {
     pub fn moves(&self) -> bool {
         self.line_delay > 0.0 || self.exposure > 0.0
     }
-
-    /// Pixel `(x, y)`'s line time, seconds from the frame's stamp: its line's number in
-    /// readout order times the line delay (the f64 twin of `line_time` in `wgsl/frame.wgsl`).
-    pub fn line_time(&self, size: ImageSize, x: u32, y: u32) -> f64 {
-        let line = match self.readout {
-            Readout::TopToBottom => y,
-            Readout::BottomToTop => size.height - 1 - y,
-            Readout::LeftToRight => x,
-            Readout::RightToLeft => size.width - 1 - x,
-        };
-        f64::from(line) * self.line_delay
-    }
-
-    /// The earliest and latest times, seconds from the frame's stamp, at which any pixel of
-    /// a `size` image is exposed: from the first line's exposure's start to the last's end.
-    pub fn span(&self, size: ImageSize) -> (f64, f64) {
-        let lines = match self.readout {
-            Readout::TopToBottom | Readout::BottomToTop => size.height,
-            Readout::LeftToRight | Readout::RightToLeft => size.width,
-        };
-        let half = 0.5 * self.exposure;
-        (-half, f64::from(lines - 1) * self.line_delay + half)
-    }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::lens::{ImageSize, LensCamera, parse_spec};
 
     /// Lines are read in the order named, `line_delay` apart; the span runs from the first
     /// line's exposure's start to the last's end; bad times are refused by name.
     #[test]
     fn lines_are_timed_in_readout_order() {
         let size = ImageSize::new(4, 3).unwrap();
-        let at = |readout, x, y| {
-            Shutter::new(0.5, 0.0, readout)
-                .unwrap()
-                .line_time(size, x, y)
+        let camera = |line_delay, exposure, readout| {
+            LensCamera::new(parse_spec("equidistant:f=0.5").unwrap(), size)
+                .with_shutter(Shutter::new(line_delay, exposure, readout).unwrap())
         };
+        let at = |readout, x, y| camera(0.5, 0.0, readout).line_time(x, y);
         assert_eq!(at(Readout::TopToBottom, 3, 2), 1.0);
         assert_eq!(at(Readout::BottomToTop, 3, 2), 0.0);
         assert_eq!(at(Readout::LeftToRight, 3, 0), 1.5);
         assert_eq!(at(Readout::RightToLeft, 3, 0), 0.0);
-        let rolling = Shutter::new(0.5, 0.2, Readout::LeftToRight).unwrap();
-        assert_eq!(rolling.span(size), (-0.1, 1.6));
-        assert!(rolling.moves() && !Shutter::GLOBAL.moves());
-        assert_eq!(Shutter::GLOBAL.span(size), (0.0, 0.0));
+        let rolling = camera(0.5, 0.2, Readout::LeftToRight);
+        assert_eq!(rolling.exposure_span(), (-0.1, 1.6));
+        assert!(rolling.shutter.moves() && !Shutter::GLOBAL.moves());
+        assert_eq!(
+            camera(0.0, 0.0, Readout::TopToBottom).exposure_span(),
+            (0.0, 0.0)
+        );
         for (line_delay, exposure, wanted) in [
             (-1.0, 0.0, "line delay -1"),
             (0.0, f64::NAN, "exposure time NaN"),

@@ -30,7 +30,7 @@ pub use frame::FramePass;
 pub use gpu_scene::{GpuScene, SceneBytes, gpu_lights, shading_vertices};
 pub use motion::{Motion, moving_directions};
 pub use options::{Adaptive, RenderOptions, Sampling, Traversal, surface_constants, surface_id};
-pub use output::{Channel, RenderOutput, Values};
+pub use output::{Channel, RenderOutput, Values, write_exr, write_npy};
 pub use pass::TracePass;
 pub use ray_query::RayQueryScene;
 

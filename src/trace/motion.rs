@@ -100,7 +100,7 @@ impl Motion {
 }
 
 /// The world-space direction of every pixel's centre ray of `camera` moving by `motion`,
-/// each at its line's time ([`Shutter::line_time`]), row-major, `None` where the lens masks
+/// each at its line's time ([`LensCamera::line_time`]), row-major, `None` where the lens masks
 /// the pixel: `directions` are `camera`'s in its own frame ([`LensCamera::directions`]).
 pub fn moving_directions(
     camera: &LensCamera,
@@ -114,7 +114,7 @@ pub fn moving_directions(
         .enumerate()
         .map(|(i, d)| {
             let (x, y) = ((i % width) as u32, (i / width) as u32);
-            let t = camera.shutter.line_time(size, x, y);
+            let t = camera.line_time(x, y);
             d.map(|d| motion.camera_at(t).matrix3 * d)
         })
         .collect()

@@ -177,13 +177,7 @@ impl RenderOutput {
         directions: &[Option<DVec3>],
         path: &Path,
     ) -> Result<()> {
-        let (h, w) = (u64::from(self.size.height), u64::from(self.size.width));
-        match self.values(channel, directions) {
-            Values::F32(1, v) => write_array(path, &[h, w], v),
-            Values::F32(n, v) => write_array(path, &[h, w, n as u64], v),
-            Values::U32(v) => write_array(path, &[h, w], v),
-            Values::U8(v) => write_array(path, &[h, w], v),
-        }
+        write_npy(path, self.size, self.values(channel, directions))
     }
 
     /// Writes one channel as an OpenEXR file (see [`Channel`] for the channel names); the mask
@@ -194,47 +188,70 @@ impl RenderOutput {
         directions: &[Option<DVec3>],
         path: &Path,
     ) -> Result<()> {
-        use exr::prelude::{
-            AnyChannel, AnyChannels, Encoding, FlatSamples, Image, Layer, LayerAttributes,
-            SmallVec, WritableImage,
-        };
-        let list: SmallVec<[AnyChannel<FlatSamples>; 4]> = match self.values(channel, directions) {
-            Values::F32(1, v) => [AnyChannel::new("Y", FlatSamples::F32(v))]
-                .into_iter()
-                .collect(),
-            Values::F32(n, v) => ["R", "G", "B"]
-                .iter()
-                .enumerate()
-                .map(|(k, name)| {
-                    let component = v.iter().skip(k).step_by(n).copied().collect();
-                    AnyChannel::new(*name, FlatSamples::F32(component))
-                })
-                .collect(),
-            Values::U32(v) => [AnyChannel::new("id", FlatSamples::U32(v))]
-                .into_iter()
-                .collect(),
-            Values::U8(v) => [AnyChannel::new(
-                "Y",
-                FlatSamples::F32(v.into_iter().map(f32::from).collect()),
-            )]
+        write_exr(
+            path,
+            self.size,
+            channel.name(),
+            self.values(channel, directions),
+        )
+    }
+}
+
+/// Writes an image's array as NPY: H×W, or H×W×n for n components a pixel.
+pub fn write_npy(path: &Path, size: ImageSize, values: Values) -> Result<()> {
+    let (h, w) = (u64::from(size.height), u64::from(size.width));
+    match values {
+        Values::F32(1, v) => write_array(path, &[h, w], v),
+        Values::F32(n, v) => write_array(path, &[h, w, n as u64], v),
+        Values::U32(v) => write_array(path, &[h, w], v),
+        Values::U8(v) => write_array(path, &[h, w], v),
+    }
+}
+
+/// Writes an image's array as OpenEXR, its layer named `name`: a scalar in channel `Y` (a
+/// `u8` as float 0 to 255), a `u32` in `id`, components in `R`, `G`, `B` (as many as it has).
+pub fn write_exr(path: &Path, size: ImageSize, name: &str, values: Values) -> Result<()> {
+    use exr::prelude::{
+        AnyChannel, AnyChannels, Encoding, FlatSamples, Image, Layer, LayerAttributes, SmallVec,
+        WritableImage,
+    };
+    let list: SmallVec<[AnyChannel<FlatSamples>; 4]> = match values {
+        Values::F32(1, v) => [AnyChannel::new("Y", FlatSamples::F32(v))]
             .into_iter()
             .collect(),
-        };
-        let size = (self.size.width as usize, self.size.height as usize);
-        let layer = Layer::new(
-            size,
-            LayerAttributes::named(channel.name()),
-            Encoding::SMALL_LOSSLESS,
-            AnyChannels::sort(list),
-        );
-        write_atomically(path, |temporary| {
-            Image::from_layer(layer)
-                .write()
-                .to_file(temporary)
-                .map_err(|e| Error::Io {
-                    path: path.to_path_buf(),
-                    reason: std::io::Error::other(e.to_string()),
-                })
-        })
-    }
+        Values::F32(n, v) => ["R", "G", "B"]
+            .iter()
+            .take(n)
+            .enumerate()
+            .map(|(k, name)| {
+                let component = v.iter().skip(k).step_by(n).copied().collect();
+                AnyChannel::new(*name, FlatSamples::F32(component))
+            })
+            .collect(),
+        Values::U32(v) => [AnyChannel::new("id", FlatSamples::U32(v))]
+            .into_iter()
+            .collect(),
+        Values::U8(v) => [AnyChannel::new(
+            "Y",
+            FlatSamples::F32(v.into_iter().map(f32::from).collect()),
+        )]
+        .into_iter()
+        .collect(),
+    };
+    let size = (size.width as usize, size.height as usize);
+    let layer = Layer::new(
+        size,
+        LayerAttributes::named(name),
+        Encoding::SMALL_LOSSLESS,
+        AnyChannels::sort(list),
+    );
+    write_atomically(path, |temporary| {
+        Image::from_layer(layer)
+            .write()
+            .to_file(temporary)
+            .map_err(|e| Error::Io {
+                path: path.to_path_buf(),
+                reason: std::io::Error::other(e.to_string()),
+            })
+    })
 }

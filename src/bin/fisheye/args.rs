@@ -7,6 +7,7 @@ use anyhow::{Context, Result, bail};
 use clap::ValueEnum;
 use fisheye_rt::bvh::BvhQuality;
 use fisheye_rt::cube::CubeMethod;
+use fisheye_rt::dataset::Between;
 use fisheye_rt::lens::calib::{self, CalibFormat};
 use fisheye_rt::lens::glass::camera_for;
 use fisheye_rt::lens::gpu::DirectionSource;
@@ -386,10 +387,17 @@ pub(crate) enum Output {
     Mask,
     /// The rays each pixel took, as a picture (`render` only).
     Spp,
+    /// Optical flow to the next frame and its covisibility (`dataset render` only).
+    Flow,
+    /// Optical flow to the previous frame and its covisibility (`dataset render` only).
+    FlowBackward,
+    /// Each hit's motion in the camera's frame by the next frame (`dataset render` only).
+    SceneFlow,
 }
 
 impl Output {
-    /// The ground-truth array of this output; `None` for the spp map, which is a picture.
+    /// The ground-truth array of this output; `None` for the spp map, which is a picture,
+    /// and for the outputs between frames ([`Output::between`]).
     pub(crate) fn channel(self) -> Option<Channel> {
         Some(match self {
             Output::Range => Channel::Range,
@@ -397,8 +405,18 @@ impl Output {
             Output::Id => Channel::Id,
             Output::Direction => Channel::Direction,
             Output::Mask => Channel::Mask,
-            Output::Spp => return None,
+            Output::Spp | Output::Flow | Output::FlowBackward | Output::SceneFlow => return None,
         })
+    }
+
+    /// The output between a frame and its neighbours, for a dataset.
+    pub(crate) fn between(self) -> Option<Between> {
+        match self {
+            Output::Flow => Some(Between::Flow),
+            Output::FlowBackward => Some(Between::FlowBackward),
+            Output::SceneFlow => Some(Between::SceneFlow),
+            _ => None,
+        }
     }
 }
 

@@ -4,10 +4,10 @@
 use std::path::PathBuf;
 use std::time::Instant;
 
-use anyhow::{Context, Result, bail};
+use anyhow::{Result, bail};
 use clap::{Subcommand, ValueEnum};
 use fisheye_rt::dataset::trajectory::{self, TrajectoryFormat};
-use fisheye_rt::dataset::{ArrayFile, Dataset, Shard, Submission};
+use fisheye_rt::dataset::{ArrayFile, Between, Dataset, FlowFile, Shard, Submission};
 use fisheye_rt::gpu::GpuContext;
 use fisheye_rt::lens::calib;
 use fisheye_rt::lens::glass::camera_for;
@@ -116,9 +116,15 @@ pub(crate) struct RenderArgs {
     /// Tone curve of PNG images (see `render --tone`).
     #[arg(long, value_enum, default_value = "aces")]
     tone: ToneArg,
-    /// Ground truth written beside each image: range, normal, id, direction, mask.
+    /// Ground truth written beside each image: range, normal, id, direction, mask; and
+    /// between frames, through the lens (and rolling shutter): flow (to the next frame, with
+    /// flow_valid where it sees the point), flow-backward (from the previous), scene-flow.
     #[arg(long, value_enum, value_delimiter = ',')]
     outputs: Vec<Output>,
+    /// Optical flow's files: the arrays' --format (npy: H×W×2 float32), flo (Middlebury's,
+    /// as cv2.readOpticalFlow reads) or kitti (16-bit PNG: u·64 + 2^15, blue = valid).
+    #[arg(long, value_enum, default_value = "arrays")]
+    flow_format: FlowFormatArg,
     /// File format of the ground-truth arrays.
     #[arg(long, value_enum, default_value = "npy")]
     format: ArrayFormat,
@@ -144,6 +150,13 @@ enum FormatArg {
     Tum,
     Kitti,
     Euroc,
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+enum FlowFormatArg {
+    Arrays,
+    Flo,
+    Kitti,
 }
 
 #[derive(Clone, Copy, ValueEnum)]
@@ -232,17 +245,20 @@ fn render(args: &RenderArgs) -> Result<()> {
         None => stamps.clone(),
     };
     let scene = load_scene_with(&args.scene, args.gltf_scene)?;
-    let channels: Vec<Channel> = args
-        .outputs
-        .iter()
-        .map(|&o| {
-            o.channel()
-                .context("--outputs spp is render's (a picture of one frame's rays)")
-        })
-        .collect::<Result<_>>()?;
+    if args.outputs.iter().any(|o| matches!(o, Output::Spp)) {
+        bail!("--outputs spp is render's (a picture of one frame's rays)");
+    }
+    let channels: Vec<Channel> = args.outputs.iter().filter_map(|o| o.channel()).collect();
+    let mut between: Vec<Between> = Vec::new();
+    for b in args.outputs.iter().filter_map(|o| o.between()) {
+        if !between.contains(&b) {
+            between.push(b);
+        }
+    }
     // Adaptive sampling traces the hits of the pixels it interpolates where arrays of them
-    // are written.
-    let (spp, adaptive) = args.spp.options(channels.iter().any(Channel::traced));
+    // (or flow, made from them) are written.
+    let traced = channels.iter().any(Channel::traced) || !between.is_empty();
+    let (spp, adaptive) = args.spp.options(traced);
     let dataset = Dataset {
         // The plan records the scene by this name: a glTF file's other scene is another.
         scene_name: match args.gltf_scene {
@@ -268,6 +284,14 @@ fn render(args: &RenderArgs) -> Result<()> {
             Display {
                 exposure: args.exposure,
                 tone: args.tone.into(),
+            },
+        ),
+        between: (
+            between,
+            match args.flow_format {
+                FlowFormatArg::Arrays => FlowFile::Arrays,
+                FlowFormatArg::Flo => FlowFile::Flo,
+                FlowFormatArg::Kitti => FlowFile::Kitti,
             },
         ),
         outputs: (

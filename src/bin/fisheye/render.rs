@@ -118,11 +118,19 @@ pub(crate) fn render(args: &RenderArgs) -> Result<()> {
         args.out
             .with_extension(format!("{}.{extension}", channel.name()))
     };
+    if let Some(b) = args.outputs.iter().find_map(|o| o.between()) {
+        anyhow::bail!(
+            "--outputs {}: it needs the frames before and after; `fisheye dataset render \
+             --outputs {}` writes it along a trajectory",
+            b.name(),
+            b.name()
+        );
+    }
     let channels: Vec<Channel> = args.outputs.iter().filter_map(|o| o.channel()).collect();
     let spp_map = args
         .outputs
         .iter()
-        .any(|o| o.channel().is_none())
+        .any(|o| matches!(o, Output::Spp))
         .then(|| args.out.with_extension("spp.png"));
     check_writable(&args.out)?;
     for &channel in &channels {
