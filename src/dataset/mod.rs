@@ -16,7 +16,9 @@
 //! renamed, so a frame whose files all exist is complete and a rerun skips it.
 
 pub mod flow;
+pub mod imu;
 pub mod readout;
+pub mod smooth;
 pub mod trajectory;
 
 #[cfg(feature = "cli")]

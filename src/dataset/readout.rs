@@ -5,6 +5,7 @@
 
 use glam::DAffine3;
 
+use super::smooth::Spline;
 use super::trajectory::{Pose, pose_at};
 use crate::lens::LensCamera;
 use crate::shared::MAX_KNOTS;
@@ -19,28 +20,74 @@ pub enum Unrenderable {
     Crowded(String),
 }
 
+/// A trajectory as a function of time: slerp and lerp between its stamps, or its smooth
+/// spline where an IMU is simulated.
+#[derive(Clone, Copy, Debug)]
+pub enum Track<'a> {
+    /// Between the stamps ([`pose_at`]).
+    Stamps(&'a [Pose]),
+    /// The cumulative cubic B-spline through them.
+    Smooth(&'a Spline),
+}
+
+impl Track<'_> {
+    /// `T_world_body` at `t` seconds, `None` outside the path's span.
+    pub fn pose_at(&self, t: f64) -> Option<DAffine3> {
+        match self {
+            Track::Stamps(stamps) => pose_at(stamps, t),
+            Track::Smooth(spline) => spline.at(t).map(|m| m.pose),
+        }
+    }
+
+    /// The first and last times the path has a pose.
+    pub fn span(&self) -> (f64, f64) {
+        match self {
+            Track::Stamps(stamps) => (
+                stamps.first().map_or(0.0, |p| p.seconds),
+                stamps.last().map_or(0.0, |p| p.seconds),
+            ),
+            Track::Smooth(spline) => spline.span(),
+        }
+    }
+
+    /// The times strictly between `a` and `b` where a frame's knots go: the stamps, between
+    /// which the kernels' slerp is exact; on the spline, an eighth of its step apart.
+    fn between(&self, a: f64, b: f64) -> Vec<f64> {
+        match self {
+            Track::Stamps(stamps) => {
+                let lo = stamps.partition_point(|p| p.seconds <= a);
+                let hi = stamps.partition_point(|p| p.seconds < b);
+                stamps[lo..hi.max(lo)].iter().map(|p| p.seconds).collect()
+            }
+            Track::Smooth(spline) => {
+                let pieces = ((b - a) / (spline.step() / 8.0)).ceil().max(1.0) as usize;
+                (1..pieces)
+                    .map(|k| a + (b - a) * k as f64 / pieces as f64)
+                    .collect()
+            }
+        }
+    }
+}
+
 /// The motion of `camera` (at `body_from_camera` on the body) over the frame at `seconds`:
-/// the body's poses `T_scene_world · T_world_body(t)` at the start and end of the camera's
-/// readout and exposure ([`LensCamera::exposure_span`]) and at every stamp of `trajectory`
-/// between them, times counted from `seconds`. A camera whose rays are all at the stamp
-/// gets the one pose there.
+/// the body's poses `T_scene_world · T_world_body(t)` along `track` at the start and end of
+/// the camera's readout and exposure ([`LensCamera::exposure_span`]) and at the times
+/// between where the path needs knots, times counted from `seconds`. A camera whose rays
+/// are all at the stamp gets the one pose there.
 pub fn frame_motion(
-    trajectory: &[Pose],
+    track: Track,
     seconds: f64,
     camera: &LensCamera,
     scene_from_world: &DAffine3,
     body_from_camera: DAffine3,
 ) -> Result<Motion, Unrenderable> {
     let (first, last) = camera.exposure_span();
-    let body = |t: f64| pose_at(trajectory, seconds + t).map(|p| *scene_from_world * p);
+    let body = |t: f64| track.pose_at(seconds + t).map(|p| *scene_from_world * p);
     let (Some(start), Some(end)) = (body(first), body(last)) else {
-        let (a, b) = (
-            trajectory.first().map_or(0.0, |p| p.seconds),
-            trajectory.last().map_or(0.0, |p| p.seconds),
-        );
+        let (a, b) = track.span();
         return Err(Unrenderable::Outside(format!(
             "its readout and exposure, {:.6} s to {:.6} s, reach past the trajectory's \
-             stamps ({a:.6} s to {b:.6} s), and poses are never extrapolated",
+             poses ({a:.6} s to {b:.6} s), and poses are never extrapolated",
             seconds + first,
             seconds + last
         )));
@@ -51,11 +98,10 @@ pub fn frame_motion(
             body_from_camera,
         });
     }
-    let lo = trajectory.partition_point(|p| p.seconds <= seconds + first);
-    let hi = trajectory.partition_point(|p| p.seconds < seconds + last);
-    let inside = trajectory[lo..hi.max(lo)]
-        .iter()
-        .map(|p| (p.seconds - seconds, *scene_from_world * p.world_from_body));
+    let inside = track
+        .between(seconds + first, seconds + last)
+        .into_iter()
+        .filter_map(|t| Some((t - seconds, *scene_from_world * track.pose_at(t)?)));
     let knots: Vec<(f64, DAffine3)> = std::iter::once((first, start))
         .chain(inside)
         .chain(std::iter::once((last, end)))
@@ -99,7 +145,14 @@ mod tests {
         let trajectory = parse(&tum, TrajectoryFormat::Tum, 1.0).unwrap();
         let rolling = camera(0.1, 0.0);
         let offset = DAffine3::from_translation(DVec3::Y);
-        let motion = frame_motion(&trajectory, 0.6, &rolling, &DAffine3::IDENTITY, offset).unwrap();
+        let motion = frame_motion(
+            Track::Stamps(&trajectory),
+            0.6,
+            &rolling,
+            &DAffine3::IDENTITY,
+            offset,
+        )
+        .unwrap();
         let times: Vec<f64> = motion.knots.iter().map(|k| k.0).collect();
         let wanted = [0.0, 0.15, 0.4, 0.65, 0.9, 1.0];
         assert_eq!(times.len(), wanted.len());
@@ -112,7 +165,13 @@ mod tests {
             assert!(motion.camera_at(t).abs_diff_eq(truth, 1e-12), "line {line}");
         }
         for seconds in [1.1, -0.01] {
-            let outside = frame_motion(&trajectory, seconds, &rolling, &DAffine3::IDENTITY, offset);
+            let outside = frame_motion(
+                Track::Stamps(&trajectory),
+                seconds,
+                &rolling,
+                &DAffine3::IDENTITY,
+                offset,
+            );
             assert!(
                 matches!(outside, Err(Unrenderable::Outside(_))),
                 "{seconds}"
@@ -120,16 +179,35 @@ mod tests {
         }
         // An exposure of 0.2 s centred on the stamp reaches 0.1 s before the first.
         let exposed = camera(0.0, 0.2);
-        let early = frame_motion(&trajectory, 0.05, &exposed, &DAffine3::IDENTITY, offset);
+        let early = frame_motion(
+            Track::Stamps(&trajectory),
+            0.05,
+            &exposed,
+            &DAffine3::IDENTITY,
+            offset,
+        );
         assert!(matches!(early, Err(Unrenderable::Outside(_))));
         let dense: String = (0..=200)
             .map(|k| format!("{} 0 0 0 0 0 0 1\n", f64::from(k) * 0.01))
             .collect();
         let dense = parse(&dense, TrajectoryFormat::Tum, 1.0).unwrap();
-        let crowded = frame_motion(&dense, 0.0, &rolling, &DAffine3::IDENTITY, offset);
+        let crowded = frame_motion(
+            Track::Stamps(&dense),
+            0.0,
+            &rolling,
+            &DAffine3::IDENTITY,
+            offset,
+        );
         assert!(matches!(crowded, Err(Unrenderable::Crowded(m)) if m.contains("at most 64")));
         let still = camera(0.0, 0.0);
-        let one = frame_motion(&trajectory, 0.6, &still, &DAffine3::IDENTITY, offset).unwrap();
+        let one = frame_motion(
+            Track::Stamps(&trajectory),
+            0.6,
+            &still,
+            &DAffine3::IDENTITY,
+            offset,
+        )
+        .unwrap();
         assert_eq!(one.knots.len(), 1);
     }
 }

@@ -10,10 +10,14 @@ use glam::{DAffine3, DVec3};
 
 mod plan;
 
+/// The rig as a Kalibr camchain on the IMU, beside a simulated IMU's readings.
+const CAMCHAIN: &str = "camchain-imucam.yaml";
+
 use super::between::{Between, FlowFile};
 use super::files::{ArrayFile, check_plan, merge, remove_leftovers};
 use super::flow::Seen;
-use super::readout::{Unrenderable, frame_motion};
+use super::imu::Imu;
+use super::readout::{Track, Unrenderable, frame_motion};
 use super::trajectory::{Pose, TrajectoryFormat};
 use super::{Shard, camera_from_transform, frame_stem};
 use crate::error::{Error, Result};
@@ -65,6 +69,9 @@ pub struct Dataset {
     /// The ground truth between a frame and its neighbours (optical and scene flow), and
     /// the files optical flow is written in.
     pub between: (Vec<Between>, FlowFile),
+    /// A synthetic IMU on the body, whose spline the frames' poses follow too (`poses` hold
+    /// them).
+    pub imu: Option<Imu>,
 }
 
 /// Progress of a run: frames (poses) done of the shard's, and how many were already complete.
@@ -150,10 +157,19 @@ impl Dataset {
         self.cameras[c].0
     }
 
+    /// The trajectory as a function of time: its spline where an IMU is simulated (the
+    /// frames' poses then follow it too), else between its stamps.
+    fn track(&self) -> Track<'_> {
+        match &self.imu {
+            Some(imu) => Track::Smooth(&imu.spline),
+            None => Track::Stamps(&self.stamps),
+        }
+    }
+
     /// Camera `c`'s motion over frame `p` (see [`frame_motion`]).
     fn motion(&self, p: usize, c: usize) -> std::result::Result<Motion, Unrenderable> {
         frame_motion(
-            &self.stamps,
+            self.track(),
             self.poses[p].seconds,
             &self.cameras[c].0,
             &self.scene_from_world,
@@ -167,6 +183,14 @@ impl Dataset {
     pub fn skipped(&self) -> Result<Vec<Option<String>>> {
         (0..self.poses.len())
             .map(|p| {
+                let seconds = self.poses[p].seconds;
+                if self.imu.is_some() && self.track().pose_at(seconds).is_none() {
+                    let (a, b) = self.track().span();
+                    return Ok(Some(format!(
+                        "its time, {seconds:.6} s, is outside the IMU's spline ({a:.6} s to \
+                         {b:.6} s: a spline step in from the trajectory's ends)"
+                    )));
+                }
                 for c in 0..self.cameras.len() {
                     if !self.cameras[c].0.shutter.moves() {
                         continue;
@@ -250,6 +274,12 @@ impl Dataset {
     ) -> Result<RunReport> {
         let plan = self.plan()?;
         check_plan(folder, &plan)?;
+        if let Some(imu) = &self.imu {
+            imu.write(folder, self.stamps.first(), self.trajectory.1)?;
+            if let Some(camchain) = self.camchain() {
+                write_file(&folder.join(CAMCHAIN), camchain.as_bytes())?;
+            }
+        }
         let range = shard.poses(self.poses.len());
         let reasons = self.skipped()?;
         let complete = |p: usize| {

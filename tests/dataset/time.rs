@@ -346,3 +346,105 @@ fn flow_through_the_lens_follows_a_pure_rotation_and_shards_agree() {
     );
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// `--imu 400` writes EuRoC's `imu0/data.csv` from the trajectory's spline, which the frames
+/// follow too: the noise-free gyro integrated between two frames' times turns the first
+/// frame's `T_world_body` into the second's (within 1e-5 rad over 0.1 s of 2.5 ms steps); the
+/// readings start a spline step after the first stamp, 400 a second, stamped in integer
+/// nanoseconds; the frames outside the spline are skipped; the camchain beside them puts each
+/// camera where the rig does (read back as a rig); with `--imu-noise` the readings differ
+/// from the noise-free ones, and a rate that is not the noise's update_rate is refused.
+#[test]
+fn an_imu_reads_the_spline_the_frames_follow() {
+    let dir = temp_dir("imu");
+    let out = dir.join("set");
+    let noise = dir.join("imu.yaml");
+    std::fs::write(
+        &noise,
+        "accelerometer_noise_density: 2.0e-3\naccelerometer_random_walk: 3.0e-3\n\
+         gyroscope_noise_density: 1.7e-4\ngyroscope_random_walk: 1.9e-5\nupdate_rate: 400.0\n",
+    )
+    .unwrap();
+    let args = |rate: &str| {
+        let mut command = fisheye();
+        command
+            .args([
+                "dataset",
+                "render",
+                "--trajectory",
+                &repo("scenes/dataset/room-loop.tum"),
+            ])
+            .args([
+                "--rig",
+                &small_rig(&dir),
+                "--t-scene-world",
+                "z-up",
+                "--spp",
+                "1",
+            ])
+            .args(["--imu", rate, "--imu-noise"])
+            .arg(&noise)
+            .arg("-o")
+            .arg(&out);
+        command
+    };
+    succeed(&mut args("400"));
+    let plan: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("manifest.json")).unwrap()).unwrap();
+    assert_eq!(plan["skipped_frames"], serde_json::json!([0, 99]));
+    let read = |name: &str| -> Vec<Vec<f64>> {
+        let text = std::fs::read_to_string(out.join(name)).unwrap();
+        assert!(text.starts_with("#timestamp [ns],w_RS_S_x [rad s^-1]"));
+        text.lines()
+            .skip(1)
+            .map(|l| l.split(',').map(|v| v.parse().unwrap()).collect())
+            .collect()
+    };
+    let (clean, noisy) = (read("imu0/data_noise_free.csv"), read("imu0/data.csv"));
+    assert_eq!(clean.len(), noisy.len());
+    // From 0.05 s to 9.85 s (a spline step in from the 0 s and 9.9 s stamps), both ends.
+    assert_eq!(clean.len(), 3921);
+    assert_eq!((clean[0][0], clean[1][0]), (50_000_000.0, 52_500_000.0));
+    assert!(
+        clean
+            .iter()
+            .zip(&noisy)
+            .all(|(c, n)| c[1] != n[1] && c[0] == n[0])
+    );
+    let rotation = |k: usize| {
+        let rows: Vec<Vec<f64>> =
+            serde_json::from_value(plan["frames"][k]["T_world_body"].clone()).unwrap();
+        glam::DQuat::from_mat3(&glam::DMat3::from_cols_array_2d(&[
+            [rows[0][0], rows[1][0], rows[2][0]],
+            [rows[0][1], rows[1][1], rows[2][1]],
+            [rows[0][2], rows[1][2], rows[2][2]],
+        ]))
+    };
+    for k in [1, 40, 97] {
+        // Frame k at 0.1 k s; readings at 0.05 + n / 400 s.
+        let first = 40 * k - 20;
+        let mut turned = rotation(k);
+        for pair in clean[first..=first + 40].windows(2) {
+            let rate = |s: &[f64]| DVec3::new(s[1], s[2], s[3]);
+            let dt = (pair[1][0] - pair[0][0]) * 1e-9;
+            turned *= glam::DQuat::from_scaled_axis((rate(&pair[0]) + rate(&pair[1])) * 0.5 * dt);
+        }
+        let off = (rotation(k + 1).inverse() * turned)
+            .to_scaled_axis()
+            .length();
+        assert!(off < 1e-5, "frames {k} to {}: {off:e} rad", k + 1);
+    }
+    let rig = read_rig(&out.join("camchain-imucam.yaml")).unwrap();
+    let original = read_rig(Path::new(&small_rig(&dir))).unwrap();
+    assert_eq!(rig.len(), original.len());
+    for (a, b) in rig.iter().zip(&original) {
+        assert!(a.body_from_camera.abs_diff_eq(b.body_from_camera, 1e-12));
+    }
+    let output = args("200").output().unwrap();
+    let message = String::from_utf8_lossy(&output.stderr);
+    assert!(
+        !output.status.success() && message.contains("update_rate is 400 Hz"),
+        "{message}"
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}

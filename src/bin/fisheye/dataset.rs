@@ -6,6 +6,8 @@ use std::time::Instant;
 
 use anyhow::{Result, bail};
 use clap::{Subcommand, ValueEnum};
+use fisheye_rt::dataset::imu::{Imu, ImuNoise};
+use fisheye_rt::dataset::smooth::Spline;
 use fisheye_rt::dataset::trajectory::{self, TrajectoryFormat};
 use fisheye_rt::dataset::{ArrayFile, Between, Dataset, FlowFile, Shard, Submission};
 use fisheye_rt::gpu::GpuContext;
@@ -67,6 +69,26 @@ pub(crate) struct RenderArgs {
     /// The order a rolling shutter reads lines in.
     #[arg(long, default_value = "top-to-bottom")]
     readout: Readout,
+    /// A synthetic IMU on the body at this rate (Hz): angular rate and specific force from a
+    /// smooth spline through the trajectory, which the frames' poses then follow too, written
+    /// as EuRoC's imu0/data.csv (and data_noise_free.csv), with the rig as a Kalibr camchain
+    /// on the IMU. The rate defaults to --imu-noise's update_rate.
+    #[arg(long)]
+    imu: Option<f64>,
+    /// The IMU's noise: a Kalibr imu.yaml (accelerometer and gyroscope noise densities and
+    /// random walks, update_rate); without it the readings are noise-free.
+    #[arg(long)]
+    imu_noise: Option<PathBuf>,
+    /// The seed of the IMU's noise.
+    #[arg(long, default_value_t = 0)]
+    imu_seed: u64,
+    /// Gravity in the trajectory's world, m/s² (EuRoC's and TUM's worlds have z up).
+    #[arg(long, default_value = "0,0,-9.81", allow_hyphen_values = true)]
+    gravity: String,
+    /// Seconds between the IMU spline's control poses (the trajectory sampled by slerp):
+    /// longer smooths more.
+    #[arg(long, default_value_t = 0.05)]
+    spline_step: f64,
     /// The trajectory's format, if detection from its text is not wanted.
     #[arg(long, value_enum)]
     trajectory_format: Option<FormatArg>,
@@ -239,11 +261,20 @@ fn render(args: &RenderArgs) -> Result<()> {
         FormatArg::Euroc => TrajectoryFormat::Euroc,
     });
     let (detected, stamps) = trajectory::read(&args.trajectory, format, args.fps)?;
-    let poses = match args.frame_rate {
+    let mut poses = match args.frame_rate {
         Some(hz) => trajectory::resample(&stamps, detected, hz)
             .map_err(|e| anyhow::anyhow!("--frame-rate: {e}"))?,
         None => stamps.clone(),
     };
+    let imu = imu(args, &stamps)?;
+    if let Some(imu) = &imu {
+        // The frames follow the IMU's spline (those outside it are skipped).
+        for pose in &mut poses {
+            if let Some(m) = imu.spline.at(pose.seconds) {
+                pose.world_from_body = m.pose;
+            }
+        }
+    }
     let scene = load_scene_with(&args.scene, args.gltf_scene)?;
     if args.outputs.iter().any(|o| matches!(o, Output::Spp)) {
         bail!("--outputs spp is render's (a picture of one frame's rays)");
@@ -269,6 +300,7 @@ fn render(args: &RenderArgs) -> Result<()> {
         trajectory: (args.trajectory.clone(), detected, args.frame_rate),
         poses,
         stamps,
+        imu,
         cameras,
         scene_from_world,
         body_from_rig,
@@ -370,8 +402,8 @@ fn render(args: &RenderArgs) -> Result<()> {
     }
     if report.outside > 0 {
         println!(
-            "{} frames skipped: their readout or exposure reach past the trajectory's stamps \
-             (plan.json's skipped_frames)",
+            "{} frames skipped: they reach past the trajectory's poses (plan.json's \
+             skipped_frames, and each frame's skipped, say why)",
             report.outside
         );
     }
@@ -387,4 +419,50 @@ fn render(args: &RenderArgs) -> Result<()> {
         );
     }
     Ok(())
+}
+
+/// The IMU `args` ask for, on `stamps`' spline.
+fn imu(args: &RenderArgs, stamps: &[trajectory::Pose]) -> Result<Option<Imu>> {
+    let noise = args.imu_noise.as_deref().map(ImuNoise::read).transpose()?;
+    let rate = match (args.imu, noise) {
+        (None, None) => return Ok(None),
+        (Some(rate), Some(n)) if rate != n.update_rate => bail!(
+            "--imu {rate} Hz: --imu-noise's update_rate is {} Hz; the noise is discretised at \
+             the rate the IMU samples, so give one rate",
+            n.update_rate
+        ),
+        (Some(rate), _) => rate,
+        (None, Some(n)) => n.update_rate,
+    };
+    if !(rate.is_finite() && rate > 0.0) {
+        bail!("--imu {rate}: give the IMU's rate in Hz, a positive number");
+    }
+    if !(args.spline_step.is_finite() && args.spline_step > 0.0) {
+        bail!(
+            "--spline-step {}: give a positive number of seconds",
+            args.spline_step
+        );
+    }
+    let gravity: Vec<f64> = args
+        .gravity
+        .split(',')
+        .map(|v| v.trim().parse::<f64>())
+        .collect::<Result<_, _>>()
+        .ok()
+        .filter(|g: &Vec<f64>| g.len() == 3 && g.iter().all(|v| v.is_finite()))
+        .ok_or_else(|| anyhow::anyhow!("--gravity {}: give X,Y,Z in m/s²", args.gravity))?;
+    let Some(spline) = Spline::new(stamps, args.spline_step) else {
+        bail!(
+            "--imu: the trajectory spans fewer than four control poses {} s apart \
+             (--spline-step); a cubic spline needs four",
+            args.spline_step
+        );
+    };
+    Ok(Some(Imu {
+        spline,
+        rate,
+        noise,
+        seed: args.imu_seed,
+        gravity: glam::DVec3::from_slice(&gravity),
+    }))
 }

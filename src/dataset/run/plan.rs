@@ -3,10 +3,12 @@
 
 use serde_json::{Value, json};
 
-use super::Dataset;
+use super::{CAMCHAIN, Dataset};
 use crate::dataset::between::FlowFile;
 use crate::dataset::files::LAYOUT;
+use crate::dataset::imu::IMU_FILES;
 use crate::error::Result;
+use crate::lens::calib::{CalibFormat, Calibration, float_text};
 use crate::lens::{CalibratedModel, Lens};
 use crate::pose::rows;
 use crate::trace::{ColourFile, Tone};
@@ -119,10 +121,64 @@ impl Dataset {
                 "arrays": self.outputs.1.extension(),
             },
             "cameras": cameras,
+            "imu": self.imu.as_ref().map(|imu| {
+                let (first, last) = imu.spline.span();
+                json!({
+                    "files": {"data": IMU_FILES[0], "noise_free": IMU_FILES[1]},
+                    "layout": "EuRoC imu0/data.csv: timestamp [ns], angular rate (rad/s), \
+                               specific force (m/s^2), in the IMU's frame: the body's",
+                    "rate": imu.rate,
+                    "noise": imu.noise.map(|n| json!({
+                        "accelerometer_noise_density": n.accelerometer_noise_density,
+                        "accelerometer_random_walk": n.accelerometer_random_walk,
+                        "gyroscope_noise_density": n.gyroscope_noise_density,
+                        "gyroscope_random_walk": n.gyroscope_random_walk,
+                        "update_rate": n.update_rate,
+                    })),
+                    "seed": imu.seed,
+                    "gravity": imu.gravity.to_array(),
+                    "spline": {
+                        "kind": "uniform cumulative cubic B-spline on SO(3) x R^3; the frames' \
+                                 T_world_body follow it too",
+                        "step": imu.spline.step(),
+                        "span": [first, last],
+                    },
+                    "camchain": self.camchain().map(|_| CAMCHAIN),
+                })
+            }),
             "skipped_frames": skipped_frames,
             "frames": frames,
         });
         Ok(serde_json::to_string_pretty(&plan).expect("JSON values serialise") + "\n")
+    }
+
+    /// The rig as a Kalibr camchain on the IMU (the body): each camera's calibration (a
+    /// classic lens as its calibrated equivalent) with `T_cam_imu` and a zero
+    /// `timeshift_cam_imu`; `None` where a camera's model has no Kalibr form.
+    pub(super) fn camchain(&self) -> Option<String> {
+        let mut text = String::new();
+        for c in 0..self.cameras.len() {
+            let camera = self.lens_camera(c);
+            let lens = match camera.lens {
+                Lens::Calibrated(lens) => lens,
+                Lens::Classic(_) => crate::lens::fit::calibrated_equivalent(&camera).ok()?.lens,
+            };
+            let calibration = Calibration {
+                lens,
+                size: camera.size,
+                line_delay: camera.shutter.line_delay,
+            };
+            let one = crate::lens::calib::write(&calibration, CalibFormat::Kalibr).ok()?;
+            let cam_imu = (self.body_from_rig * self.cameras[c].1).inverse();
+            text += &one.replacen("cam0:", &format!("cam{c}:"), 1);
+            text += "  T_cam_imu:\n";
+            for row in rows(&cam_imu) {
+                let row: Vec<String> = row.iter().map(|&v| float_text(v)).collect();
+                text += &format!("  - [{}]\n", row.join(", "));
+            }
+            text += "  timeshift_cam_imu: 0.0\n";
+        }
+        Some(text)
     }
 
     /// A camera's calibration in the project's and OpenCV's conventions, and its rig pose.

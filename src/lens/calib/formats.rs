@@ -34,7 +34,7 @@ pub(super) fn numbers(text: &str) -> Vec<Option<f64>> {
     text.split_whitespace().map(|t| t.parse().ok()).collect()
 }
 
-pub(super) fn load_yaml(text: &str) -> Result<Yaml, String> {
+pub(crate) fn load_yaml(text: &str) -> Result<Yaml, String> {
     let docs = YamlLoader::load_from_str(text).map_err(|e| {
         let m = e.marker();
         format!(
@@ -49,7 +49,7 @@ pub(super) fn load_yaml(text: &str) -> Result<Yaml, String> {
         .ok_or_else(|| "the file is empty".into())
 }
 
-pub(super) fn yaml_number(node: &Yaml) -> Option<f64> {
+pub(crate) fn yaml_number(node: &Yaml) -> Option<f64> {
     match node {
         Yaml::Real(text) | Yaml::String(text) => text.trim().parse().ok(),
         Yaml::Integer(i) => Some(*i as f64),

@@ -21,7 +21,9 @@ mod write;
 
 pub use calibration::{CalibFormat, Calibration};
 use formats::*;
-pub use write::write;
+/// YAML as the calibration readers parse it, for the other Kalibr files (`imu.yaml`).
+pub(crate) use formats::{load_yaml, yaml_number};
+pub use write::{float_text, write};
 
 use std::path::Path;
 

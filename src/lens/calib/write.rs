@@ -26,7 +26,7 @@ use crate::lens::calibrated::CalibratedModel;
 /// same f64 (Rust's `{:e}`), with a decimal point and a signed exponent (`2.3e+2`,
 /// `1.0e-5`), the form every reader takes as a float: YAML 1.1 (PyYAML, so Kalibr) reads
 /// `2.3e2` as a string, as it needs both; JSON and OpenCV take either.
-pub(super) fn float_text(x: f64) -> String {
+pub fn float_text(x: f64) -> String {
     let text = format!("{x:e}");
     let (mantissa, exponent) = text.split_once('e').expect("{:e} has an exponent");
     let point = if mantissa.contains('.') { "" } else { ".0" };
