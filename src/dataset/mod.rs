@@ -17,6 +17,7 @@
 
 pub mod flow;
 pub mod imu;
+pub mod labels;
 pub mod readout;
 pub mod smooth;
 pub mod trajectory;

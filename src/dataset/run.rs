@@ -17,6 +17,7 @@ use super::between::{Between, FlowFile};
 use super::files::{ArrayFile, check_plan, merge, remove_leftovers};
 use super::flow::Seen;
 use super::imu::Imu;
+use super::labels::{LABEL_MAP, Label, label_map};
 use super::readout::{Track, Unrenderable, frame_motion};
 use super::trajectory::{Pose, TrajectoryFormat};
 use super::{Shard, camera_from_transform, frame_stem};
@@ -27,7 +28,7 @@ use crate::lens::gpu::DirectionSource;
 use crate::scene::Scene;
 use crate::trace::{
     Channel, ColourFile, Display, FramePass, GpuScene, Motion, RenderOptions, RenderOutput,
-    moving_directions, rotated, write_colour, write_file,
+    moving_directions, rotated, write_colour, write_exr, write_file, write_npy,
 };
 
 /// How a pose's cameras are submitted to the GPU.
@@ -69,6 +70,8 @@ pub struct Dataset {
     /// The ground truth between a frame and its neighbours (optical and scene flow), and
     /// the files optical flow is written in.
     pub between: (Vec<Between>, FlowFile),
+    /// Segmentation written beside each image (in the arrays' format), with the label map.
+    pub labels: Vec<Label>,
     /// A synthetic IMU on the body, whose spline the frames' poses follow too (`poses` hold
     /// them).
     pub imu: Option<Imu>,
@@ -237,6 +240,11 @@ impl Dataset {
                 .iter()
                 .map(|ch| (ch.name().to_string(), format!("{stem}.{}.{ext}", ch.name()))),
         );
+        files.extend(self.labels.iter().map(|l| {
+            let name = l.name().to_string();
+            let file = format!("{stem}.{name}.{ext}");
+            (name, file)
+        }));
         for b in &self.between.0 {
             files.extend(b.files(&stem, self.outputs.1, self.between.1));
         }
@@ -279,6 +287,9 @@ impl Dataset {
             if let Some(camchain) = self.camchain() {
                 write_file(&folder.join(CAMCHAIN), camchain.as_bytes())?;
             }
+        }
+        if !self.labels.is_empty() {
+            write_file(&folder.join(LABEL_MAP), label_map(&self.scene).as_bytes())?;
         }
         let range = shard.poses(self.poses.len());
         let reasons = self.skipped()?;
@@ -575,6 +586,15 @@ impl Dataset {
                 }
             }
         }
+        let mut rest = &files[1 + channels.len()..];
+        for (label, (name, file)) in self.labels.iter().zip(rest) {
+            let values = label.values(&self.scene, &out.ids);
+            match arrays {
+                ArrayFile::Npy => write_npy(&folder.join(file), out.size, values)?,
+                ArrayFile::Exr => write_exr(&folder.join(file), out.size, name, values)?,
+            }
+        }
+        rest = &rest[self.labels.len()..];
         if self.between.0.is_empty() {
             return Ok(());
         }
@@ -599,7 +619,6 @@ impl Dataset {
         let seen = |k: usize, w| seen(&camera, motions[k].as_ref(), w, camera_rays);
         let this = seen(0, Some(w));
         let (previous, next) = (seen(1, around.0), seen(2, around.1));
-        let mut rest = &files[1 + channels.len()..];
         for b in &self.between.0 {
             let count = b.files("", *arrays, self.between.1).len();
             let this = this.as_ref().expect("the frame itself");

@@ -109,6 +109,9 @@ impl Default for Scale {
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
 struct MeshSpec {
+    /// The object's name and class for the instance and semantic outputs.
+    name: Option<String>,
+    class: Option<String>,
     path: Option<PathBuf>,
     shape: Option<Shape>,
     #[serde(default)]
@@ -357,6 +360,9 @@ pub fn load_scene_file_from(path: &Path, read: ReadFile) -> Result<Loaded> {
     for (i, mesh) in file.meshes.iter().enumerate() {
         let what = format!("mesh {}", i + 1);
         let transform = check.transform(&what, mesh)?;
+        // Its label: as given, else an OBJ's own objects name its parts, else "mesh N".
+        let name = mesh.name.clone().unwrap_or_else(|| what.clone());
+        b.object(&name, mesh.class.as_deref().unwrap_or(&name));
         let kind = file.meshes.iter().position(|m| same(m, mesh)).unwrap_or(i);
         if let Some(id) = shared[kind] {
             if !b.place(id, transform) {

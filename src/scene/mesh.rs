@@ -4,7 +4,7 @@ use std::f64::consts::{PI, TAU};
 
 use glam::{DAffine3, DVec3, Vec2, Vec3};
 
-use super::{Camera, Instance, Light, Material, Scene, Texture, face_normal};
+use super::{Camera, Instance, Light, Material, Object, Scene, Texture, face_normal};
 
 /// Collects triangles with their materials, normals and UVs, then makes a [`Scene`].
 #[derive(Default)]
@@ -17,8 +17,12 @@ pub struct MeshBuilder {
     textures: Vec<Texture>,
     /// Meshes for instances: ranges `(first, count)` of the triangles above, in mesh space.
     meshes: Vec<(usize, usize)>,
-    /// Instances: a mesh and its transform to world space.
-    placed: Vec<(usize, DAffine3)>,
+    /// Instances: a mesh, its transform to world space and its object's label.
+    placed: Vec<(usize, DAffine3, Option<u32>)>,
+    /// The labels [`MeshBuilder::object`] gave, and the one triangles are added under.
+    labels: Vec<Object>,
+    label_of: Vec<Option<u32>>,
+    current: Option<u32>,
 }
 
 /// A mesh [`MeshBuilder::place`] can place (see [`MeshBuilder::mesh_since`]).
@@ -54,8 +58,20 @@ impl MeshBuilder {
         if !(transform.is_finite() && det.is_normal() && transform.inverse().is_finite()) {
             return false;
         }
-        self.placed.push((mesh.0, transform));
+        self.placed.push((mesh.0, transform, self.current));
         true
+    }
+
+    /// Names the object the triangles added (and the meshes placed) from now on belong to,
+    /// and its class: each call is an object of its own (each placement of a mesh too), for
+    /// the instance and semantic outputs. Triangles added before any call are labelled by
+    /// their material's name.
+    pub fn object(&mut self, name: &str, class: &str) {
+        self.labels.push(Object {
+            name: name.to_string(),
+            class: class.to_string(),
+        });
+        self.current = Some(self.labels.len() as u32 - 1);
     }
 
     /// Adds a material and returns its index.
@@ -93,7 +109,7 @@ impl MeshBuilder {
             .collect();
         self.placed
             .iter()
-            .fold(super::bounds(&world), |acc, &(m, t)| {
+            .fold(super::bounds(&world), |acc, &(m, t, _)| {
                 let (first, count) = self.meshes[m];
                 super::union(
                     acc,
@@ -124,7 +140,7 @@ impl MeshBuilder {
         let normal_matrix = transform.matrix3.inverse().transpose();
         let mirrored = transform.matrix3.determinant() < 0.0;
         let in_mesh = self.in_meshes(first);
-        for (mesh, placed) in &mut self.placed {
+        for (mesh, placed, _) in &mut self.placed {
             if self.meshes[*mesh].0 >= first {
                 *placed = transform * *placed;
             }
@@ -167,6 +183,7 @@ impl MeshBuilder {
         self.normals.push(normals);
         self.uvs.push(uvs);
         self.material_of.push(material);
+        self.label_of.push(self.current);
     }
 
     /// A parallelogram `corner + s·u + t·v`, s, t ∈ [0, 1], facing `u × v`, with UVs running
@@ -306,16 +323,62 @@ impl MeshBuilder {
         let world_triangles = order.len();
         let mut mesh_first = vec![None; self.meshes.len()];
         let mut instances = Vec::with_capacity(self.placed.len());
-        for &(mesh, transform) in &self.placed {
+        // Objects: the labels as given (or a material's name where there is none); a placement
+        // whose label the world or another placement took first gets a numbered copy.
+        let mut objects: Vec<Object> = self.labels.clone();
+        let mut claimed = vec![false; objects.len()];
+        let mut by_material: Vec<Option<u32>> = vec![None; self.materials.len()];
+        let mut of_material = |material: u32, objects: &mut Vec<Object>| {
+            *by_material[material as usize].get_or_insert_with(|| {
+                let name = &self.materials[material as usize].name;
+                objects.push(Object {
+                    name: name.clone(),
+                    class: name.clone(),
+                });
+                objects.len() as u32 - 1
+            })
+        };
+        let object_of: Vec<u32> = order
+            .iter()
+            .map(|&i| match self.label_of[i] {
+                Some(l) => {
+                    claimed[l as usize] = true;
+                    l
+                }
+                None => of_material(self.material_of[i], &mut objects),
+            })
+            .collect();
+        for &(mesh, transform, label) in &self.placed {
             let (first, count) = self.meshes[mesh];
             let stored = *mesh_first[mesh].get_or_insert_with(|| {
                 order.extend(first..first + count);
                 order.len() - count
             });
+            let object = match label {
+                Some(l) if !claimed[l as usize] => {
+                    claimed[l as usize] = true;
+                    l
+                }
+                _ => {
+                    let like = match label {
+                        Some(l) => objects[l as usize].clone(),
+                        None => {
+                            let o = of_material(self.material_of[first], &mut objects);
+                            objects[o as usize].clone()
+                        }
+                    };
+                    objects.push(Object {
+                        name: format!("{} {}", like.name, instances.len()),
+                        class: like.class,
+                    });
+                    objects.len() as u32 - 1
+                }
+            };
             instances.push(Instance {
                 first: stored as u32,
                 count: count as u32,
                 transform,
+                object,
             });
         }
         let normals = self.normals.iter().any(Option::is_some).then(|| {
@@ -350,6 +413,8 @@ impl MeshBuilder {
             cameras: Vec::new(),
             headlight: None,
             framed: None,
+            objects,
+            object_of,
         }
     }
 }
@@ -384,5 +449,60 @@ pub fn checker(
         width: size,
         height: size,
         rgba,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Triangles added before any label are named by their material; labelled ones by their
+    /// label; each placement of a mesh is an object of its own, the first taking the label
+    /// and the rest numbered copies of the same class; ids map to them through
+    /// `Scene::objects_of` (a miss to `NO_OBJECT`), and classes are listed once each.
+    #[test]
+    fn objects_come_from_labels_or_materials_and_each_placement_is_one() {
+        let mut b = MeshBuilder::new();
+        let red = b.material(Material::diffuse("red", Vec3::X));
+        let (x, y) = (DVec3::X, DVec3::Y);
+        b.quad(DVec3::ZERO, x, y, Vec2::ONE, red);
+        b.object("chair", "furniture");
+        b.quad(DVec3::Z, x, y, Vec2::ONE, red);
+        let first = b.len();
+        b.quad(DVec3::ZERO, x, y, Vec2::ONE, red);
+        let mesh = b.mesh_since(first);
+        b.object("cup", "tableware");
+        for k in 0..2 {
+            assert!(b.place(mesh, DAffine3::from_translation(DVec3::splat(f64::from(k)))));
+        }
+        let camera = Camera {
+            position: DVec3::ZERO,
+            look_at: DVec3::Z,
+            up: DVec3::Y,
+        };
+        let scene = b.finish(Vec::new(), Vec3::ZERO, Vec3::ZERO, camera);
+        let names: Vec<(String, String)> = scene
+            .objects_of(&[0, 1, 2, 3, 4, 5, 6, 7, crate::shared::NO_HIT])
+            .into_iter()
+            .map(|o| match scene.objects.get(o as usize) {
+                Some(o) => (o.name.clone(), o.class.clone()),
+                None => (String::new(), String::new()),
+            })
+            .collect();
+        let pair = |n: &str, c: &str| (n.to_string(), c.to_string());
+        let wanted = [
+            pair("red", "red"),
+            pair("red", "red"),
+            pair("chair", "furniture"),
+            pair("chair", "furniture"),
+            pair("cup", "tableware"),
+            pair("cup", "tableware"),
+            pair("cup 1", "tableware"),
+            pair("cup 1", "tableware"),
+            pair("", ""),
+        ];
+        assert_eq!(names, wanted);
+        let (classes, _) = scene.classes();
+        assert_eq!(classes, ["furniture", "tableware", "red"].map(String::from));
     }
 }

@@ -186,7 +186,24 @@ pub struct Instance {
     pub count: u32,
     /// Mesh space to world space (its 3×3 part invertible).
     pub transform: DAffine3,
+    /// Its object ([`Scene::objects`]): each instance is one of its own.
+    pub object: u32,
 }
+
+/// A labelled object of a scene, for the instance and semantic outputs: its name (a glTF
+/// node's, an OBJ object's, a scene file's mesh's, a material's where nothing names it) and
+/// its class (a glTF `extras.class`, else its mesh's name; a scene file's `class`; else the
+/// name).
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Object {
+    /// The object's name.
+    pub name: String,
+    /// Its semantic class.
+    pub class: String,
+}
+
+/// The instance and class of a pixel that sees nothing (`Scene::objects_of`).
+pub const NO_OBJECT: u32 = u32::MAX;
 
 /// The most triangles an instanced scene is flattened to for the paths that draw world
 /// triangles only (the rasterized cube map): 50M, 2.4 GB of f64 corners on the host and more
@@ -245,6 +262,10 @@ pub struct Scene {
     /// The bounds the camera was placed to frame, where the scene did not give one (a bare
     /// OBJ, a scene file without `[camera]`): [`Scene::frame_for`] re-frames them for a lens.
     pub framed: Option<(DVec3, DVec3)>,
+    /// The labelled objects: the world triangles' (`object_of`), then each instance's.
+    pub objects: Vec<Object>,
+    /// The object of each world triangle (the first [`Scene::world_triangles`]).
+    pub object_of: Vec<u32>,
 }
 
 /// The share of the picture a scene's bounding sphere fills when [`Scene::frame_for`] places
@@ -316,13 +337,69 @@ impl Scene {
             b.transform_since(first, instance.transform);
         }
         let flat = b.finish(self.lights.clone(), self.sky, self.ambient, self.camera);
+        // The same objects: each instance's copied triangles keep its object.
+        let object_of = self
+            .object_of
+            .iter()
+            .copied()
+            .chain(
+                self.instances
+                    .iter()
+                    .flat_map(|i| std::iter::repeat_n(i.object, i.count as usize)),
+            )
+            .collect();
         Ok(Scene {
             camera_path: self.camera_path.clone(),
             cameras: self.cameras.clone(),
             headlight: self.headlight,
             framed: self.framed,
+            objects: self.objects.clone(),
+            object_of,
             ..flat
         })
+    }
+
+    /// The object ([`Scene::objects`]) of each scene triangle id (as the `id` output gives
+    /// them), [`NO_OBJECT`] for a miss.
+    pub fn objects_of(&self, ids: &[u32]) -> Vec<u32> {
+        // Where each instance's scene triangles start, after the world's.
+        let starts: Vec<u64> = self
+            .instances
+            .iter()
+            .scan(self.world_triangles as u64, |next, i| {
+                let start = *next;
+                *next += u64::from(i.count);
+                Some(start)
+            })
+            .collect();
+        ids.iter()
+            .map(|&id| match id {
+                crate::shared::NO_HIT => NO_OBJECT,
+                id if (id as usize) < self.world_triangles => self.object_of[id as usize],
+                id => {
+                    let k = starts.partition_point(|&s| s <= u64::from(id)) - 1;
+                    self.instances[k].object
+                }
+            })
+            .collect()
+    }
+
+    /// The semantic classes, in the order their objects first name them, and each object's
+    /// class (an index into them).
+    pub fn classes(&self) -> (Vec<String>, Vec<u32>) {
+        let mut names: Vec<String> = Vec::new();
+        let of = self
+            .objects
+            .iter()
+            .map(|o| match names.iter().position(|n| *n == o.class) {
+                Some(i) => i as u32,
+                None => {
+                    names.push(o.class.clone());
+                    names.len() as u32 - 1
+                }
+            })
+            .collect();
+        (names, of)
     }
 
     /// Puts the camera at `pose`, and the headlight, if the scene has one, at its eye.

@@ -198,7 +198,14 @@ pub fn load_into(
         b.material(m);
     }
     let default = b.material(Material::diffuse("default", Vec3::splat(0.8)));
+    // Each OBJ object or group (tobj splits one by material into models of the same name)
+    // is an object for the instance and semantic outputs, its name its class too.
+    let mut last: Option<&str> = None;
     for model in &models {
+        if last != Some(model.name.as_str()) {
+            b.object(&model.name, &model.name);
+            last = Some(&model.name);
+        }
         add_mesh(path, model, base, default, b, warnings);
     }
     Ok(())

@@ -443,3 +443,101 @@ fn adaptive_datasets_keep_exact_ground_truth() {
     assert_eq!(plan["render"]["spp"], 4);
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// `--outputs instance,semantic` names each pixel's object and class: an OBJ with objects
+/// `chair` and `table` side by side in front of the camera gives, in every frame, the
+/// chair's instance id on the left of the image and the table's on the right (as its hit's
+/// triangle says: ids 0-1 are the chair's, 2-3 the table's), classes by the same names, and
+/// `labels.json` naming both; `render` refuses the outputs, pointing to `dataset render`.
+#[test]
+fn segmentation_names_each_pixels_object_and_class() {
+    let dir = temp_dir("labels");
+    let obj = dir.join("room.obj");
+    std::fs::write(
+        &obj,
+        "o chair\nv -2 -1 3\nv 0 -1 3\nv 0 1 3\nv -2 1 3\nf 1 2 3\nf 1 3 4\n\
+         o table\nv 0 -1 3\nv 2 -1 3\nv 2 1 3\nv 0 1 3\nf 5 6 7\nf 5 7 8\n",
+    )
+    .unwrap();
+    let trajectory = dir.join("still.tum");
+    std::fs::write(&trajectory, "0 0 0 0 0 0 0 1\n1 0 0 0.1 0 0 0 1\n").unwrap();
+    let out = dir.join("set");
+    succeed(
+        fisheye()
+            .arg("dataset")
+            .arg("render")
+            .arg(&obj)
+            .args([
+                "--lens",
+                "equidistant:f=0.6",
+                "--size",
+                "32x24",
+                "--spp",
+                "1",
+            ])
+            .args(["--outputs", "id,instance,semantic", "--trajectory"])
+            .arg(&trajectory)
+            .arg("-o")
+            .arg(&out),
+    );
+    let labels: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("labels.json")).unwrap()).unwrap();
+    let id_of = |name: &str| {
+        labels["instances"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .find(|o| o["name"] == name)
+            .unwrap_or_else(|| panic!("no {name} in {labels}"))
+            .clone()
+    };
+    let (chair, table) = (id_of("chair"), id_of("table"));
+    let class_name = |o: &serde_json::Value| {
+        labels["classes"][o["class_id"].as_u64().unwrap() as usize]["name"].clone()
+    };
+    assert_eq!(
+        (class_name(&chair), class_name(&table)),
+        ("chair".into(), "table".into())
+    );
+    let load = |name: String| -> Vec<u32> {
+        let bytes = std::fs::read(out.join("cam0").join(name)).unwrap();
+        npyz::NpyFile::new(&bytes[..]).unwrap().into_vec().unwrap()
+    };
+    for stem in ["000000_0", "000001_1"] {
+        let (ids, instance, semantic) = (
+            load(format!("{stem}.id.npy")),
+            load(format!("{stem}.instance.npy")),
+            load(format!("{stem}.semantic.npy")),
+        );
+        let mut sides = [0, 0];
+        for (i, &id) in ids.iter().enumerate() {
+            let object = match id {
+                0 | 1 => &chair,
+                2 | 3 => &table,
+                _ => {
+                    assert_eq!((instance[i], semantic[i]), (u32::MAX, u32::MAX));
+                    continue;
+                }
+            };
+            assert_eq!(
+                u64::from(instance[i]),
+                object["id"].as_u64().unwrap(),
+                "pixel {i}"
+            );
+            assert_eq!(u64::from(semantic[i]), object["class_id"].as_u64().unwrap());
+            let left = i % 32 < 16;
+            sides[usize::from(!left)] += 1;
+            assert_eq!(left, id < 2, "pixel {i}: id {id}");
+        }
+        assert!(sides[0] > 20 && sides[1] > 20, "{stem}: {sides:?}");
+    }
+    let output = fisheye()
+        .args(["render", "--lens", "equidistant:f=0.6", "--size", "32x24"])
+        .args(["--outputs", "instance", "-o"])
+        .arg(dir.join("one.png"))
+        .output()
+        .unwrap();
+    let message = String::from_utf8_lossy(&output.stderr);
+    assert!(!output.status.success() && message.contains("dataset render --outputs instance"));
+    std::fs::remove_dir_all(&dir).unwrap();
+}

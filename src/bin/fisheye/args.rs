@@ -8,6 +8,7 @@ use clap::ValueEnum;
 use fisheye_rt::bvh::BvhQuality;
 use fisheye_rt::cube::CubeMethod;
 use fisheye_rt::dataset::Between;
+use fisheye_rt::dataset::labels::Label;
 use fisheye_rt::lens::calib::{self, CalibFormat};
 use fisheye_rt::lens::glass::camera_for;
 use fisheye_rt::lens::gpu::DirectionSource;
@@ -393,6 +394,10 @@ pub(crate) enum Output {
     FlowBackward,
     /// Each hit's motion in the camera's frame by the next frame (`dataset render` only).
     SceneFlow,
+    /// Each pixel's object, with the label map (`dataset render` only).
+    Instance,
+    /// Each pixel's class, with the label map (`dataset render` only).
+    Semantic,
 }
 
 impl Output {
@@ -405,8 +410,22 @@ impl Output {
             Output::Id => Channel::Id,
             Output::Direction => Channel::Direction,
             Output::Mask => Channel::Mask,
-            Output::Spp | Output::Flow | Output::FlowBackward | Output::SceneFlow => return None,
+            Output::Spp
+            | Output::Flow
+            | Output::FlowBackward
+            | Output::SceneFlow
+            | Output::Instance
+            | Output::Semantic => return None,
         })
+    }
+
+    /// The segmentation output, for a dataset.
+    pub(crate) fn label(self) -> Option<Label> {
+        match self {
+            Output::Instance => Some(Label::Instance),
+            Output::Semantic => Some(Label::Semantic),
+            _ => None,
+        }
     }
 
     /// The output between a frame and its neighbours, for a dataset.

@@ -7,6 +7,7 @@ use std::time::Instant;
 use anyhow::{Result, bail};
 use clap::{Subcommand, ValueEnum};
 use fisheye_rt::dataset::imu::{Imu, ImuNoise};
+use fisheye_rt::dataset::labels::Label;
 use fisheye_rt::dataset::smooth::Spline;
 use fisheye_rt::dataset::trajectory::{self, TrajectoryFormat};
 use fisheye_rt::dataset::{ArrayFile, Between, Dataset, FlowFile, Shard, Submission};
@@ -138,7 +139,8 @@ pub(crate) struct RenderArgs {
     /// Tone curve of PNG images (see `render --tone`).
     #[arg(long, value_enum, default_value = "aces")]
     tone: ToneArg,
-    /// Ground truth written beside each image: range, normal, id, direction, mask; and
+    /// Ground truth written beside each image: range, normal, id, direction, mask;
+    /// instance and semantic (each pixel's object and class, named in labels.json); and
     /// between frames, through the lens (and rolling shutter): flow (to the next frame, with
     /// flow_valid where it sees the point), flow-backward (from the previous), scene-flow.
     #[arg(long, value_enum, value_delimiter = ',')]
@@ -286,9 +288,15 @@ fn render(args: &RenderArgs) -> Result<()> {
             between.push(b);
         }
     }
+    let mut labels: Vec<Label> = Vec::new();
+    for l in args.outputs.iter().filter_map(|o| o.label()) {
+        if !labels.contains(&l) {
+            labels.push(l);
+        }
+    }
     // Adaptive sampling traces the hits of the pixels it interpolates where arrays of them
-    // (or flow, made from them) are written.
-    let traced = channels.iter().any(Channel::traced) || !between.is_empty();
+    // (or flow and labels, made from them) are written.
+    let traced = channels.iter().any(Channel::traced) || !between.is_empty() || !labels.is_empty();
     let (spp, adaptive) = args.spp.options(traced);
     let dataset = Dataset {
         // The plan records the scene by this name: a glTF file's other scene is another.
@@ -301,6 +309,7 @@ fn render(args: &RenderArgs) -> Result<()> {
         poses,
         stamps,
         imu,
+        labels,
         cameras,
         scene_from_world,
         body_from_rig,

@@ -126,6 +126,13 @@ pub(crate) fn render(args: &RenderArgs) -> Result<()> {
             b.name()
         );
     }
+    if let Some(l) = args.outputs.iter().find_map(|o| o.label()) {
+        anyhow::bail!(
+            "--outputs {}: `fisheye dataset render --outputs {}` writes it, with its label map",
+            l.name(),
+            l.name()
+        );
+    }
     let channels: Vec<Channel> = args.outputs.iter().filter_map(|o| o.channel()).collect();
     let spp_map = args
         .outputs

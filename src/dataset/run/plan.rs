@@ -7,6 +7,7 @@ use super::{CAMCHAIN, Dataset};
 use crate::dataset::between::FlowFile;
 use crate::dataset::files::LAYOUT;
 use crate::dataset::imu::IMU_FILES;
+use crate::dataset::labels::LABEL_MAP;
 use crate::error::Result;
 use crate::lens::calib::{CalibFormat, Calibration, float_text};
 use crate::lens::{CalibratedModel, Lens};
@@ -111,6 +112,7 @@ impl Dataset {
                     Tone::Clamp => "clamp",
                 },
                 "outputs": self.outputs.0.iter().map(|c| c.name())
+                    .chain(self.labels.iter().map(|l| l.name()))
                     .chain(self.between.0.iter().map(|b| b.name()))
                     .collect::<Vec<_>>(),
                 "flow_files": match self.between.1 {
@@ -121,6 +123,7 @@ impl Dataset {
                 "arrays": self.outputs.1.extension(),
             },
             "cameras": cameras,
+            "labels": (!self.labels.is_empty()).then_some(LABEL_MAP),
             "imu": self.imu.as_ref().map(|imu| {
                 let (first, last) = imu.spline.span();
                 json!({

@@ -141,6 +141,16 @@ impl Loader<'_> {
         }
         let affine = DAffine3::from_mat4(world);
         if let Some(mesh) = node.mesh() {
+            // Its label: the node's name, and the class its extras (or its mesh's) give,
+            // else the mesh's name.
+            let name = node
+                .name()
+                .map_or_else(|| format!("nodes[{}]", node.index()), String::from);
+            let class = class_of(node.extras())
+                .or_else(|| class_of(mesh.extras()))
+                .or_else(|| mesh.name().map(String::from))
+                .unwrap_or_else(|| name.clone());
+            b.object(&name, &class);
             if node.skin().is_some() {
                 self.ignored.insert("skins".into());
             }
@@ -511,4 +521,12 @@ impl Loader<'_> {
         self.textures.insert(texture.index(), id);
         Ok(id)
     }
+}
+
+/// The `class` (or `semantic`, `category`) string of a glTF object's `extras`, if it has one.
+fn class_of(extras: &gltf::json::Extras) -> Option<String> {
+    let value: serde_json::Value = serde_json::from_str(extras.as_ref()?.get()).ok()?;
+    ["class", "semantic", "category"]
+        .iter()
+        .find_map(|key| value.get(key)?.as_str().map(String::from))
 }
