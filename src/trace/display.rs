@@ -27,7 +27,11 @@ pub fn colour_image(size: ImageSize, colour: &[[f32; 4]]) -> image::RgbaImage {
 }
 
 /// Writes an image as PNG (creating the parent folder; atomically, see [`write_atomically`]).
-pub fn save_png(image: &image::RgbaImage, path: &Path) -> Result<()> {
+pub fn save_png<P>(image: &image::ImageBuffer<P, Vec<P::Subpixel>>, path: &Path) -> Result<()>
+where
+    P: image::PixelWithColorType,
+    [P::Subpixel]: image::EncodableLayout,
+{
     write_atomically(path, |temporary| {
         image
             .save_with_format(temporary, image::ImageFormat::Png)

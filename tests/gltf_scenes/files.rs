@@ -215,31 +215,9 @@ fn shared_meshes_are_instanced() {
     use fisheye_rt::trace::cpu::Reference;
     let dir = temp_dir("instances");
     let mut doc = Doc::default();
-    // A unit cube (12 triangles) and a floor square.
-    let corners: Vec<[f32; 3]> = (0..8)
-        .map(|k| [(k & 1) as f32, ((k >> 1) & 1) as f32, ((k >> 2) & 1) as f32])
-        .collect();
-    let cube_faces: [u32; 36] = [
-        0, 2, 1, 1, 2, 3, 4, 5, 6, 5, 7, 6, 0, 1, 4, 1, 5, 4, 2, 6, 3, 3, 6, 7, 0, 4, 2, 2, 4, 6,
-        1, 3, 5, 3, 7, 5,
-    ];
-    let positions = doc.positions(&corners);
-    let indices = doc.indices(&cube_faces, 5123);
     doc.materials.push(json!({"pbrMetallicRoughness":
         {"baseColorFactor": [0.8, 0.3, 0.2, 1.0], "metallicFactor": 0.0, "roughnessFactor": 1.0}}));
-    let cube = doc.mesh(vec![
-        json!({"attributes": {"POSITION": positions}, "indices": indices,
-        "material": 0}),
-    ]);
-    let floor_positions = doc.positions(&[
-        [-6.0, 0.0, -12.0],
-        [6.0, 0.0, -12.0],
-        [6.0, 0.0, 2.0],
-        [-6.0, 0.0, 2.0],
-    ]);
-    let floor_indices = doc.indices(&[0, 2, 1, 0, 3, 2], 5121);
-    let floor = doc.mesh(vec![json!({"attributes": {"POSITION": floor_positions},
-        "indices": floor_indices})]);
+    let (cube, floor) = doc.cube_and_floor(Some(0));
     let mut roots = vec![doc.node(json!({"mesh": floor}))];
     for (t, extra) in [
         ([-2.0, 0.0, -4.0], json!({})),

@@ -13,28 +13,8 @@ fn gltf_nodes_name_objects_and_extras_class_them() {
     use fisheye_rt::trace::NO_HIT;
     let dir = temp_dir("labels");
     let mut doc = Doc::default();
-    let corners: Vec<[f32; 3]> = (0..8)
-        .map(|k| [(k & 1) as f32, ((k >> 1) & 1) as f32, ((k >> 2) & 1) as f32])
-        .collect();
-    let faces: [u32; 36] = [
-        0, 2, 1, 1, 2, 3, 4, 5, 6, 5, 7, 6, 0, 1, 4, 1, 5, 4, 2, 6, 3, 3, 6, 7, 0, 4, 2, 2, 4, 6,
-        1, 3, 5, 3, 7, 5,
-    ];
-    let positions = doc.positions(&corners);
-    let indices = doc.indices(&faces, 5123);
-    let cube = doc.mesh(vec![
-        json!({"attributes": {"POSITION": positions}, "indices": indices}),
-    ]);
+    let (cube, floor) = doc.cube_and_floor(None);
     doc.meshes[cube]["name"] = json!("crate");
-    let floor_positions = doc.positions(&[
-        [-6.0, 0.0, -12.0],
-        [6.0, 0.0, -12.0],
-        [6.0, 0.0, 2.0],
-        [-6.0, 0.0, 2.0],
-    ]);
-    let floor_indices = doc.indices(&[0, 2, 1, 0, 3, 2], 5121);
-    let floor = doc.mesh(vec![json!({"attributes": {"POSITION": floor_positions},
-        "indices": floor_indices})]);
     let roots = vec![
         doc.node(json!({"mesh": floor, "name": "floor", "extras": {"semantic": "ground"}})),
         doc.node(

@@ -38,6 +38,34 @@ struct Doc {
 
 impl Doc {
     /// A view of `bytes` (4-byte aligned).
+    /// A unit cube (12 triangles, `material` if given) and a floor square (2), as meshes.
+    fn cube_and_floor(&mut self, material: Option<usize>) -> (usize, usize) {
+        let corners: Vec<[f32; 3]> = (0..8)
+            .map(|k| [(k & 1) as f32, ((k >> 1) & 1) as f32, ((k >> 2) & 1) as f32])
+            .collect();
+        let faces: [u32; 36] = [
+            0, 2, 1, 1, 2, 3, 4, 5, 6, 5, 7, 6, 0, 1, 4, 1, 5, 4, 2, 6, 3, 3, 6, 7, 0, 4, 2, 2, 4,
+            6, 1, 3, 5, 3, 7, 5,
+        ];
+        let positions = self.positions(&corners);
+        let indices = self.indices(&faces, 5123);
+        let mut primitive = json!({"attributes": {"POSITION": positions}, "indices": indices});
+        if let Some(m) = material {
+            primitive["material"] = json!(m);
+        }
+        let cube = self.mesh(vec![primitive]);
+        let floor_positions = self.positions(&[
+            [-6.0, 0.0, -12.0],
+            [6.0, 0.0, -12.0],
+            [6.0, 0.0, 2.0],
+            [-6.0, 0.0, 2.0],
+        ]);
+        let floor_indices = self.indices(&[0, 2, 1, 0, 3, 2], 5121);
+        let floor = self.mesh(vec![json!({"attributes": {"POSITION": floor_positions},
+            "indices": floor_indices})]);
+        (cube, floor)
+    }
+
     fn view(&mut self, bytes: &[u8]) -> usize {
         while !self.bin.len().is_multiple_of(4) {
             self.bin.push(0);

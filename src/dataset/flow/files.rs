@@ -10,7 +10,7 @@ use std::path::Path;
 
 use crate::error::{Error, Result};
 use crate::lens::ImageSize;
-use crate::trace::write_atomically;
+use crate::trace::{save_png, write_atomically};
 
 /// What Middlebury's files write for an unknown component (above their 10⁹ threshold).
 const UNKNOWN: f32 = 1e10;
@@ -49,12 +49,5 @@ pub fn write_kitti(path: &Path, size: ImageSize, flow: &[[f32; 2]], valid: &[u8]
         .collect();
     let image = image::ImageBuffer::<image::Rgb<u16>, _>::from_raw(size.width, size.height, pixels)
         .expect("three channels a pixel");
-    write_atomically(path, |temporary| {
-        image
-            .save_with_format(temporary, image::ImageFormat::Png)
-            .map_err(|reason| Error::Image {
-                path: path.to_path_buf(),
-                reason,
-            })
-    })
+    save_png(&image, path)
 }

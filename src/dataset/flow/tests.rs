@@ -39,6 +39,37 @@ fn frame(camera: &LensCamera, motion: &Motion, cast: &Caster) -> RenderOutput {
     output
 }
 
+/// Two frames of one camera: its rays, its motions over each, and what it saw.
+struct Pair<'a> {
+    camera: &'a LensCamera,
+    directions: Vec<Option<DVec3>>,
+    motions: [Motion; 2],
+    outputs: [RenderOutput; 2],
+}
+
+impl<'a> Pair<'a> {
+    /// `camera` moving by each of `motions` over `cast`.
+    fn new(camera: &'a LensCamera, motions: [Motion; 2], cast: &Caster) -> Self {
+        let outputs = motions.each_ref().map(|m| frame(camera, m, cast));
+        Self {
+            camera,
+            directions: camera.directions(),
+            motions,
+            outputs,
+        }
+    }
+
+    /// Frame `k` as flow reads it.
+    fn seen(&self, k: usize) -> Seen<'_> {
+        Seen {
+            camera: self.camera,
+            motion: &self.motions[k],
+            output: &self.outputs[k],
+            directions: &self.directions,
+        }
+    }
+}
+
 /// A sphere of radius `r` about `centre`, seen from inside.
 fn sphere(centre: DVec3, r: f64) -> Box<Caster> {
     Box::new(move |o, d| {
@@ -118,22 +149,11 @@ fn a_pure_rotation_moves_each_pixel_by_the_lens_mapping_of_the_turned_ray() {
     );
     for camera in every_family() {
         let directions = camera.directions();
-        let (from_motion, to_motion) = (standing(eye, a), standing(eye, b));
         let mut flows = Vec::new();
         for radius in [2.0, 50.0] {
             let scene = sphere(eye, radius);
-            let outputs = [
-                frame(&camera, &from_motion, &scene),
-                frame(&camera, &to_motion, &scene),
-            ];
-            let seen = |k: usize, motion| Seen {
-                camera: &camera,
-                motion,
-                output: &outputs[k],
-                directions: &directions,
-            };
-            let (from, to) = (seen(0, &from_motion), seen(1, &to_motion));
-            flows.push(optical_flow(&from, Some(&to)));
+            let pair = Pair::new(&camera, [standing(eye, a), standing(eye, b)], &scene);
+            flows.push(optical_flow(&pair.seen(0), Some(&pair.seen(1))));
         }
         let name = camera.lens.to_string();
         let mut landed = 0;
@@ -172,7 +192,6 @@ fn a_sideways_slide_past_a_plane_moves_pixels_by_focal_length_times_slide_over_d
         parse_spec("rectilinear:f=1.5").unwrap(),
         ImageSize::new(80, 60).unwrap(),
     );
-    let directions = camera.directions();
     let f = 1.5 * 40.0;
     for (depth, slide) in [(2.0, 0.1), (10.0, 0.5)] {
         let scene = wall(depth, DVec2::splat(1e3));
@@ -180,15 +199,9 @@ fn a_sideways_slide_past_a_plane_moves_pixels_by_focal_length_times_slide_over_d
             standing(DVec3::ZERO, DQuat::IDENTITY),
             standing(DVec3::new(slide, 0.0, 0.0), DQuat::IDENTITY),
         ];
-        let outputs = motions.each_ref().map(|m| frame(&camera, m, &scene));
-        let seen = |k: usize| Seen {
-            camera: &camera,
-            motion: &motions[k],
-            output: &outputs[k],
-            directions: &directions,
-        };
-        let (flow, valid) = optical_flow(&seen(0), Some(&seen(1)));
-        let moved = scene_flow(&seen(0), Some(&seen(1)));
+        let pair = Pair::new(&camera, motions, &scene);
+        let (flow, valid) = optical_flow(&pair.seen(0), Some(&pair.seen(1)));
+        let moved = scene_flow(&pair.seen(0), Some(&pair.seen(1)));
         let wanted = -f * slide / depth;
         let mut landed = 0;
         for i in 0..flow.len() {
@@ -227,7 +240,6 @@ fn forward_and_backward_flow_agree_where_both_frames_see_the_point() {
         ImageSize::new(160, 120).unwrap(),
     )
     .with_shutter(Shutter::new(2e-4, 0.0, Readout::TopToBottom).unwrap());
-    let directions = camera.directions();
     let scene = nearer(
         wall(6.0, DVec2::splat(50.0)),
         wall(3.0, DVec2::new(1.0, 0.8)),
@@ -244,13 +256,8 @@ fn forward_and_backward_flow_agree_where_both_frames_see_the_point() {
         body_from_camera: DAffine3::IDENTITY,
     };
     let motions = [over(0.0), over(0.05)];
-    let outputs = motions.each_ref().map(|m| frame(&camera, m, &scene));
-    let seen = |k: usize| Seen {
-        camera: &camera,
-        motion: &motions[k],
-        output: &outputs[k],
-        directions: &directions,
-    };
+    let pair = Pair::new(&camera, motions, &scene);
+    let seen = |k: usize| pair.seen(k);
     let (forward, forward_valid) = optical_flow(&seen(0), Some(&seen(1)));
     let (backward, backward_valid) = optical_flow(&seen(1), Some(&seen(0)));
     let w = 160;
@@ -276,7 +283,7 @@ fn forward_and_backward_flow_agree_where_both_frames_see_the_point() {
     // Visibility cast in the scene against flow_valid: they may differ only where the
     // landing's pixel borders a step in range (an edge of the panel).
     let (from, to) = (seen(0), seen(1));
-    let range = |q: usize| f64::from(outputs[1].geometry[q][3]);
+    let range = |q: usize| f64::from(pair.outputs[1].geometry[q][3]);
     let beside_edge = |q: usize| {
         let (x, y) = ((q % w) as i64, (q / w) as i64);
         (-1..=1)
