@@ -254,3 +254,45 @@ fn an_exposure_smears_an_edge_by_the_distance_it_moves() {
         );
     }
 }
+
+/// Adaptive sampling moves the camera as uniform sampling does: at threshold 0, through a
+/// rolling shutter with an exposure on a turning camera, it gives uniform sampling's bits
+/// (every sample at the same time from the same pose), ground truth included.
+#[test]
+fn adaptive_sampling_at_threshold_zero_is_uniform_sampling_in_motion() {
+    use fisheye_rt::trace::Adaptive;
+    let scene = builtin::scene("default").unwrap();
+    let shutter = Shutter::new(5e-4, 0.01, Readout::TopToBottom).unwrap();
+    let rolling = camera("samyang-7.5mm", 61, 46).with_shutter(shutter);
+    let motion = turning(
+        scene.camera.position,
+        scene.camera.rotation(),
+        DVec3::Y,
+        2.0,
+        0.05,
+    );
+    let motion = Motion {
+        knots: motion
+            .knots
+            .iter()
+            .map(|&(t, pose)| (t - 0.005, pose))
+            .collect(),
+        ..motion
+    };
+    let uniform = RenderOptions {
+        spp: 16,
+        ..RenderOptions::default()
+    };
+    let adaptive = RenderOptions {
+        adaptive: Some(Adaptive {
+            threshold: 0.0,
+            ground_truth: true,
+        }),
+        ..uniform
+    };
+    let a = moving(&scene, &rolling, &uniform, &motion);
+    let b = moving(&scene, &rolling, &adaptive, &motion);
+    assert_eq!(a.colour, b.colour, "colour");
+    assert_eq!(a.geometry, b.geometry, "geometry");
+    assert_eq!(a.ids, b.ids, "ids");
+}
