@@ -84,7 +84,8 @@ pub struct Progress {
     pub done: usize,
     /// Poses in the shard.
     pub total: usize,
-    /// Of them, already complete before this run.
+    /// Of them, already complete before this run (frames skipped past the trajectory's
+    /// ends are done, but not counted here).
     pub skipped: usize,
 }
 
@@ -320,10 +321,11 @@ impl Dataset {
             readback_seconds: 0.0,
             write_seconds: 0.0,
         };
+        // Frames past the trajectory's ends count as done, not as already complete.
         progress(Progress {
             done: skipped,
             total: range.len(),
-            skipped,
+            skipped: skipped - outside,
         });
         if !todo.is_empty() {
             let frames = self.traced(&todo, &reasons);
@@ -331,7 +333,7 @@ impl Dataset {
                 progress(Progress {
                     done: skipped + done,
                     total: range.len(),
-                    skipped,
+                    skipped: skipped - outside,
                 })
             })?;
         }
