@@ -388,15 +388,15 @@ impl Scene {
     /// class (an index into them).
     pub fn classes(&self) -> (Vec<String>, Vec<u32>) {
         let mut names: Vec<String> = Vec::new();
+        let mut index: std::collections::HashMap<&str, u32> = Default::default();
         let of = self
             .objects
             .iter()
-            .map(|o| match names.iter().position(|n| *n == o.class) {
-                Some(i) => i as u32,
-                None => {
+            .map(|o| {
+                *index.entry(&o.class).or_insert_with(|| {
                     names.push(o.class.clone());
                     names.len() as u32 - 1
-                }
+                })
             })
             .collect();
         (names, of)

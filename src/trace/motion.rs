@@ -4,6 +4,7 @@
 
 use glam::{DAffine3, DQuat, DVec3};
 
+use super::gpu_scene::view_frame;
 use crate::error::{Error, Result};
 use crate::lens::{LensCamera, Shutter};
 use crate::pose::interpolate;
@@ -66,35 +67,29 @@ impl Motion {
                 pair[1].0, pair[0].0
             )));
         }
-        let col = |v: DVec3| {
-            let v = v.as_vec3();
-            [v.x, v.y, v.z, 0.0]
-        };
-        let mut frame: Frame = bytemuck::Zeroable::zeroed();
-        frame.motion = [1, shutter.readout.id(), 0, 0];
-        frame.shutter = [shutter.line_delay as f32, shutter.exposure as f32, 0.0, 0.0];
-        frame.knots[0].rotation = [0.0, 0.0, 0.0, 1.0];
-        let (camera, knots) = if shutter.moves() && self.knots.len() > 1 {
-            (self.body_from_camera, &self.knots[..])
+        // The camera in the body where it moves, else in the world relative to the origin
+        // at the stamp (one knot at rest).
+        let (mut frame, knots) = if shutter.moves() && self.knots.len() > 1 {
+            let camera = self.body_from_camera;
+            let frame = view_frame(DVec3::ZERO, camera.translation, camera.matrix3, [0, 0]);
+            (frame, &self.knots[..])
         } else {
-            // Still: the camera at the stamp, relative to the origin; one knot at rest.
             let at = self.camera_at(0.0);
-            let relative = DAffine3::from_mat3_translation(at.matrix3, at.translation - origin);
-            (relative, &[][..])
+            (
+                view_frame(origin, at.translation, at.matrix3, [0, 0]),
+                &[][..],
+            )
         };
-        frame.right = col(camera.matrix3.x_axis);
-        frame.down = col(camera.matrix3.y_axis);
-        frame.forward = col(camera.matrix3.z_axis);
-        frame.eye = col(camera.translation);
+        frame.shutter = [shutter.line_delay as f32, shutter.exposure as f32, 0.0, 0.0];
+        frame.motion = [knots.len().max(1) as u32, shutter.readout.id(), 0, 0];
         for (knot, (t, body)) in frame.knots.iter_mut().zip(knots) {
             let q = DQuat::from_mat3(&body.matrix3).normalize().as_quat();
-            let p = col(body.translation - origin);
+            let p = (body.translation - origin).as_vec3();
             *knot = Knot {
                 rotation: q.to_array(),
-                position: [p[0], p[1], p[2], *t as f32],
+                position: [p.x, p.y, p.z, *t as f32],
             };
         }
-        frame.motion[0] = knots.len().max(1) as u32;
         Ok(frame)
     }
 }
