@@ -11,7 +11,11 @@ use obvhs::cwbvh::node::CwBvhNode;
 
 use crate::error::{Error, Result};
 use crate::scene::Scene;
+mod sweep;
+
 pub use crate::shared::{GpuInstance, GpuTriangle, TRAVERSAL_STACK};
+use crate::shared::{InstanceKnot, KNOT_VEC4S};
+pub use sweep::{MAX_INSTANCE_KNOTS, SPLITS};
 
 /// The widest extent, in scene units from the camera, of a scene the BVH is built for. obvhs
 /// computes surface areas in f32, and past about 1e19 they overflow and its build panics
@@ -100,20 +104,36 @@ pub struct SceneBvh {
     pub depth: u32,
     /// Time obvhs spent building.
     pub build_time: Duration,
+    /// What the top level is built from, where instances move: [`TopLevel::build`] rebuilds
+    /// it for each time, into the first [`TopLevel::reserved`] nodes.
+    pub top: Option<TopLevel>,
 }
 
 /// A mesh's BVH placed in the top level.
+#[derive(Clone, Debug)]
 struct Placed {
-    /// Mesh to world; `None` for the world's own triangles.
-    transform: Option<DAffine3>,
-    /// Its root node (before the top level's nodes are put first).
+    /// The instance placing it (an index into the scene's); `None` for the world's own
+    /// triangles.
+    instance: Option<usize>,
+    /// Its root node (after the top level's reserved nodes).
     root: u32,
     /// The scene triangle id of its first triangle.
     id_base: u32,
     /// Its first stored triangle.
     first: u32,
-    /// Its world bounds.
+    /// Its bounds in its own space (the world's, for the world's triangles).
     bounds: (DVec3, DVec3),
+}
+
+/// The top level of an instanced scene: the meshes' BVHs as placed, and the nodes reserved
+/// for it at the start of the nodes buffer. Instances (moving ones at some time) are boxed
+/// and a CWBVH built over them; the meshes' BVHs stay as built.
+#[derive(Clone, Debug)]
+pub struct TopLevel {
+    placed: Vec<Placed>,
+    /// Nodes reserved for the top level (a CWBVH over n boxes has at most n nodes).
+    pub reserved: usize,
+    quality: BvhQuality,
 }
 
 /// One level's BVH as obvhs built it, with its triangles or instances in leaf order.
@@ -267,6 +287,7 @@ pub(crate) fn gpu_instance(
         id_base,
         normal_z: [normal[2][0], normal[2][1], normal[2][2]],
         first,
+        motion: [0, 0, u32::from(crate::scene::shows(&transform)), 0],
     }
 }
 
@@ -283,6 +304,7 @@ impl SceneBvh {
                 origin,
                 depth: 1,
                 build_time,
+                top: None,
             });
         }
         if !scene.is_instanced() {
@@ -294,6 +316,7 @@ impl SceneBvh {
                 origin,
                 depth: level.depth,
                 build_time,
+                top: None,
             });
         }
         // The bottom level: the world's triangles, then each mesh once.
@@ -315,7 +338,7 @@ impl SceneBvh {
         if let Some(bounds) = crate::scene::bounds(&scene.triangles[..scene.world_triangles]) {
             let level = triangle_level(scene, &world, 0, quality, &mut build_time)?;
             placed.push(Placed {
-                transform: None,
+                instance: None,
                 root: append(level, &mut nodes),
                 id_base: 0,
                 first: 0,
@@ -324,17 +347,20 @@ impl SceneBvh {
         }
         let mut roots = std::collections::HashMap::new();
         let mut id_base = scene.world_triangles as u32;
-        for instance in &scene.instances {
+        for (index, instance) in scene.instances.iter().enumerate() {
             let base = id_base;
             id_base += instance.count;
-            let Some(bounds) = scene.instance_bounds(instance) else {
+            let first = instance.first as usize;
+            let mesh = &scene.triangles[first..first + instance.count as usize];
+            // A fixed instance that shows nothing is left out; a moving one may show later.
+            let moving = instance.animation.is_some();
+            let Some(bounds) = crate::scene::bounds(mesh).filter(|_| moving || instance.visible())
+            else {
                 continue;
             };
             let root = match roots.get(&instance.first) {
                 Some(&root) => root,
                 None => {
-                    let first = instance.first as usize;
-                    let mesh = &scene.triangles[first..first + instance.count as usize];
                     let corners = rounded(mesh, DVec3::ZERO, first)?;
                     let level = triangle_level(scene, &corners, first, quality, &mut build_time)?;
                     let root = append(level, &mut nodes);
@@ -343,19 +369,147 @@ impl SceneBvh {
                 }
             };
             placed.push(Placed {
-                transform: Some(instance.transform),
+                instance: Some(index),
                 root,
                 id_base: base,
                 first: instance.first,
                 bounds,
             });
         }
-        // The top level over the instances' boxes, camera-relative, padded for the roundings
-        // of the f32 transforms (a relative 1e-5 of the box's reach is hundreds of ulp).
-        let boxes: Vec<obvhs::aabb::Aabb> = placed
+        let mut top = TopLevel {
+            // Room for any time's top level where instances move; else exactly this one's.
+            reserved: if scene.moves() { placed.len() + 1 } else { 0 },
+            placed,
+            quality,
+        };
+        let placements: Vec<DAffine3> = scene.instances.iter().map(|i| i.transform).collect();
+        let built = top.build(&placements, origin)?;
+        build_time += built.build_time;
+        if !scene.moves() {
+            top.reserved = built.nodes.len();
+        }
+        for n in &mut nodes {
+            n.child_base_idx += top.reserved as u32;
+        }
+        let mut all = built.nodes;
+        all.resize(top.reserved, CwBvhNode::default());
+        all.extend(nodes);
+        Ok(Self {
+            nodes: all,
+            triangles,
+            instances: built.instances,
+            origin,
+            depth: depth.max(built.depth),
+            build_time,
+            top: scene.moves().then_some(top),
+        })
+    }
+}
+
+/// A top level as [`TopLevel::build`] makes it.
+pub struct BuiltTop {
+    /// Its nodes (at most [`TopLevel::reserved`] where instances move).
+    pub nodes: Vec<CwBvhNode>,
+    /// Its instances in leaf order.
+    pub instances: Vec<GpuInstance>,
+    /// Moving instances' knots, where a frame spans time: they start at vec4
+    /// [`TopLevel::knots_at`] of the instances' buffer.
+    pub knots: Vec<InstanceKnot>,
+    /// Its depth.
+    pub depth: u32,
+    /// obvhs's time.
+    pub build_time: Duration,
+}
+
+/// Where an instance is over a frame.
+enum Place {
+    /// Still, by this placement.
+    Fixed(DAffine3),
+    /// Moving, by these knots.
+    Swept(sweep::Swept),
+}
+
+impl TopLevel {
+    /// The top level over the scene's instances placed by `placements` (one per instance of
+    /// the scene it was made for: [`Scene::placements_at`]), camera-relative to `origin`.
+    /// Instances placed to show nothing are left out.
+    pub fn build(&self, placements: &[DAffine3], origin: DVec3) -> Result<BuiltTop> {
+        let places = placements.iter().map(|&m| Place::Fixed(m)).collect();
+        self.build_from(places, origin)
+    }
+
+    /// The top level of `scene` (the scene it was made for) over a frame at scene time
+    /// `stamp` whose rays span `window` seconds from it ([`crate::lens::LensCamera::
+    /// exposure_span`]): still instances placed, moving ones by knots over the window
+    /// (where it is an instant, placed at it).
+    pub fn build_over(
+        &self,
+        scene: &Scene,
+        stamp: f64,
+        window: (f64, f64),
+        origin: DVec3,
+    ) -> Result<BuiltTop> {
+        if window.0 == window.1 {
+            return self.build(&scene.placements_at(stamp + window.0), origin);
+        }
+        let mut boxes = vec![None; scene.instances.len()];
+        for p in &self.placed {
+            if let Some(i) = p.instance {
+                boxes[i] = Some(p.bounds);
+            }
+        }
+        let places = scene
+            .instances
             .iter()
-            .map(|p| {
-                let (lo, hi) = (p.bounds.0 - origin, p.bounds.1 - origin);
+            .zip(boxes)
+            .map(
+                |(instance, mesh_box)| match (instance.animation, mesh_box) {
+                    (Some(a), Some(mesh_box)) => {
+                        let animation = &scene.animations[a as usize];
+                        Place::Swept(sweep::sweep(animation, stamp, window, mesh_box, origin))
+                    }
+                    _ => Place::Fixed(instance.transform),
+                },
+            )
+            .collect();
+        self.build_from(places, origin)
+    }
+
+    /// The vec4 of the instances' buffer moving instances' knots start at.
+    pub fn knots_at(&self) -> u32 {
+        self.reserved as u32 * crate::shared::INSTANCE_VEC4S
+    }
+
+    /// The most knots a frame's moving instances take.
+    pub fn knot_capacity(&self, scene: &Scene) -> usize {
+        let moving = scene.instances.iter().filter(|i| i.animation.is_some());
+        moving.count() * sweep::MAX_INSTANCE_KNOTS
+    }
+
+    fn build_from(&self, places: Vec<Place>, origin: DVec3) -> Result<BuiltTop> {
+        let world = Place::Fixed(DAffine3::from_translation(origin));
+        // Each shown mesh, with its placement (where still) and its camera-relative box.
+        let shown: Vec<(&Placed, &Place, (DVec3, DVec3))> = self
+            .placed
+            .iter()
+            .filter_map(|p| {
+                let place = p.instance.map_or(&world, |i| &places[i]);
+                let bounds = match (p.instance, place) {
+                    (None, _) => Some((p.bounds.0 - origin, p.bounds.1 - origin)),
+                    (Some(_), Place::Fixed(m)) => crate::scene::shows(m).then(|| {
+                        let (lo, hi) = crate::scene::placed_box(p.bounds, *m);
+                        (lo - origin, hi - origin)
+                    }),
+                    (Some(_), Place::Swept(swept)) => swept.bounds,
+                };
+                bounds.map(|b| (p, place, b))
+            })
+            .collect();
+        // Padded for the roundings of the f32 transforms (a relative 1e-5 of the box's reach
+        // is hundreds of ulp).
+        let boxes: Vec<obvhs::aabb::Aabb> = shown
+            .iter()
+            .map(|&(_, _, (lo, hi))| {
                 let pad = DVec3::splat(1e-5 * lo.abs().max(hi.abs()).max_element());
                 obvhs::aabb::Aabb {
                     min: (lo - pad).as_vec3().into(),
@@ -364,29 +518,58 @@ impl SceneBvh {
             })
             .collect();
         check_extent(boxes.iter().flat_map(|b| [b.min, b.max]))?;
-        let (mut top, order, top_depth) = build_level(
-            |core| obvhs::cwbvh::builder::build_cwbvh(&boxes, quality.params(), core),
+        let mut build_time = Duration::ZERO;
+        if boxes.is_empty() {
+            return Ok(BuiltTop {
+                nodes: vec![CwBvhNode::default()],
+                instances: Vec::new(),
+                knots: Vec::new(),
+                depth: 1,
+                build_time,
+            });
+        }
+        let (top, order, depth) = build_level(
+            |core| obvhs::cwbvh::builder::build_cwbvh(&boxes, self.quality.params(), core),
             &mut build_time,
         )?;
-        let shift = top.len() as u32;
-        for n in &mut nodes {
-            n.child_base_idx += shift;
+        if self.reserved > 0 && top.len() > self.reserved {
+            return Err(Error::Limit(format!(
+                "the top level over {} instances took {} nodes, more than the {} reserved",
+                boxes.len(),
+                top.len(),
+                self.reserved
+            )));
         }
-        top.extend(nodes);
+        let shift = self.reserved.max(top.len()) as u32;
+        let mut knots = Vec::new();
         let instances = order
             .iter()
             .map(|&i| {
-                let p = &placed[i as usize];
-                let transform = p.transform.unwrap_or(DAffine3::from_translation(origin));
-                gpu_instance(transform, origin, p.root + shift, p.id_base, p.first)
+                let (p, place, _) = shown[i as usize];
+                let root = p.root + shift;
+                match place {
+                    Place::Fixed(m) => gpu_instance(*m, origin, root, p.id_base, p.first),
+                    Place::Swept(swept) => {
+                        let start = self.knots_at() + knots.len() as u32 * KNOT_VEC4S;
+                        knots.extend_from_slice(&swept.knots);
+                        let mut instance = gpu_instance(
+                            DAffine3::from_translation(origin),
+                            origin,
+                            root,
+                            p.id_base,
+                            p.first,
+                        );
+                        instance.motion = [start, swept.knots.len() as u32, 1, 0];
+                        instance
+                    }
+                }
             })
             .collect();
-        Ok(Self {
+        Ok(BuiltTop {
             nodes: top,
-            triangles,
             instances,
-            origin,
-            depth: depth.max(top_depth),
+            knots,
+            depth,
             build_time,
         })
     }

@@ -15,8 +15,9 @@ use crate::split::SceneArrays;
 const SCENE_ARRAYS: &str = "scene_arrays";
 
 /// Every WGSL file of the project, by name (its file stem under `wgsl/`).
-pub const FILES: [(&str, &str); 32] = [
+pub const FILES: [(&str, &str); 33] = [
     ("math", include_str!("../wgsl/math.wgsl")),
+    ("quaternion", include_str!("../wgsl/quaternion.wgsl")),
     ("calibrated", include_str!("../wgsl/calibrated.wgsl")),
     ("triangles", include_str!("../wgsl/triangles.wgsl")),
     ("bvh", include_str!("../wgsl/bvh.wgsl")),

@@ -304,6 +304,8 @@ pub fn wgsl_constants() -> Vec<(String, u32)> {
         ("NO_HIT", NO_HIT),
         ("ADAPTIVE_BLOCK", ADAPTIVE_BLOCK),
         ("MAX_KNOTS", MAX_KNOTS as u32),
+        ("INSTANCE_VEC4S", INSTANCE_VEC4S),
+        ("KNOT_VEC4S", KNOT_VEC4S),
         ("ADAPTIVE_HEADER", ADAPTIVE_HEADER),
         ("ADAPTIVE_COUNT", ADAPTIVE_COUNT),
         ("ADAPTIVE_ESTIMATE_SIDE", ADAPTIVE_ESTIMATE_SIDE),
@@ -487,8 +489,8 @@ pub struct CastRay {
     pub tmax: f32,
 }
 
-/// An instance as `wgsl/triangles.wgsl` reads it (144 bytes): a mesh's BVH and the affine
-/// maps between the camera-relative world and the mesh's space.
+/// An instance as `wgsl/triangles.wgsl` reads it (160 bytes): a mesh's BVH and the affine
+/// maps between the camera-relative world and the mesh's space, or a moving one's knots.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, PartialEq, Pod, Zeroable)]
 pub struct GpuInstance {
@@ -508,9 +510,37 @@ pub struct GpuInstance {
     pub normal_z: [f32; 3],
     /// The mesh's first stored triangle (`Scene::triangles`).
     pub first: u32,
+    /// Where it moves within a frame: the vec4 its [`InstanceKnot`]s start at in the
+    /// instances' buffer and how many (with fewer than 2 the maps above place it); then 1 where
+    /// it shows (0 where its placement flattens it), and a zero.
+    pub motion: [u32; 4],
 }
 
-const _: () = assert!(std::mem::size_of::<GpuInstance>() == 144);
+const _: () = assert!(std::mem::size_of::<GpuInstance>() == 16 * INSTANCE_VEC4S as usize);
+
+/// The vec4s of a [`GpuInstance`] in the instances' buffer.
+pub const INSTANCE_VEC4S: u32 = 10;
+
+/// A moving instance's placement at a time within a frame (64 bytes), after the instances in
+/// their buffer: the polar decomposition M = R·A of its 3×3 part (R a rotation, A symmetric),
+/// between knots R by slerp and A and the translation linearly.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, PartialEq, Pod, Zeroable)]
+pub struct InstanceKnot {
+    /// R, a unit quaternion (x, y, z, w).
+    pub rotation: [f32; 4],
+    /// The translation, camera-relative (xyz), and the time in seconds from the frame's stamp.
+    pub translation: [f32; 4],
+    /// A's xx, yy, zz, xy.
+    pub diagonal: [f32; 4],
+    /// A's xz, yz, then zeros.
+    pub off_diagonal: [f32; 4],
+}
+
+/// The vec4s of an [`InstanceKnot`].
+pub const KNOT_VEC4S: u32 = 4;
+
+const _: () = assert!(std::mem::size_of::<InstanceKnot>() == 16 * KNOT_VEC4S as usize);
 
 /// The lens as WGSL's `LensParams` reads it (96 bytes; `wgsl/lens.wgsl` mirrors it and a test
 /// checks the layouts agree). See the WGSL struct for the fields' meaning; the first eight

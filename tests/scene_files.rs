@@ -335,3 +335,102 @@ fn bad_scene_files_are_clear_errors() {
     assert!(load_scene_file(&lit).unwrap().warnings.is_empty());
     std::fs::remove_dir_all(dir).unwrap();
 }
+
+/// `[[mesh.key]]` moves a mesh: two boxes of one shape, one keyed (translation and rotation
+/// given, scale left to the mesh's 0.5) and one still, are one stored mesh placed twice; the
+/// keyed one is where linear interpolation (slerp for the rotation) of its keys puts it, held
+/// outside them. Keys out of order are an error naming the mesh.
+#[test]
+fn keyed_meshes_move() {
+    use glam::{DAffine3, DQuat};
+    let dir = temp_dir("scene-keys");
+    let path = write(
+        &dir,
+        "keyed.toml",
+        r#"
+[[mesh]]
+shape = "box"
+scale = 0.5
+translation = [0.0, 0.0, -4.0]
+[[mesh.key]]
+time = 1.0
+translation = [-2.0, 0.0, -4.0]
+[[mesh.key]]
+time = 3.0
+translation = [2.0, 1.0, -4.0]
+rotation = [0.0, 90.0, 0.0]
+
+[[mesh]]
+shape = "box"
+scale = 0.5
+translation = [3.0, 0.0, -6.0]
+
+[[light]]
+type = "sun"
+direction = [0.0, -1.0, -1.0]
+irradiance = [1.0, 1.0, 1.0]
+"#,
+    );
+    let scene = load_scene_file(&path).unwrap().scene;
+    assert_eq!(scene.instances.len(), 2);
+    assert_eq!(scene.triangles.len(), 12, "one box stored");
+    assert!(scene.moves());
+    let placed = |t: f64, degrees: f64| {
+        let x = -2.0 + 4.0 * ((t - 1.0) / 2.0).clamp(0.0, 1.0);
+        let y = ((t - 1.0) / 2.0).clamp(0.0, 1.0);
+        DAffine3::from_scale_rotation_translation(
+            DVec3::splat(0.5),
+            DQuat::from_rotation_y(degrees.to_radians()),
+            DVec3::new(x, y, -4.0),
+        )
+    };
+    let still = DAffine3::from_scale_rotation_translation(
+        DVec3::splat(0.5),
+        DQuat::IDENTITY,
+        DVec3::new(3.0, 0.0, -6.0),
+    );
+    for (t, degrees) in [
+        (0.0, 0.0),
+        (1.0, 0.0),
+        (1.5, 22.5),
+        (2.0, 45.0),
+        (3.0, 90.0),
+        (9.0, 90.0),
+    ] {
+        let at = scene.placements_at(t);
+        assert!(
+            at[0].abs_diff_eq(placed(t, degrees), 1e-12),
+            "t {t}: {:?}",
+            at[0]
+        );
+        assert!(at[1].abs_diff_eq(still, 1e-12));
+    }
+    let bad = write(
+        &dir,
+        "unordered.toml",
+        "[[mesh]]\nshape = \"box\"\n[[mesh.key]]\ntime = 2.0\n[[mesh.key]]\ntime = 1.0\n",
+    );
+    let message = load_scene_file(&bad).err().expect("refused").to_string();
+    assert!(
+        message.contains("mesh 1") && message.contains("key times must increase"),
+        "{message}"
+    );
+}
+
+/// The book's moving-objects example is the file the README renders.
+#[test]
+fn the_books_sliding_scene_is_the_shipped_one() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let book = std::fs::read_to_string(root.join("docs/src/scenes.md")).unwrap();
+    let block = book
+        .split("```toml,file=sliding.toml\n")
+        .nth(1)
+        .and_then(|rest| rest.split("```\n").next())
+        .expect("the book shows sliding.toml");
+    let shipped = std::fs::read_to_string(root.join("scenes/dataset/sliding.toml")).unwrap();
+    assert_eq!(block, shipped);
+    let scene = load_scene_file(&root.join("scenes/dataset/sliding.toml"))
+        .unwrap()
+        .scene;
+    assert!(scene.moves());
+}

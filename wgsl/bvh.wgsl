@@ -274,9 +274,17 @@ fn bvh_trace(ray: Ray, any_hit: bool) -> Hit {
             let bit = firstTrailingBit(w.leaves.y);
             w.leaves.y &= w.leaves.y - 1u;
             let k = w.leaves.x + bit;
-            let to_mesh = instances[k].to_mesh;
+            let instance = instance_at(k);
+            if instance.motion.z == 0u {
+                continue;
+            }
+            let to_mesh = instance.to_mesh;
             let local = Ray(affine(to_mesh, ray.origin), linear(to_mesh, ray.dir), ray.tmin, hit.t);
-            hit = mesh_trace(instances[k].root, local, any_hit, hit, k);
+            hit = mesh_trace(instance.root, local, any_hit, hit, k);
+            // Each instance is visited once a trace: the best hit is in k only if k gave it.
+            if MOVING && hit.instance == k {
+                hit_placed = instance;
+            }
             if any_hit && hit.slot != NO_HIT {
                 return hit;
             }

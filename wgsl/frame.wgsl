@@ -6,6 +6,7 @@
 // its sample's stratum of it (centred on the line's time). Between knots the body turns by
 // Shoemake's slerp and moves linearly, as `fisheye_rt::pose::interpolate` does in f64.
 #import math
+#import quaternion
 #import primary
 #import triangles
 #import sampling
@@ -52,34 +53,10 @@ fn placed_ray(at: Placement, origin: vec3<f32>, d: vec3<f32>) -> Ray {
     return Ray(at.eye + at.axes * origin, at.axes * d, 0.0, 3.0e38);
 }
 
-// The quaternion product a b (rotation b, then a).
-fn quat_mul(a: vec4<f32>, b: vec4<f32>) -> vec4<f32> {
-    return vec4<f32>(a.w * b.xyz + b.w * a.xyz + cross(a.xyz, b.xyz), a.w * b.w - dot(a.xyz, b.xyz));
-}
-
-// `v` turned by the unit quaternion `q`.
-fn quat_rotate(q: vec4<f32>, v: vec3<f32>) -> vec3<f32> {
-    let t = 2.0 * cross(q.xyz, v);
-    return v + q.w * t + cross(q.xyz, t);
-}
-
-// Shoemake's slerp from `a` to `b` at `s` on the shortest arc, as a (a⁻¹ b)^s: the relative
-// turn's half angle φ = atan2(|v|, w) taken to s φ, through atanc and sinc so that it stays
-// exact as the turn vanishes.
-fn slerp(a: vec4<f32>, b: vec4<f32>, s: f32) -> vec4<f32> {
-    var r = quat_mul(vec4<f32>(-a.xyz, a.w), b);
-    if r.w < 0.0 {
-        r = -r;
-    }
-    let v = length(r.xyz);
-    // φ / |v|.
-    let per = select(atan2_pos(v, r.w) / v, atanc(v / r.w) / r.w, r.w > v);
-    let sc = sinc_cos(s * per * v);
-    return normalize(quat_mul(a, vec4<f32>(r.xyz * (sc.x * s * per), sc.y)));
-}
-
 // The camera at `t` seconds from the frame's stamp.
 fn camera_at(t: f32) -> Placement {
+    // What the ray traced next meets is placed at its time too.
+    scene_time = t;
     let axes = mat3x3<f32>(frame.right.xyz, frame.down.xyz, frame.forward.xyz);
     if !MOTION {
         return Placement(axes, frame.eye.xyz);

@@ -397,8 +397,10 @@ impl Renderer {
     /// writes PNGs), and the centre ray's ground truth "range" (H×W float32), "normal"
     /// (H×W×3 float32), "id" (H×W uint32, 4294967295 for none), "direction" (H×W×3 float32,
     /// scene frame) and "mask" (H×W uint8). The same arrays `fisheye render --outputs`
-    /// writes, bit for bit.
-    #[pyo3(signature = (lens, pose = None, spp = Spp::Count(16), outputs = vec!["colour".to_string(), "srgb".to_string()], exposure = 0.0, tone = "aces"))]
+    /// writes, bit for bit. Moving objects (glTF animations, scene-file keys) are placed at
+    /// scene time `time` (seconds), as `fisheye render --time` places them, without building
+    /// the meshes' BVHs again.
+    #[pyo3(signature = (lens, pose = None, spp = Spp::Count(16), outputs = vec!["colour".to_string(), "srgb".to_string()], exposure = 0.0, tone = "aces", time = 0.0))]
     #[allow(clippy::too_many_arguments)]
     fn render<'py>(
         &self,
@@ -409,7 +411,13 @@ impl Renderer {
         outputs: Vec<String>,
         exposure: f32,
         tone: &str,
+        time: f64,
     ) -> PyResult<Bound<'py, PyDict>> {
+        if !time.is_finite() {
+            return Err(PyValueError::new_err(format!(
+                "time={time}: give a finite number of seconds"
+            )));
+        }
         if let Some(bad) = outputs.iter().find(|o| !OUTPUTS.contains(&o.as_str())) {
             return Err(PyValueError::new_err(format!(
                 "outputs: {bad:?} is not one of {}",
@@ -457,7 +465,7 @@ impl Renderer {
         let camera = lens.camera;
         let options = self.options;
         let rays = (sampling, ground_truth);
-        let output = py.detach(|| self.trace(ctx, &camera, &pose, rays, &options))?;
+        let output = py.detach(|| self.trace(ctx, &camera, (&pose, time), rays, &options))?;
         let dict = PyDict::new(py);
         let (h, w) = (camera.size.height as usize, camera.size.width as usize);
         // Only the direction and mask arrays read the rays (an f64 lens evaluation a pixel).
@@ -514,7 +522,7 @@ impl Renderer {
         &self,
         ctx: &GpuContext,
         camera: &LensCamera,
-        pose: &Camera,
+        (pose, time): (&Camera, f64),
         (sampling, ground_truth): (Sampling, bool),
         options: &RenderOptions,
     ) -> PyResult<RenderOutput> {
@@ -538,6 +546,9 @@ impl Renderer {
             let pass = FramePass::new(ctx, camera, scene, &options).map_err(raise)?;
             passes.insert(key.clone(), pass);
         }
+        scene
+            .place_at(ctx, &self.scene, time, (0.0, 0.0))
+            .map_err(raise)?;
         passes[&key]
             .trace(ctx, scene, pose, "rendering")
             .map_err(raise)

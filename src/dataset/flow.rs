@@ -9,14 +9,65 @@
 //! fixed point (the image moving less than a line a line time converges; otherwise there is
 //! none). It is seen there (covisible) where the other frame's pixel under it has a hit at the
 //! point's distance, within the spread of range across a pixel's footprint on a slanted
-//! surface (derived at `covisible`). The scene is still: objects move with issue 36's
-//! animations.
+//! surface (derived at `covisible`). A hit on a moving instance moves with it: it is where
+//! the instance's animation puts the same point of its mesh at each time ([`Movers`]).
 
 use glam::{DAffine3, DVec2, DVec3};
 
 use crate::lens::LensCamera;
+use crate::scene::Scene;
+use crate::scene::animation::Animation;
 use crate::shared::NO_HIT;
 use crate::trace::{Motion, RenderOutput};
+
+/// A scene's moving instances, by the scene triangles (ids) they hold.
+pub struct Movers<'a> {
+    scene: &'a Scene,
+    /// Each instance's first scene triangle id.
+    bases: Vec<u32>,
+}
+
+impl<'a> Movers<'a> {
+    /// `scene`'s moving instances; `None` where nothing moves.
+    pub fn new(scene: &'a Scene) -> Option<Self> {
+        scene.moves().then(|| {
+            let mut next = scene.world_triangles as u32;
+            let bases = scene
+                .instances
+                .iter()
+                .map(|i| {
+                    next += i.count;
+                    next - i.count
+                })
+                .collect();
+            Movers { scene, bases }
+        })
+    }
+
+    /// The animation moving scene triangle `id`, if it moves.
+    fn animation(&self, id: u32) -> Option<&'a Animation> {
+        let k = self.bases.partition_point(|&b| b <= id).checked_sub(1)?;
+        let instance = &self.scene.instances[k];
+        let animation = instance.animation?;
+        (id < self.bases[k] + instance.count).then(|| &self.scene.animations[animation as usize])
+    }
+}
+
+/// A hit point over time: still, or a point of a moving instance's mesh.
+enum Tracked<'a> {
+    Still(DVec3),
+    Moving(DVec3, &'a Animation),
+}
+
+impl Tracked<'_> {
+    /// Where it is at scene time `t`.
+    fn at(&self, t: f64) -> DVec3 {
+        match self {
+            Tracked::Still(p) => *p,
+            Tracked::Moving(local, animation) => animation.at(t).transform_point3(*local),
+        }
+    }
+}
 
 /// One camera's frame as flow reads it.
 pub struct Seen<'a> {
@@ -28,6 +79,10 @@ pub struct Seen<'a> {
     pub output: &'a RenderOutput,
     /// The camera-frame direction of each pixel's centre ([`LensCamera::directions`]).
     pub directions: &'a [Option<DVec3>],
+    /// The scene time of the frame's stamp.
+    pub time: f64,
+    /// The scene's moving instances, if any.
+    pub movers: Option<&'a Movers<'a>>,
 }
 
 /// Rolling-shutter landings iterated at most this often.
@@ -51,36 +106,52 @@ impl Seen<'_> {
         self.motion.camera_at(t)
     }
 
-    /// Pixel `i`'s primary hit in the scene and the camera's pose it was seen from; `None`
-    /// where it has no hit (a miss or a masked pixel).
-    fn hit(&self, i: usize) -> Option<(DVec3, DAffine3)> {
+    /// Pixel `i`'s primary hit (moving with its instance where that moves), where it was
+    /// then, and the camera's pose it was seen from; `None` where it has no hit (a miss or a
+    /// masked pixel).
+    fn hit(&self, i: usize) -> Option<(Tracked<'_>, DVec3, DAffine3)> {
         let d = self.directions[i]?;
-        if self.output.ids[i] == NO_HIT {
+        let id = self.output.ids[i];
+        if id == NO_HIT {
             return None;
         }
         let pose = self.pose(i);
         let range = f64::from(self.output.geometry[i][3]);
-        Some((pose.transform_point3(d * range), pose))
+        let point = pose.transform_point3(d * range);
+        let tracked = match self.movers.and_then(|m| m.animation(id)) {
+            Some(animation) => {
+                let t = self.time + self.camera.time_at(self.centre(i));
+                let local = animation.at(t).inverse().transform_point3(point);
+                Tracked::Moving(local, animation)
+            }
+            None => Tracked::Still(point),
+        };
+        Some((tracked, point, pose))
     }
 
-    /// Where scene point `point` lands in this frame's image (a continuous position), and the
-    /// camera's pose at that position's time; `None` where the lens does not see it, it falls
-    /// outside the image, or a rolling shutter's landing has no fixed point.
-    fn land(&self, point: DVec3) -> Option<(DVec2, DAffine3)> {
+    /// Where `point` lands in this frame's image (a continuous position), the camera's pose
+    /// at that position's time and the point then; `None` where the lens does not see it, it
+    /// falls outside the image, or a rolling shutter's landing has no fixed point.
+    fn land(&self, point: &Tracked) -> Option<(DVec2, DAffine3, DVec3)> {
         let camera = self.camera;
-        let through = |pose: &DAffine3| camera.project(pose.inverse().transform_point3(point));
-        let mut pose = self.motion.camera_at(0.0);
-        let mut pixel = through(&pose)?;
+        // The camera and the point at `t` seconds from the stamp, and where the lens sees it.
+        let at = |t: f64| {
+            let (pose, p) = (self.motion.camera_at(t), point.at(self.time + t));
+            (camera.project(pose.inverse().transform_point3(p)), pose, p)
+        };
+        let (pixel, mut pose, mut p) = at(0.0);
+        let mut pixel = pixel?;
         if camera.shutter.line_delay == 0.0 {
-            return Some((pixel, pose));
+            return Some((pixel, pose, p));
         }
         for _ in 0..LANDING_STEPS {
-            pose = self.motion.camera_at(camera.time_at(pixel));
-            let next = through(&pose)?;
+            let (next, next_pose, next_p) = at(camera.time_at(pixel));
+            let next = next?;
+            (pose, p) = (next_pose, next_p);
             let moved = (next - pixel).length();
             pixel = next;
             if moved < 1e-9 {
-                return Some((pixel, pose));
+                return Some((pixel, pose, p));
             }
         }
         None
@@ -154,8 +225,8 @@ pub fn optical_flow(from: &Seen, to: Option<&Seen>) -> (Vec<[f32; 2]>, Vec<u8>) 
     (0..from.directions.len())
         .map(|i| {
             let landed = to.and_then(|to| {
-                let (point, _) = from.hit(i)?;
-                let (pixel, pose) = to.land(point)?;
+                let (point, _, _) = from.hit(i)?;
+                let (pixel, pose, point) = to.land(&point)?;
                 let seen = covisible(to, to.nearest(pixel), point, &pose);
                 Some((pixel - from.centre(i), seen))
             });
@@ -175,12 +246,13 @@ pub fn scene_flow(from: &Seen, to: Option<&Seen>) -> Vec<[f32; 3]> {
     (0..from.directions.len())
         .map(|i| {
             let moved = to.and_then(|to| {
-                let (point, pose) = from.hit(i)?;
-                let after = to
-                    .land(point)
-                    .map_or_else(|| to.motion.camera_at(0.0), |(_, pose)| pose);
+                let (tracked, point, pose) = from.hit(i)?;
+                let (after, moved) = to.land(&tracked).map_or_else(
+                    || (to.motion.camera_at(0.0), tracked.at(to.time)),
+                    |(_, pose, p)| (pose, p),
+                );
                 let before = pose.inverse().transform_point3(point);
-                Some(after.inverse().transform_point3(point) - before)
+                Some(after.inverse().transform_point3(moved) - before)
             });
             moved.map_or([f32::NAN; 3], |v| v.as_vec3().to_array())
         })

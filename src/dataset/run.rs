@@ -15,7 +15,7 @@ const CAMCHAIN: &str = "camchain-imucam.yaml";
 
 use super::between::{Between, FlowFile};
 use super::files::{ArrayFile, check_plan, merge, remove_leftovers};
-use super::flow::Seen;
+use super::flow::{Movers, Seen};
 use super::imu::Imu;
 use super::labels::{LABEL_MAP, Label, label_map};
 use super::readout::{Track, Unrenderable, frame_motion};
@@ -168,6 +168,12 @@ impl Dataset {
             Some(imu) => Track::Smooth(&imu.spline),
             None => Track::Stamps(&self.stamps),
         }
+    }
+
+    /// The scene time of frame `p`: seconds from the trajectory's first stamp (where the
+    /// scene's animations start).
+    pub fn scene_time(&self, p: usize) -> f64 {
+        self.poses[p].seconds - self.stamps.first().map_or(0.0, |s| s.seconds)
     }
 
     /// Camera `c`'s motion over frame `p` (see [`frame_motion`]).
@@ -482,6 +488,12 @@ impl Dataset {
                         })
                         .collect();
                     let mut outputs = Vec::with_capacity(passes.len());
+                    // Every ray of the frame's cameras is within this of its stamp.
+                    let window = lens_cameras
+                        .iter()
+                        .map(LensCamera::exposure_span)
+                        .fold((0.0f64, 0.0f64), |(a, b), (lo, hi)| (a.min(lo), b.max(hi)));
+                    gpu_scene.place_at(ctx, &scene, self.scene_time(p), window)?;
                     for group in groups {
                         let t = Instant::now();
                         ctx.checked("rendering a dataset frame", || -> Result<()> {
@@ -604,11 +616,13 @@ impl Dataset {
         let camera = self.lens_camera(w.camera);
         let motion = |w: &Written| w.motion.clone().unwrap_or_else(|| Motion::still(&w.pose));
         let motions = [Some(w), around.0, around.1].map(|w| w.map(motion));
+        let movers = Movers::new(&self.scene);
         fn seen<'a>(
             camera: &'a LensCamera,
             motion: Option<&'a Motion>,
             w: Option<&'a Written>,
             rays: &'a [Vec<Option<DVec3>>],
+            (dataset, movers): (&Dataset, Option<&'a Movers<'a>>),
         ) -> Option<Seen<'a>> {
             let w = w?;
             Some(Seen {
@@ -616,9 +630,12 @@ impl Dataset {
                 motion: motion?,
                 output: &w.output,
                 directions: &rays[w.camera],
+                time: dataset.scene_time(w.index),
+                movers,
             })
         }
-        let seen = |k: usize, w| seen(&camera, motions[k].as_ref(), w, camera_rays);
+        let moving = (self, movers.as_ref());
+        let seen = |k: usize, w| seen(&camera, motions[k].as_ref(), w, camera_rays, moving);
         let this = seen(0, Some(w));
         let (previous, next) = (seen(1, around.0), seen(2, around.1));
         for b in &self.between.0 {

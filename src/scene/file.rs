@@ -26,6 +26,14 @@
 //!                                 # (entries naming the same file or shape with the same
 //!                                 # material are one mesh, stored once and placed by each)
 //!
+//! [[mesh.key]]                    # keyframes move it: at scene time `time` (seconds) the
+//! time = 0.0                      # placement the key gives (what it leaves out, the mesh's);
+//! translation = [-1.0, 0.0, 0.0]  # linear between keys (rotations by slerp), held before
+//! [[mesh.key]]                    # the first and after the last (see `fisheye render
+//! time = 2.0                      # --time` and `dataset render`)
+//! translation = [1.0, 0.0, 0.0]
+//! rotation = [0.0, 90.0, 0.0]
+//!
 //! [[material]]                    # overrides the fields it names in materials of that name
 //! name = "light"
 //! emission = [17.0, 12.0, 4.0]
@@ -38,9 +46,12 @@
 
 use std::path::{Path, PathBuf};
 
-use glam::{DAffine3, DMat3, DVec3, Vec3};
+use std::f64::consts::PI;
+
+use glam::{DAffine3, DMat3, DQuat, DVec3, Vec3};
 use serde::Deserialize;
 
+use super::animation::{Animation, Factor, Interpolation, Keys, Trs};
 use super::obj::{
     DEFAULT_AMBIENT, DEFAULT_DISTANCE, DEFAULT_SKY, Loaded, because, framing, load_into,
 };
@@ -121,6 +132,18 @@ struct MeshSpec {
     #[serde(default)]
     translation: Triple,
     material: Option<MaterialSpec>,
+    #[serde(default, rename = "key")]
+    keys: Vec<KeySpec>,
+}
+
+/// A keyframe of a mesh's placement.
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct KeySpec {
+    time: f64,
+    scale: Option<Scale>,
+    rotation: Option<Triple>,
+    translation: Option<Triple>,
 }
 
 #[derive(Deserialize, Clone, Copy, PartialEq)]
@@ -250,23 +273,78 @@ impl Check<'_> {
 
     /// The mesh's placement: scale, then rotation about x, y and z, then translation.
     fn transform(&self, what: &str, mesh: &MeshSpec) -> Result<DAffine3> {
-        let scale = match mesh.scale {
+        let (scale, rotation, translation) =
+            self.trs(what, mesh.scale, mesh.rotation, mesh.translation)?;
+        if scale.abs().min_element() == 0.0 {
+            return self.fail(format!("{what}.scale = {scale}: must be non-zero"));
+        }
+        Ok(DAffine3::from_scale_rotation_translation(
+            scale,
+            rotation,
+            translation,
+        ))
+    }
+
+    /// A scale, a rotation in degrees about x, then y, then z, and a translation, checked.
+    fn trs(
+        &self,
+        what: &str,
+        scale: Scale,
+        rotation: Triple,
+        translation: Triple,
+    ) -> Result<(DVec3, DQuat, DVec3)> {
+        let scale = match scale {
             Scale::Uniform(s) => DVec3::splat(s),
             Scale::Axes(v) => DVec3::from(v),
         };
-        if !scale.is_finite() || scale.abs().min_element() == 0.0 {
-            return self.fail(format!(
-                "{what}.scale = {scale}: must be finite and non-zero"
-            ));
+        if !scale.is_finite() {
+            return self.fail(format!("{what}.scale = {scale}: must be finite"));
         }
-        let r = self.finite(&format!("{what}.rotation"), mesh.rotation)?
-            * (std::f64::consts::PI / 180.0);
+        let r = self.finite(&format!("{what}.rotation"), rotation)? * (PI / 180.0);
         let rotation =
             DMat3::from_rotation_z(r.z) * DMat3::from_rotation_y(r.y) * DMat3::from_rotation_x(r.x);
-        let translation = self.finite(&format!("{what}.translation"), mesh.translation)?;
-        Ok(DAffine3 {
-            matrix3: rotation * DMat3::from_diagonal(scale),
-            translation,
+        let translation = self.finite(&format!("{what}.translation"), translation)?;
+        Ok((scale, DQuat::from_mat3(&rotation), translation))
+    }
+
+    /// The animation a mesh's keys give (each key's missing parts the mesh's own).
+    fn animation(&self, what: &str, mesh: &MeshSpec) -> Result<Animation> {
+        let mut keys = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
+        for (k, key) in mesh.keys.iter().enumerate() {
+            let (scale, rotation, translation) = self.trs(
+                &format!("{what}.key {}", k + 1),
+                key.scale.unwrap_or(mesh.scale),
+                key.rotation.unwrap_or(mesh.rotation),
+                key.translation.unwrap_or(mesh.translation),
+            )?;
+            keys.0.push(key.time);
+            keys.1.push(translation);
+            keys.2.push(rotation);
+            keys.3.push(scale);
+        }
+        let (times, translations, rotations, scales) = keys;
+        let linear = |values| Keys {
+            times: times.clone(),
+            values,
+            interpolation: Interpolation::Linear,
+        };
+        let trs = Trs {
+            translation: DVec3::ZERO,
+            rotation: DQuat::IDENTITY,
+            scale: DVec3::ONE,
+            translation_keys: Some(linear(translations)),
+            rotation_keys: Some(Keys {
+                times: times.clone(),
+                values: rotations,
+                interpolation: Interpolation::Linear,
+            }),
+            scale_keys: Some(linear(scales)),
+        };
+        if let Err(e) = trs.translation_keys.as_ref().map_or(Ok(()), Keys::check) {
+            return self.fail(format!("{what}'s keys: {e}"));
+        }
+        Ok(Animation {
+            factors: vec![Factor::Keyed(trs)],
         })
     }
 }
@@ -363,11 +441,24 @@ pub fn load_scene_file_from(path: &Path, read: ReadFile) -> Result<Loaded> {
         // Its label: as given, else an OBJ's own objects name its parts, else "mesh N".
         let name = mesh.name.clone().unwrap_or_else(|| what.clone());
         b.object(&name, mesh.class.as_deref().unwrap_or(&name));
+        let animation = match mesh.keys.is_empty() {
+            true => None,
+            false => Some(check.animation(&what, mesh)?),
+        };
+        // Placed by `transform`, or moved by its keys.
+        let place = |b: &mut MeshBuilder, id: MeshId| {
+            let placed = match &animation {
+                Some(a) => b.place_moving(id, a.clone()),
+                None => b.place(id, transform),
+            };
+            match placed {
+                true => Ok(()),
+                false => check.fail(format!("{what}: its transform flattens the mesh")),
+            }
+        };
         let kind = file.meshes.iter().position(|m| same(m, mesh)).unwrap_or(i);
         if let Some(id) = shared[kind] {
-            if !b.place(id, transform) {
-                return check.fail(format!("{what}: its transform flattens the mesh"));
-            }
+            place(&mut b, id)?;
             continue;
         }
         let (first, placed) = (b.len(), b.placed_count());
@@ -376,12 +467,20 @@ pub fn load_scene_file_from(path: &Path, read: ReadFile) -> Result<Loaded> {
             warnings.push(format!("{what}: no triangles"));
         }
         let repeated = file.meshes[i + 1..].iter().any(|m| same(m, mesh));
-        if repeated && b.len() > first && b.placed_count() == placed {
+        let own = b.len() > first && b.placed_count() == placed;
+        if own && (repeated || animation.is_some()) {
             let id = b.mesh_since(first);
-            if !b.place(id, transform) {
-                return check.fail(format!("{what}: its transform flattens the mesh"));
+            place(&mut b, id)?;
+            if repeated {
+                shared[kind] = Some(id);
             }
-            shared[kind] = Some(id);
+        } else if animation.is_some() && b.len() > first {
+            return check.fail(format!(
+                "{what}: keys move a mesh stored once, and {} places meshes of its own",
+                mesh.path
+                    .as_ref()
+                    .map_or("it".into(), |p| p.display().to_string())
+            ));
         } else {
             b.transform_since(first, transform);
         }

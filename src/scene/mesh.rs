@@ -4,6 +4,7 @@ use std::f64::consts::{PI, TAU};
 
 use glam::{DAffine3, DVec3, Vec2, Vec3};
 
+use super::animation::Animation;
 use super::{Camera, Instance, Light, Material, Object, Scene, Texture, face_normal};
 
 /// Collects triangles with their materials, normals and UVs, then makes a [`Scene`].
@@ -17,8 +18,10 @@ pub struct MeshBuilder {
     textures: Vec<Texture>,
     /// Meshes for instances: ranges `(first, count)` of the triangles above, in mesh space.
     meshes: Vec<(usize, usize)>,
-    /// Instances: a mesh, its transform to world space and its object's label.
-    placed: Vec<(usize, DAffine3, Option<u32>)>,
+    /// Instances: a mesh, its transform to world space, its object's label and its
+    /// animation (an index into `animations`).
+    placed: Vec<(usize, DAffine3, Option<u32>, Option<u32>)>,
+    animations: Vec<Animation>,
     /// The labels [`MeshBuilder::object`] gave, and the one triangles are added under.
     labels: Vec<Object>,
     label_of: Vec<Option<u32>>,
@@ -58,7 +61,28 @@ impl MeshBuilder {
         if !(transform.is_finite() && det.is_normal() && transform.inverse().is_finite()) {
             return false;
         }
-        self.placed.push((mesh.0, transform, self.current));
+        self.placed.push((mesh.0, transform, self.current, None));
+        true
+    }
+
+    /// Places `mesh` where `animation` puts it at each scene time (at time 0 until a
+    /// renderer asks for another: [`Scene::at`]). Returns false (nothing placed) where a
+    /// placement at one of its key times is not finite. A placement that flattens the mesh at
+    /// some time (a key scaling it to zero, as animations do to hide things) hides it then.
+    pub fn place_moving(&mut self, mesh: MeshId, animation: Animation) -> bool {
+        let times = animation.key_times();
+        if !times
+            .iter()
+            .chain([&0.0])
+            .all(|&t| animation.at(t).is_finite())
+        {
+            return false;
+        }
+        let transform = animation.at(0.0);
+        self.animations.push(animation);
+        let index = self.animations.len() as u32 - 1;
+        self.placed
+            .push((mesh.0, transform, self.current, Some(index)));
         true
     }
 
@@ -109,7 +133,7 @@ impl MeshBuilder {
             .collect();
         self.placed
             .iter()
-            .fold(super::bounds(&world), |acc, &(m, t, _)| {
+            .fold(super::bounds(&world), |acc, &(m, t, _, _)| {
                 let (first, count) = self.meshes[m];
                 super::union(
                     acc,
@@ -140,9 +164,13 @@ impl MeshBuilder {
         let normal_matrix = transform.matrix3.inverse().transpose();
         let mirrored = transform.matrix3.determinant() < 0.0;
         let in_mesh = self.in_meshes(first);
-        for (mesh, placed, _) in &mut self.placed {
+        for (mesh, placed, _, animation) in &mut self.placed {
             if self.meshes[*mesh].0 >= first {
                 *placed = transform * *placed;
+                if let Some(a) = animation {
+                    let factors = &mut self.animations[*a as usize].factors;
+                    factors.insert(0, super::animation::Factor::Fixed(transform));
+                }
             }
         }
         for i in (first..self.triangles.len()).filter(|&i| !in_mesh[i - first]) {
@@ -348,7 +376,7 @@ impl MeshBuilder {
                 None => of_material(self.material_of[i], &mut objects),
             })
             .collect();
-        for &(mesh, transform, label) in &self.placed {
+        for &(mesh, transform, label, animation) in &self.placed {
             let (first, count) = self.meshes[mesh];
             let stored = *mesh_first[mesh].get_or_insert_with(|| {
                 order.extend(first..first + count);
@@ -379,6 +407,7 @@ impl MeshBuilder {
                 count: count as u32,
                 transform,
                 object,
+                animation,
             });
         }
         let normals = self.normals.iter().any(Option::is_some).then(|| {
@@ -415,6 +444,7 @@ impl MeshBuilder {
             framed: None,
             objects,
             object_of,
+            animations: self.animations,
         }
     }
 }

@@ -3,6 +3,7 @@
 //! Positions stay in f64 until upload, where they are made relative to the camera and rounded
 //! to f32 once, so a scene far from the origin renders as it does at the origin.
 
+pub mod animation;
 pub mod builtin;
 pub mod file;
 pub mod gltf;
@@ -188,6 +189,22 @@ pub struct Instance {
     pub transform: DAffine3,
     /// Its object ([`Scene::objects`]): each instance is one of its own.
     pub object: u32,
+    /// Where it moves: an index into [`Scene::animations`] (`transform` is then its placement
+    /// at the time the scene was posed at, [`Scene::at`]).
+    pub animation: Option<u32>,
+}
+
+impl Instance {
+    /// Whether its placement shows its mesh: finite and not flattening it (a moving instance
+    /// scaled to zero is hidden; [`MeshBuilder::place`] refuses such a fixed one).
+    pub fn visible(&self) -> bool {
+        shows(&self.transform)
+    }
+}
+
+/// Whether a placement shows its mesh: finite and not flattening it.
+pub fn shows(transform: &DAffine3) -> bool {
+    transform.is_finite() && transform.matrix3.determinant().is_normal()
 }
 
 /// A labelled object of a scene, for the instance and semantic outputs: its name (a glTF
@@ -266,6 +283,8 @@ pub struct Scene {
     pub objects: Vec<Object>,
     /// The object of each world triangle (the first [`Scene::world_triangles`]).
     pub object_of: Vec<u32>,
+    /// How moving instances move ([`Instance::animation`]).
+    pub animations: Vec<animation::Animation>,
 }
 
 /// The share of the picture a scene's bounding sphere fills when [`Scene::frame_for`] places
@@ -294,6 +313,35 @@ impl Scene {
     /// Whether the scene has no triangles.
     pub fn is_empty(&self) -> bool {
         self.len() == 0
+    }
+
+    /// Whether some instance moves.
+    pub fn moves(&self) -> bool {
+        self.instances.iter().any(|i| i.animation.is_some())
+    }
+
+    /// The scene still at scene time `t` (seconds): each moving instance fixed where its
+    /// animation puts it then (a placement that flattens its mesh hides it: see
+    /// [`Instance::visible`]).
+    pub fn at(&self, t: f64) -> Scene {
+        let mut posed = self.clone();
+        for (instance, transform) in posed.instances.iter_mut().zip(self.placements_at(t)) {
+            instance.transform = transform;
+            instance.animation = None;
+        }
+        posed.animations.clear();
+        posed
+    }
+
+    /// Every instance's placement at scene time `t`.
+    pub fn placements_at(&self, t: f64) -> Vec<DAffine3> {
+        self.instances
+            .iter()
+            .map(|i| match i.animation {
+                Some(a) => self.animations[a as usize].at(t),
+                None => i.transform,
+            })
+            .collect()
     }
 
     /// Whether some mesh is placed by instances.
@@ -440,6 +488,9 @@ impl Scene {
 
     /// The world bounds of `instance` (see [`placed_bounds`]).
     pub fn instance_bounds(&self, instance: &Instance) -> Option<(DVec3, DVec3)> {
+        if !instance.visible() {
+            return None;
+        }
         let mesh = &self.triangles[instance.first as usize..][..instance.count as usize];
         placed_bounds(mesh, instance.transform)
     }
@@ -485,6 +536,7 @@ impl Scene {
             smooth_normals: self.normals.is_some(),
             translucent: used.iter().any(|m| m.opacity < 1.0),
             instanced: self.is_instanced(),
+            moving: self.moves(),
         }
     }
 }
@@ -541,6 +593,8 @@ pub struct Features {
     pub translucent: bool,
     /// Meshes are placed by instances (a two-level BVH).
     pub instanced: bool,
+    /// Some instance moves ([`Scene::moves`]).
+    pub moving: bool,
 }
 
 /// The axis-aligned bounds of some triangles (`None` when there are none).
@@ -553,8 +607,12 @@ pub fn bounds(triangles: &[[DVec3; 3]]) -> Option<(DVec3, DVec3)> {
 /// The box around the transformed bounding box of `mesh` (`None` when empty): bounds a
 /// placed mesh without transforming its triangles.
 pub fn placed_bounds(mesh: &[[DVec3; 3]], transform: DAffine3) -> Option<(DVec3, DVec3)> {
-    let (lo, hi) = bounds(mesh)?;
-    let corners: Vec<[DVec3; 3]> = (0..8)
+    Some(placed_box(bounds(mesh)?, transform))
+}
+
+/// The box around box `(lo, hi)`'s corners moved by `transform`.
+pub fn placed_box((lo, hi): (DVec3, DVec3), transform: DAffine3) -> (DVec3, DVec3) {
+    (0..8)
         .map(|k| {
             let pick = |bit: u32, a: f64, b: f64| if k & bit == 0 { a } else { b };
             let c = DVec3::new(
@@ -562,10 +620,11 @@ pub fn placed_bounds(mesh: &[[DVec3; 3]], transform: DAffine3) -> Option<(DVec3,
                 pick(2, lo.y, hi.y),
                 pick(4, lo.z, hi.z),
             );
-            [transform.transform_point3(c); 3]
+            transform.transform_point3(c)
         })
-        .collect();
-    bounds(&corners)
+        .fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(a, b), p| {
+            (a.min(p), b.max(p))
+        })
 }
 
 /// The union of two optional boxes.

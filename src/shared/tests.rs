@@ -43,6 +43,7 @@ fn gpu_structs_match_their_wgsl_twins() {
             ("id_base", offset_of!(GpuInstance, id_base)),
             ("normal_z", offset_of!(GpuInstance, normal_z)),
             ("first", offset_of!(GpuInstance, first)),
+            ("motion", offset_of!(GpuInstance, motion)),
         ],
     );
     assert_wgsl_layout(

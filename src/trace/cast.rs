@@ -85,6 +85,7 @@ impl RayCast {
             let constants = [
                 ("ANY_HIT", f64::from(u8::from(any_hit))),
                 ("INSTANCED", f64::from(u8::from(scene.features.instanced))),
+                ("MOVING", f64::from(u8::from(scene.features.moving))),
                 ("COUNT_WORK", f64::from(u8::from(counts))),
             ];
             let layout = ctx

@@ -200,6 +200,9 @@ pub struct GpuScene {
     pub bytes: SceneBytes,
     /// The camera-to-world rotation.
     pub(super) frame: Frame,
+    /// Where instances move: their top level, and the buffers [`GpuScene::place_at`] writes
+    /// it to (the nodes' first chunk, the instances).
+    moving: Option<(crate::bvh::TopLevel, wgpu::Buffer, wgpu::Buffer)>,
 }
 
 /// The bytes a scene's buffers take on the device, by what they hold.
@@ -296,12 +299,17 @@ impl GpuScene {
             wgpu::BufferUsages::empty()
         };
         let none = wgpu::BufferUsages::empty();
+        // A moving scene's top level is rewritten at each time.
+        let rewritten = match bvh.top {
+            Some(_) => wgpu::BufferUsages::COPY_DST,
+            None => none,
+        };
         let nodes = chunked_storage(
             ctx,
             "fisheye.scene.bvh_nodes",
             &bvh.nodes,
             &arrays.nodes,
-            none,
+            rewritten,
         )?;
         let triangles = chunked_storage(
             ctx,
@@ -321,7 +329,13 @@ impl GpuScene {
         let lights_buffer = storage(ctx, "fisheye.scene.lights", &lights)?;
         let texture_info = storage(ctx, "fisheye.scene.texture_info", &texture_info)?;
         let texels = storage(ctx, "fisheye.scene.texels", &texels)?;
-        let instances = storage(ctx, "fisheye.scene.instances", &bvh.instances)?;
+        // Room for every instance to show at some time, and for moving ones' knots.
+        let mut instance_data: Vec<[f32; 4]> = bytemuck::cast_slice(&bvh.instances).to_vec();
+        if let Some(top) = &bvh.top {
+            let knots = top.knot_capacity(scene) as u32 * crate::shared::KNOT_VEC4S;
+            instance_data.resize((top.knots_at() + knots) as usize, [0.0; 4]);
+        }
+        let instances = storage_for(ctx, "fisheye.scene.instances", &instance_data, rewritten)?;
         let scene = ctx.checked("uploading the scene", || {
             let device = &ctx.device;
             let uniform = crate::gpu::buffer_init(
@@ -393,11 +407,54 @@ impl GpuScene {
                 bvh_build_time: bvh.build_time,
                 bytes,
                 frame,
+                moving: bvh
+                    .top
+                    .map(|top| (top, nodes[0].clone(), instances.clone())),
             }
         })?;
         // Surfaces a failed acceleration-structure build here rather than at the first frame.
         ctx.wait()?;
         Ok(scene)
+    }
+}
+
+impl GpuScene {
+    /// Places `scene`'s moving instances (the scene this was made from) for the work
+    /// submitted from now on: a frame at scene time `stamp` whose rays span `window` seconds
+    /// from it ([`crate::lens::LensCamera::exposure_span`]; `(0, 0)` for an instant). The top
+    /// level is rebuilt over them and written over the last, with moving instances' knots
+    /// over the window; the meshes' BVHs stay as built. Nothing to do where nothing moves.
+    pub fn place_at(
+        &self,
+        ctx: &GpuContext,
+        scene: &Scene,
+        stamp: f64,
+        window: (f64, f64),
+    ) -> Result<()> {
+        if !scene.moves() {
+            return Ok(());
+        }
+        // Only a scene flattened for ray queries moves without a top level.
+        let Some((top, nodes, instances)) = &self.moving else {
+            return Err(Error::Limit(
+                "moving instances are placed by the BVH traversal; ray queries take the scene \
+                 flattened once (use the software traversal)"
+                    .into(),
+            ));
+        };
+        let built = top.build_over(scene, stamp, window, self.origin)?;
+        ctx.queue
+            .write_buffer(nodes, 0, bytemuck::cast_slice(&built.nodes));
+        if !built.instances.is_empty() {
+            ctx.queue
+                .write_buffer(instances, 0, bytemuck::cast_slice(&built.instances));
+        }
+        if !built.knots.is_empty() {
+            let at = u64::from(top.knots_at()) * 16;
+            ctx.queue
+                .write_buffer(instances, at, bytemuck::cast_slice(&built.knots));
+        }
+        Ok(())
     }
 }
 

@@ -94,7 +94,7 @@ impl RenderOptions {
 
 /// The overrides of `wgsl/surface.wgsl` for a scene's features: code for what the scene does
 /// not use is dead.
-pub fn surface_constants(f: Features) -> [(&'static str, f64); 5] {
+pub fn surface_constants(f: Features) -> [(&'static str, f64); 6] {
     let flag = |b: bool| f64::from(u8::from(b));
     [
         ("HAS_MIRRORS", flag(f.mirrors)),
@@ -102,6 +102,7 @@ pub fn surface_constants(f: Features) -> [(&'static str, f64); 5] {
         ("HAS_TEXTURES", flag(f.textures)),
         ("SMOOTH_NORMALS", flag(f.smooth_normals)),
         ("INSTANCED", flag(f.instanced)),
+        ("MOVING", flag(f.moving)),
     ]
 }
 

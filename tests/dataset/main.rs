@@ -11,6 +11,7 @@ use std::time::{Duration, Instant};
 
 use fisheye_rt::lens::calib::read_rig;
 
+mod objects;
 mod time;
 use glam::{DAffine3, DVec3};
 

@@ -3,6 +3,7 @@
 //! accessor forms, material mappings, lights, cameras, buffer containers, and bad files; and a
 //! glTF twin of an OBJ scene rendering the same triangles on the GPU.
 
+mod animation;
 #[path = "../common/mod.rs"]
 mod common;
 mod files;

@@ -46,6 +46,11 @@ pub(crate) struct RenderArgs {
     /// -16,-11.5,0:0,-9,0`).
     #[arg(long, allow_hyphen_values = true)]
     pub(crate) camera: Option<String>,
+    /// Scene time in seconds: animated glTF nodes and keyed scene-file instances are placed
+    /// where their keys put them then (before their first key, at it; after their last, at
+    /// it).
+    #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
+    pub(crate) time: f64,
     /// How to make the image: `rt` traces the lens's rays directly, `rq` does too with the
     /// adapter's hardware ray queries in place of the software BVH traversal (same lens and
     /// shading code; an error where the adapter lacks them); the `cube-*` methods render
@@ -175,6 +180,34 @@ pub(crate) fn render(args: &RenderArgs) -> Result<()> {
     let out = &args.out;
     let scene_spec = &args.scene;
     let mut scene = load_scene_with(scene_spec, args.gltf_scene)?;
+    if !args.time.is_finite() {
+        bail!("--time {}: a time in seconds must be finite", args.time);
+    }
+    if scene.moves() {
+        let keys: Vec<f64> = scene
+            .animations
+            .iter()
+            .flat_map(|a| a.key_times())
+            .collect();
+        let (first, last) = keys
+            .iter()
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &t| {
+                (a.min(t), b.max(t))
+            });
+        let moving = scene
+            .instances
+            .iter()
+            .filter(|i| i.animation.is_some())
+            .count();
+        println!(
+            "scene time {} s: {moving} moving instances placed (their keys span {first} s to \
+             {last} s)",
+            args.time
+        );
+        scene = scene.at(args.time);
+    } else if args.time != 0.0 {
+        println!("note: nothing in {scene_spec} moves, so --time changes nothing");
+    }
     if let Some(angle) = scene.frame_for(&camera) {
         println!(
             "framed for the lens: the scene's bounding sphere seen under ±{:.1}°, {:.0}% of the \

@@ -66,6 +66,8 @@ impl<'a> Pair<'a> {
             motion: &self.motions[k],
             output: &self.outputs[k],
             directions: &self.directions,
+            time: 0.0,
+            movers: None,
         }
     }
 }
@@ -294,10 +296,10 @@ fn forward_and_backward_flow_agree_where_both_frames_see_the_point() {
             })
     };
     for (i, valid) in forward_valid.iter().enumerate() {
-        let Some((point, _)) = from.hit(i) else {
+        let Some((tracked, _, _)) = from.hit(i) else {
             continue;
         };
-        let Some((pixel, pose)) = to.land(point) else {
+        let Some((pixel, pose, point)) = to.land(&tracked) else {
             continue;
         };
         let ray = point - pose.translation;

@@ -89,8 +89,12 @@ impl Dataset {
                          does not land (.flo: 1e10; kitti: 0, blue 0). flow_valid: 1 where that \
                          frame sees the point there (its range at the nearest pixel within the \
                          spread of a pixel's footprint). scene_flow: metres, how the hit moves \
-                         in the camera's frame by the next frame, NaN where none. The scene is \
-                         still; the last frame has no next (and the first no previous)",
+                         in the camera's frame by the next frame, NaN where none. A hit on a \
+                         moving object moves with it. The last frame has no next (and the \
+                         first no previous)",
+                "objects": "moving objects (glTF animations, scene-file keys) are placed at \
+                            scene time = a ray's time - the trajectory's first stamp; every ray \
+                            sees them at its own time (rolling shutter, exposure)",
             },
             "T_scene_world": rows(&self.scene_from_world),
             "T_body_rig": rows(&self.body_from_rig),

@@ -41,8 +41,10 @@ pub struct Content {
     pub cameras: Vec<Camera>,
 }
 
+use super::animation::NodeKeys;
 use super::uri::{Missing, uri_data};
 use crate::error::{Error, Result};
+use crate::scene::animation::{Animation, Factor, Trs};
 use crate::scene::obj::Dropped;
 use crate::scene::{Camera, Light, Material, MeshBuilder, MeshId, ReadFile, Surface, Texture};
 use glam::{DAffine3, DMat4, DQuat, DVec3, Vec2, Vec3};
@@ -64,6 +66,8 @@ pub(super) struct Loader<'a> {
     pub(super) meshes: HashMap<usize, MeshId>,
     /// Nodes visited so far.
     pub(super) visits: usize,
+    /// The animations' keys, by node.
+    pub(super) keyed: HashMap<usize, NodeKeys>,
     pub(super) content: Content,
     /// Features left out, for one warning each.
     pub(super) ignored: BTreeSet<String>,
@@ -79,11 +83,13 @@ impl Loader<'_> {
     }
 
     /// Adds a node and its children under `parent`'s transform; `ancestors` are the indices
-    /// of the nodes above it, root first.
+    /// of the nodes above it, root first; `moving`, where an animation keys one of them, the
+    /// factors of their placement.
     pub(super) fn node(
         &mut self,
         node: &gltf::Node,
         parent: DMat4,
+        moving: &[Factor],
         ancestors: &mut Vec<usize>,
         b: &mut MeshBuilder,
     ) -> Result<()> {
@@ -139,7 +145,50 @@ impl Loader<'_> {
                 node.index()
             )));
         }
-        let affine = DAffine3::from_mat4(world);
+        // Where it or a node above it is animated: its placement's factors (the still part
+        // above the first keyed node in one), and its placement at time 0.
+        let mut factors = moving.to_vec();
+        if let Some(keys) = self.keyed.get(&node.index()) {
+            let gltf::scene::Transform::Decomposed {
+                translation,
+                rotation,
+                scale,
+            } = node.transform()
+            else {
+                return Err(self.fail(format!(
+                    "nodes[{}]: an animation keys it, and its transform is a matrix (glTF \
+                     animates nodes given by translation, rotation and scale)",
+                    node.index()
+                )));
+            };
+            if factors.is_empty() {
+                factors.push(Factor::Fixed(DAffine3::from_mat4(parent)));
+            }
+            let [x, y, z, w] = rotation.map(f64::from);
+            factors.push(Factor::Keyed(Trs {
+                translation: Vec3::from(translation).as_dvec3(),
+                rotation: DQuat::from_xyzw(x, y, z, w).normalize(),
+                scale: Vec3::from(scale).as_dvec3(),
+                translation_keys: keys.translation.clone(),
+                rotation_keys: keys.rotation.clone(),
+                scale_keys: keys.scale.clone(),
+            }));
+        } else if !factors.is_empty() {
+            factors.push(Factor::Fixed(DAffine3::from_mat4(local)));
+        }
+        let animation = (!factors.is_empty()).then(|| Animation {
+            factors: factors.clone(),
+        });
+        let affine = match &animation {
+            Some(a) => a.at(0.0),
+            None => DAffine3::from_mat4(world),
+        };
+        if !affine.is_finite() {
+            return Err(self.fail(format!(
+                "nodes[{}]: its animated transform at time 0 is not finite",
+                node.index()
+            )));
+        }
         if let Some(mesh) = node.mesh() {
             // Its label: the node's name, and the class its extras (or its mesh's) give,
             // else the mesh's name.
@@ -154,7 +203,9 @@ impl Loader<'_> {
             if node.skin().is_some() {
                 self.ignored.insert("skins".into());
             }
-            if self.uses.get(&mesh.index()).is_some_and(|&n| n > 1) {
+            // A mesh that moves, or that several nodes use, is stored once in its own space.
+            let shared = self.uses.get(&mesh.index()).is_some_and(|&n| n > 1);
+            if shared || animation.is_some() {
                 let id = match self.meshes.get(&mesh.index()) {
                     Some(&id) => id,
                     None => {
@@ -165,13 +216,24 @@ impl Loader<'_> {
                         id
                     }
                 };
-                if !b.place(id, affine) {
+                let placed = match &animation {
+                    Some(a) => b.place_moving(id, a.clone()),
+                    None => b.place(id, affine),
+                };
+                if !placed {
                     self.ignored
                         .insert("nodes whose transform flattens a shared mesh".into());
                 }
             } else {
                 self.mesh(&mesh, affine, b)?;
             }
+        }
+        if animation.is_some() && (node.light().is_some() || node.camera().is_some()) {
+            self.ignored.insert(
+                "the motion of animated lights and cameras (they stay where they are at time \
+                 0)"
+                .into(),
+            );
         }
         if let Some(light) = node.light() {
             self.light(&light, affine);
@@ -190,7 +252,7 @@ impl Loader<'_> {
         }
         ancestors.push(node.index());
         for child in node.children() {
-            self.node(&child, world, ancestors, b)?;
+            self.node(&child, world, &factors, ancestors, b)?;
         }
         ancestors.pop();
         Ok(())

@@ -1,8 +1,8 @@
 //! glTF 2.0 scenes (`.gltf` with external or embedded buffers, `.glb`) through the `gltf`
 //! crate's document model and validation. Buffers and images are read here, through the
 //! loader's `read` (so within the input budgets). A mesh that one node uses is placed in world
-//! space; a mesh that several nodes use is stored once, in its own space, and each node places
-//! an instance of it (see [`crate::scene::Instance`]).
+//! space; a mesh that several nodes use, or that an animation moves, is stored once, in its
+//! own space, and each node places an instance of it (see [`crate::scene::Instance`]).
 //!
 //! What maps to what (the README's table says the same):
 //! - the default scene (or the one asked for), its node hierarchy with TRS or matrix transforms;
@@ -19,9 +19,13 @@
 //! - `KHR_lights_punctual`: point lights (candela / 683 lm/W as W/sr), directional (lux / 683 as
 //!   W/m²), spot lights as points without their cone (warned);
 //! - camera nodes: their poses (looking down the node's -z, up its +y), for `--camera gltf:N`;
-//! - anything else (animations, skins, morph targets, other textures, other extensions, sampler
-//!   modes other than repeat and linear) is left out with one warning per feature.
+//! - animations' translation, rotation and scale channels (step, linear, cubic spline): a
+//!   mesh under a keyed node is placed by a moving instance ([`crate::scene::animation`]);
+//! - anything else (morph-target weights, skins, morph targets, other textures, other
+//!   extensions, sampler modes other than repeat and linear) is left out with one warning per
+//!   feature.
 
+mod animation;
 mod loader;
 mod uri;
 
@@ -134,9 +138,7 @@ pub fn load_into(
         })
         .collect::<Result<_>>()?;
     let mut ignored = BTreeSet::new();
-    if document.animations().next().is_some() {
-        ignored.insert("animations".to_string());
-    }
+    let keyed = animation::read(document, &buffers, &mut ignored).map_err(fail)?;
     if document.skins().next().is_some() {
         ignored.insert("skins".to_string());
     }
@@ -171,6 +173,7 @@ pub fn load_into(
         uses,
         meshes: HashMap::new(),
         visits: 0,
+        keyed,
         materials: HashMap::new(),
         textures: HashMap::new(),
         content: Content {
@@ -181,7 +184,7 @@ pub fn load_into(
         warnings,
     };
     for node in chosen.nodes() {
-        loader.node(&node, DMat4::IDENTITY, &mut Vec::new(), b)?;
+        loader.node(&node, DMat4::IDENTITY, &[], &mut Vec::new(), b)?;
     }
     let Loader {
         ignored,
