@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
 # Re-makes the pictures of the README and the book (docs/src/images/): three renders, an
 # adaptive render beside its spp map, three renders through lens prescriptions, a moving
-# camera's frames (instant, rolling shutter, motion blur, flow), the speed-against-error plot
-# of results/lavapipe/, and the strip the README opens with. Run from
+# camera's frames (instant, rolling shutter, motion blur, flow), a moving object's, the
+# speed-against-error plot of results/lavapipe/, and the strip the README opens with. Run from
 # anywhere after `cargo build --release`; about a minute on lavapipe. Needs python3 with
 # Pillow (`.ci/install-lavapipe` installs it). Each picture is kept under 300 KB.
 set -euo pipefail
@@ -59,6 +59,37 @@ row.quantize(colors=256, method=Image.Quantize.MEDIANCUT, dither=Image.Dither.FL
 )
 PY
 rm -f "$out"/glass-fit.png "$out"/glass-fisheye.png "$out"/glass-dgauss.png
+# Three frames (instant, rolling, blur) and the instant's optical flow (hue: direction,
+# saturation: length; grey where the next frame does not see the point), side by side:
+# python3 "$row_py" PICTURE SETS FRAME.
+row_py=$(mktemp)
+cat > "$row_py" <<'PY'
+import colorsys, sys
+import numpy as np
+from PIL import Image
+
+path, sets, frame = sys.argv[1], sys.argv[2], sys.argv[3]
+tiles = [Image.open(f"{sets}/{n}/{frame}.png").convert("RGB") for n in ("instant", "rolling", "blur")]
+flow = np.load(f"{sets}/instant/{frame}.flow.npy")
+valid = np.load(f"{sets}/instant/{frame}.flow_valid.npy").astype(bool)
+u, v = np.nan_to_num(flow[..., 0]), np.nan_to_num(flow[..., 1])
+length = np.hypot(u, v)
+hue = (np.arctan2(v, u) / (2 * np.pi)) % 1.0
+sat = np.clip(length / max(np.percentile(length[valid], 99), 1e-9), 0, 1)
+rgb = np.array([colorsys.hsv_to_rgb(h, s, 1.0) for h, s in zip(hue.ravel(), sat.ravel())])
+rgb = rgb.reshape(flow.shape[:2] + (3,))
+rgb[~valid] = 0.5
+tiles.append(Image.fromarray((rgb * 255).round().astype(np.uint8)))
+row = Image.new("RGB", (sum(t.width for t in tiles) + 8 * (len(tiles) - 1), 300), "white")
+x = 0
+for t in tiles:
+    row.paste(t, (x, 0))
+    x += t.width + 8
+row = row.resize((row.width // 2, 150), Image.LANCZOS)
+row.quantize(colors=256, method=Image.Quantize.MEDIANCUT, dither=Image.Dither.FLOYDSTEINBERG).save(
+    path, optimize=True
+)
+PY
 # Time in the camera: the room through the Samyang turning 6 rad/s about the vertical while
 # sliding 3 m/s to the side: the frame at an instant, read by a rolling shutter (0.5 ms a
 # line: verticals lean), exposed for 15 ms (motion blur), and its optical flow to the next
@@ -82,35 +113,22 @@ for setup in "instant:--spp 4" "rolling:--spp 4 --line-delay 0.0005" "blur:--spp
   "$fisheye" dataset render --trajectory "$time_dir/yaw.tum" --lens samyang-7.5mm \
     --size 400x300 ${setup#*:} --outputs flow -o "$time_dir/$name" > /dev/null 2>&1
 done
-python3 - "$out" "$time_dir" <<'PY'
-import colorsys, sys
-import numpy as np
-from PIL import Image
-
-out, sets = sys.argv[1], sys.argv[2]
-frame = "cam0/000002_0.10"
-tiles = [Image.open(f"{sets}/{n}/{frame}.png").convert("RGB") for n in ("instant", "rolling", "blur")]
-flow = np.load(f"{sets}/instant/{frame}.flow.npy")
-valid = np.load(f"{sets}/instant/{frame}.flow_valid.npy").astype(bool)
-u, v = np.nan_to_num(flow[..., 0]), np.nan_to_num(flow[..., 1])
-length = np.hypot(u, v)
-hue = (np.arctan2(v, u) / (2 * np.pi)) % 1.0
-sat = np.clip(length / max(np.percentile(length[valid], 99), 1e-9), 0, 1)
-rgb = np.array([colorsys.hsv_to_rgb(h, s, 1.0) for h, s in zip(hue.ravel(), sat.ravel())])
-rgb = rgb.reshape(flow.shape[:2] + (3,))
-rgb[~valid] = 0.5
-tiles.append(Image.fromarray((rgb * 255).round().astype(np.uint8)))
-row = Image.new("RGB", (sum(t.width for t in tiles) + 8 * (len(tiles) - 1), 300), "white")
-x = 0
-for t in tiles:
-    row.paste(t, (x, 0))
-    x += t.width + 8
-row = row.resize((row.width // 2, 150), Image.LANCZOS)
-row.quantize(colors=256, method=Image.Quantize.MEDIANCUT, dither=Image.Dither.FLOYDSTEINBERG).save(
-    f"{out}/time.png", optimize=True
-)
-PY
+python3 "$row_py" "$out/time.png" "$time_dir" cam0/000002_0.10
 rm -rf "$time_dir"
+# Moving objects: scenes/dataset/sliding.toml's box sliding 2 m/s and turning 90°/s past a
+# still camera, at 0.5 s: an instant, a rolling shutter (1 ms a line: the box leans), a
+# 0.1 s exposure (it blurs), and the instant's flow (the box's own motion), side by side.
+moving_dir=$(mktemp -d)
+printf '0 0 0 0 0 0 0 1\n1 0 0 0 0 0 0 1\n' > "$moving_dir/still.tum"
+for setup in "instant:--spp 4" "rolling:--spp 4 --line-delay 0.001" "blur:--spp 16 --exposure-time 0.1"; do
+  name=${setup%%:*}
+  # shellcheck disable=SC2086
+  "$fisheye" dataset render scenes/dataset/sliding.toml --trajectory "$moving_dir/still.tum" \
+    --lens rectilinear:f=1.2 --size 400x300 --frame-rate 4 ${setup#*:} --outputs flow \
+    -o "$moving_dir/$name" > /dev/null 2>&1
+done
+python3 "$row_py" "$out/moving.png" "$moving_dir" cam0/000002_0.500000
+rm -rf "$moving_dir" "$row_py"
 python3 - "$out" <<'PY'
 import sys
 from PIL import Image

@@ -167,3 +167,68 @@ fn bad_animations_name_the_channel() {
         }
     }
 }
+
+/// Rendered on the GPU at 0.5 s, a cube keyed to slide (linear) and turn (slerp) over 2 s is
+/// where a still copy of the file with the node's translation and rotation worked out by hand
+/// puts it: the same ids but for pixels on id edges (an instance's f32 maps against world
+/// triangles), and not those of time 0.
+#[test]
+fn an_animated_gltf_renders_where_a_still_copy_at_that_time_does() {
+    use fisheye_rt::scene::Camera;
+    let dir = temp_dir("animated-render");
+    let write = |cube_node: Value, animated: bool| {
+        let mut doc = Doc::default();
+        let (cube, floor) = doc.cube_and_floor(None);
+        let mut roots = vec![doc.node(json!({"mesh": floor}))];
+        let mut node = cube_node;
+        node["mesh"] = json!(cube);
+        roots.push(doc.node(node));
+        if animated {
+            let times = doc.floats(&[0.0, 2.0], "SCALAR", 2);
+            let moves = doc.floats(&[-2.0, 0.0, -5.0, 2.0, 0.0, -5.0], "VEC3", 2);
+            let s = std::f32::consts::FRAC_1_SQRT_2;
+            let turns = doc.floats(&[0.0, 0.0, 0.0, 1.0, 0.0, s, 0.0, s], "VEC4", 2);
+            doc.extra.insert(
+                "animations".into(),
+                json!([{"samplers": [{"input": times, "output": moves},
+                                     {"input": times, "output": turns}],
+                    "channels": [
+                        {"sampler": 0, "target": {"node": roots[1], "path": "translation"}},
+                        {"sampler": 1, "target": {"node": roots[1], "path": "rotation"}}]}]),
+            );
+        }
+        let name = if animated { "animated" } else { "still" };
+        let mut scene = load_gltf(&doc.write_glb(&dir, name, &roots), None)
+            .unwrap_or_else(|e| panic!("{e}"))
+            .scene;
+        scene.set_camera(Camera {
+            position: DVec3::new(0.0, 2.0, 1.0),
+            look_at: DVec3::new(0.0, 0.0, -5.0),
+            up: DVec3::Y,
+        });
+        scene
+    };
+    let animated = write(json!({}), true);
+    // At 0.5 s: a quarter of the way, x = -1, turned 22.5° about y.
+    let turn = DQuat::from_rotation_y(22.5f64.to_radians());
+    let still = write(
+        json!({"translation": [-1.0, 0.0, -5.0],
+               "rotation": [turn.x, turn.y, turn.z, turn.w]}),
+        false,
+    );
+    let cam = common::camera("equidistant:f=0.5,fov=180", 96, 72);
+    let options = RenderOptions::default();
+    let ids = |scene: &fisheye_rt::scene::Scene| {
+        render(common::ctx(), scene, &cam, &options).unwrap().ids
+    };
+    let (moved, held, start) = (ids(&animated.at(0.5)), ids(&still), ids(&animated.at(0.0)));
+    let mut edges = 0;
+    for i in 0..moved.len() {
+        if moved[i] != held[i] {
+            assert!(common::on_id_edge(&held, cam.size, i), "pixel {i}");
+            edges += 1;
+        }
+    }
+    assert!(edges <= 4, "{edges} pixels differ");
+    assert!(moved.iter().zip(&start).filter(|(a, b)| a != b).count() > 20);
+}
