@@ -72,7 +72,7 @@ fn render_at_a_time_places_keyed_meshes() {
 /// through the lens (to 1e-3 px; a rolling shutter reads a point moving along x on the same
 /// line, so its landing is a frame later either way), its scene flow is (0.4, 0, 0); the
 /// backdrop's flow is zero, and it is valid except where the box covers it in the next frame
-/// (all but edge pixels).
+/// (all but edge pixels). Two shards write the bytes one process writes.
 #[test]
 fn flow_follows_moving_objects() {
     let dir = temp_dir("objects");
@@ -87,19 +87,30 @@ fn flow_follows_moving_objects() {
     );
     for delay in ["0", "0.002"] {
         let out = dir.join(format!("set-{delay}"));
-        succeed(
-            fisheye()
-                .args([
-                    "dataset", "render", "--lens", spec, "--size", "32x24", "--spp", "1",
-                ])
-                .args(["--frame-rate", "5", "--line-delay", delay])
-                .args(["--outputs", "flow,scene-flow,range,id"])
-                .arg("--trajectory")
-                .arg(&trajectory)
-                .arg("-o")
-                .arg(&out)
-                .arg(&scene),
-        );
+        let render = |out: &Path, shard: &str| {
+            succeed(
+                fisheye()
+                    .args([
+                        "dataset", "render", "--lens", spec, "--size", "32x24", "--spp", "1",
+                    ])
+                    .args(["--frame-rate", "5", "--line-delay", delay, "--shard", shard])
+                    .args(["--outputs", "flow,scene-flow,range,id"])
+                    .arg("--trajectory")
+                    .arg(&trajectory)
+                    .arg("-o")
+                    .arg(out)
+                    .arg(&scene),
+            );
+        };
+        render(&out, "0/1");
+        if delay != "0" {
+            // Shards place the objects at each of their frames' times as one process does.
+            let sharded = dir.join("sharded");
+            render(&sharded, "0/2");
+            render(&sharded, "1/2");
+            succeed(fisheye().args(["dataset", "merge"]).arg(&sharded));
+            assert_eq!(files(&out), files(&sharded));
+        }
         let read = |stem: &str, name: &str| -> Vec<u8> {
             std::fs::read(out.join("cam0").join(format!("{stem}.{name}.npy"))).unwrap()
         };
