@@ -92,10 +92,10 @@ pub fn sweep(
     origin: DVec3,
 ) -> Swept {
     let times = knot_times(animation, stamp, window);
-    let decomposed: Vec<Option<Polar>> = times
+    let sampled: Vec<DAffine3> = times.iter().map(|&t| animation.at(stamp + t)).collect();
+    let decomposed: Vec<Option<Polar>> = sampled
         .iter()
-        .map(|&t| {
-            let m = animation.at(stamp + t);
+        .map(|m| {
             polar(m.matrix3).map(|(rotation, stretch)| Polar {
                 rotation,
                 stretch,
@@ -107,14 +107,13 @@ pub fn sweep(
     // rotation with no extent: the mesh shrinks to it and hides there.
     let fallback = decomposed.iter().flatten().next().copied();
     let mut last = fallback;
-    let placements: Vec<Option<Polar>> = times
+    let placements: Vec<Option<Polar>> = sampled
         .iter()
         .zip(&decomposed)
-        .map(|(&t, d)| {
+        .map(|(m, d)| {
             if d.is_some() {
                 last = *d;
             }
-            let m = animation.at(stamp + t);
             d.or_else(|| {
                 last.map(|l| Polar {
                     rotation: l.rotation,

@@ -23,33 +23,27 @@ use crate::trace::{Motion, RenderOutput};
 /// A scene's moving instances, by the scene triangles (ids) they hold.
 pub struct Movers<'a> {
     scene: &'a Scene,
-    /// Each instance's first scene triangle id.
-    bases: Vec<u32>,
+    /// Each instance's first scene triangle id ([`Scene::instance_starts`]).
+    starts: Vec<u64>,
 }
 
 impl<'a> Movers<'a> {
     /// `scene`'s moving instances; `None` where nothing moves.
     pub fn new(scene: &'a Scene) -> Option<Self> {
-        scene.moves().then(|| {
-            let mut next = scene.world_triangles as u32;
-            let bases = scene
-                .instances
-                .iter()
-                .map(|i| {
-                    next += i.count;
-                    next - i.count
-                })
-                .collect();
-            Movers { scene, bases }
+        scene.moves().then(|| Movers {
+            scene,
+            starts: scene.instance_starts(),
         })
     }
 
     /// The animation moving scene triangle `id`, if it moves.
     fn animation(&self, id: u32) -> Option<&'a Animation> {
-        let k = self.bases.partition_point(|&b| b <= id).checked_sub(1)?;
+        let id = u64::from(id);
+        let k = self.starts.partition_point(|&s| s <= id).checked_sub(1)?;
         let instance = &self.scene.instances[k];
         let animation = instance.animation?;
-        (id < self.bases[k] + instance.count).then(|| &self.scene.animations[animation as usize])
+        let inside = id < self.starts[k] + u64::from(instance.count);
+        inside.then(|| &self.scene.animations[animation as usize])
     }
 }
 

@@ -471,6 +471,11 @@ impl Dataset {
             });
             let rendered = (|| -> Result<()> {
                 let mut done = 0;
+                // Every ray of a frame's cameras is within this of its stamp.
+                let window = lens_cameras
+                    .iter()
+                    .map(LensCamera::exposure_span)
+                    .fold((0.0f64, 0.0f64), |(a, b), (lo, hi)| (a.min(lo), b.max(hi)));
                 for &(p, wanted) in frames {
                     let poses: Vec<crate::scene::Camera> = (0..self.cameras.len())
                         .map(|c| camera_from_transform(&self.scene_from_camera(p, c)))
@@ -488,11 +493,6 @@ impl Dataset {
                         })
                         .collect();
                     let mut outputs = Vec::with_capacity(passes.len());
-                    // Every ray of the frame's cameras is within this of its stamp.
-                    let window = lens_cameras
-                        .iter()
-                        .map(LensCamera::exposure_span)
-                        .fold((0.0f64, 0.0f64), |(a, b), (lo, hi)| (a.min(lo), b.max(hi)));
                     gpu_scene.place_at(ctx, &scene, self.scene_time(p), window)?;
                     for group in groups {
                         let t = Instant::now();

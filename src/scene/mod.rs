@@ -410,16 +410,7 @@ impl Scene {
     /// The object ([`Scene::objects`]) of each scene triangle id (as the `id` output gives
     /// them), [`NO_OBJECT`] for a miss.
     pub fn objects_of(&self, ids: &[u32]) -> Vec<u32> {
-        // Where each instance's scene triangles start, after the world's.
-        let starts: Vec<u64> = self
-            .instances
-            .iter()
-            .scan(self.world_triangles as u64, |next, i| {
-                let start = *next;
-                *next += u64::from(i.count);
-                Some(start)
-            })
-            .collect();
+        let starts = self.instance_starts();
         ids.iter()
             .map(|&id| match id {
                 crate::shared::NO_HIT => NO_OBJECT,
@@ -428,6 +419,19 @@ impl Scene {
                     let k = starts.partition_point(|&s| s <= u64::from(id)) - 1;
                     self.instances[k].object
                 }
+            })
+            .collect()
+    }
+
+    /// The scene triangle id each instance's triangles start at, after the world's: instance
+    /// `k` holds ids `starts[k]..starts[k] + count`.
+    pub fn instance_starts(&self) -> Vec<u64> {
+        self.instances
+            .iter()
+            .scan(self.world_triangles as u64, |next, i| {
+                let start = *next;
+                *next += u64::from(i.count);
+                Some(start)
             })
             .collect()
     }
