@@ -2,15 +2,17 @@
 //! 2017) on the CPU; we flatten it and the triangles, camera-relative in f32, into the storage
 //! buffers `wgsl/bvh.wgsl` traverses.
 
-use std::time::{Duration, Instant};
+use std::time::Duration;
 
 use bytemuck::Zeroable;
 use glam::{DAffine3, DMat3, DVec3, Vec3A};
 use obvhs::BvhBuildParams;
 use obvhs::cwbvh::node::CwBvhNode;
 
+use crate::clock::Stopwatch;
 use crate::error::{Error, Result};
 use crate::scene::Scene;
+mod stages;
 mod sweep;
 
 pub use crate::shared::{GpuInstance, GpuTriangle, TRAVERSAL_STACK};
@@ -192,14 +194,13 @@ fn check_extent(points: impl Iterator<Item = Vec3A>) -> Result<()> {
     Ok(())
 }
 
-/// Runs obvhs's `build`, adding its time to `build_time`, and checks the BVH's depth.
+/// Runs `build`, adding its time to `build_time`, and checks the BVH's depth.
 fn build_level(
-    build: impl FnOnce(&mut Duration) -> obvhs::cwbvh::CwBvh,
+    build: impl FnOnce() -> obvhs::cwbvh::CwBvh,
     build_time: &mut Duration,
 ) -> Result<(Vec<CwBvhNode>, Vec<u32>, u32)> {
-    let started = Instant::now();
-    let mut core = Duration::ZERO;
-    let cwbvh = build(&mut core);
+    let started = Stopwatch::start();
+    let cwbvh = build();
     *build_time += started.elapsed();
     let depth = node_depth(&cwbvh.nodes, 0);
     if depth > TRAVERSAL_STACK {
@@ -228,7 +229,7 @@ fn triangle_level(
         .collect();
     // From triangles, so that the slow preset's spatial pre-splits apply.
     let (nodes, order, depth) = build_level(
-        |core| obvhs::cwbvh::builder::build_cwbvh_from_tris(&tris, quality.params(), core),
+        || stages::over_triangles(&tris, quality.params()),
         build_time,
     )?;
     let leaves = order
@@ -529,7 +530,7 @@ impl TopLevel {
             });
         }
         let (top, order, depth) = build_level(
-            |core| obvhs::cwbvh::builder::build_cwbvh(&boxes, self.quality.params(), core),
+            || stages::over_boxes(&boxes, self.quality.params()),
             &mut build_time,
         )?;
         if self.reserved > 0 && top.len() > self.reserved {

@@ -47,6 +47,7 @@
 #![warn(missing_docs)]
 
 pub mod bvh;
+mod clock;
 pub mod cube;
 pub mod dataset;
 mod error;

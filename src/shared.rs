@@ -17,9 +17,10 @@ pub const WORKGROUP_1D: u32 = 64;
 pub const TRAVERSAL_STACK: u32 = 32;
 
 /// Storage buffers the trace kernel binds: the direction table and three outputs (group 0),
-/// and the scene's eight (group 1). wgpu's default limit is 8, so a device made for the tracer
-/// must ask for more (`renderer::required_limits`).
-pub const TRACE_STORAGE_BUFFERS: u32 = 12;
+/// and the scene's six (group 1: nodes, triangles, lights and materials, shading vertices,
+/// textures, instances). wgpu's default limit is 8, so a device made for the tracer must ask
+/// for more (`renderer::required_limits`); browsers' adapters mostly offer 10.
+pub const TRACE_STORAGE_BUFFERS: u32 = 10;
 
 /// Storage buffers the adaptive kernels bind beyond the trace kernel's: the per-pixel state
 /// and the work list (`trace::AdaptivePass`).
@@ -306,6 +307,8 @@ pub fn wgsl_constants() -> Vec<(String, u32)> {
         ("MAX_KNOTS", MAX_KNOTS as u32),
         ("INSTANCE_VEC4S", INSTANCE_VEC4S),
         ("KNOT_VEC4S", KNOT_VEC4S),
+        ("LIGHT_VEC4S", LIGHT_VEC4S),
+        ("MATERIAL_VEC4S", MATERIAL_VEC4S),
         ("ADAPTIVE_HEADER", ADAPTIVE_HEADER),
         ("ADAPTIVE_COUNT", ADAPTIVE_COUNT),
         ("ADAPTIVE_ESTIMATE_SIDE", ADAPTIVE_ESTIMATE_SIDE),
@@ -328,7 +331,14 @@ pub fn wgsl_constants() -> Vec<(String, u32)> {
     out
 }
 
-/// A material as `wgsl/shade.wgsl` reads it (80 bytes).
+/// The `vec4`s of a [`GpuLight`] in the scene's surface buffer (lights, then materials).
+pub const LIGHT_VEC4S: u32 = 2;
+/// The `vec4`s of a [`GpuMaterial`] in the scene's surface buffer.
+pub const MATERIAL_VEC4S: u32 = 5;
+const _: () = assert!(std::mem::size_of::<GpuLight>() == 16 * LIGHT_VEC4S as usize);
+const _: () = assert!(std::mem::size_of::<GpuMaterial>() == 16 * MATERIAL_VEC4S as usize);
+
+/// A material as `wgsl/surface.wgsl`'s `material_at` reads it (80 bytes).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, PartialEq, Pod, Zeroable)]
 pub struct GpuMaterial {
@@ -346,15 +356,19 @@ pub struct GpuMaterial {
     pub ior: f32,
     /// `Tf`.
     pub transmission: [f32; 3],
-    /// Texture index or [`NO_TEXTURE`].
+    /// The diffuse texture's first texel in the scene's texels, or [`NO_TEXTURE`].
     pub texture: u32,
     /// `d`.
     pub opacity: f32,
+    /// The texture's width in texels (0 without).
+    pub texture_width: u32,
+    /// Its height.
+    pub texture_height: u32,
     /// Padding.
-    pub pad: [u32; 3],
+    pub pad: u32,
 }
 
-/// A light as `wgsl/shade.wgsl` reads it (32 bytes).
+/// A light as `wgsl/surface.wgsl`'s `light_at` reads it (32 bytes).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, PartialEq, Pod, Zeroable)]
 pub struct GpuLight {

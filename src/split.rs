@@ -19,8 +19,8 @@ pub const TRIANGLE_BYTES: u64 = 48;
 pub const VERTEX_BYTES: u64 = 16;
 
 /// Where the bindings beyond each array's first begin in group 1 (the scene's group): its
-/// fixed bindings are 0 to 8 (see `trace::GpuScene`).
-pub const FIRST_EXTRA_BINDING: u32 = 9;
+/// fixed bindings are 0 to 6 (see `trace::GpuScene`).
+pub const FIRST_EXTRA_BINDING: u32 = 7;
 
 /// How one array is stored: in `chunks` bindings of `1 << shift` elements each (the last one
 /// shorter). One chunk holds the whole array, whatever its length.
@@ -98,7 +98,7 @@ const ARRAYS: [(&str, &str); 3] = [
 
 /// The first binding of each array (its chunk 0), as `wgsl/bvh.wgsl` and `wgsl/surface.wgsl`
 /// numbered them before they were split.
-const FIRST_BINDINGS: [u32; 3] = [0, 1, 4];
+const FIRST_BINDINGS: [u32; 3] = [0, 1, 3];
 
 impl SceneArrays {
     /// The split of a scene with `nodes` BVH nodes, `triangles` stored triangles and
@@ -238,7 +238,7 @@ mod tests {
         assert_eq!(arrays.extra_bindings(), 6);
         assert_eq!(
             arrays.bindings(),
-            [vec![0, 9, 10, 11], vec![1, 12, 13, 14], vec![4]]
+            [vec![0, 7, 8, 9], vec![1, 10, 11, 12], vec![3]]
         );
     }
 

@@ -82,7 +82,7 @@ fn through_glass(pixel: vec2<u32>, index: u32) -> vec3<f32> {
                 let ray = placed_ray(at, s.origin, s.direction);
                 let radiance = s.weight * shade(ray).colour;
                 // Channel c's part alone, or every channel without dispersion.
-                let part = vec3<u32>(0u, 1u, 2u) == vec3<u32>(c) | vec3<bool>(GLASS_CHANNELS == 1u);
+                let part = (vec3<u32>(0u, 1u, 2u) == vec3<u32>(c)) | vec3<bool>(GLASS_CHANNELS == 1u);
                 sum += select(vec3<f32>(0.0), radiance, part);
             }
         }

@@ -126,11 +126,12 @@ fn raster_shade(slot: u32, bary: vec2<f32>, world: vec3<f32>) -> vec3<f32> {
     }
     colour += s.material.diffuse * shading.ambient;
     for (var i = 0u; i < shading.light_count; i++) {
-        let light = incident(s, s.position, lights[i]);
+        let l = light_at(i);
+        let light = incident(s, s.position, l);
         if !light.lit {
             continue;
         }
-        let visible = shadow_visibility(lights[i], s, light.to_light);
+        let visible = shadow_visibility(l, s, light.to_light);
         if visible > 0.0 {
             colour += reflected(s, dir, light, visible);
         }

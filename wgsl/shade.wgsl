@@ -45,7 +45,7 @@ fn shadow_transmittance(origin: vec3<f32>, to_light: vec3<f32>, distance: f32) -
             return transmittance;
         }
         let tri = triangle_at(hit.slot);
-        let m = materials[tri.material];
+        let m = material_at(tri.material);
         transmittance *= 1.0 - m.opacity;
         if m.surface != SURFACE_DIFFUSE || transmittance < MIN_WEIGHT || layer == MAX_SHADOW_LAYERS {
             return 0.0;
@@ -62,7 +62,7 @@ fn direct_light(s: Surface, view: vec3<f32>) -> vec3<f32> {
     var colour = s.material.diffuse * shading.ambient;
     let origin = offset_origin(s.position, s.geometric);
     for (var i = 0u; i < shading.light_count; i++) {
-        let light = incident(s, origin, lights[i]);
+        let light = incident(s, origin, light_at(i));
         if !light.lit {
             continue;
         }

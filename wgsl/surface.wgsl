@@ -13,11 +13,13 @@ struct Material {
     emission: vec3<f32>,
     ior: f32,
     transmission: vec3<f32>,
-    // Index into texture_info, NO_TEXTURE if none.
+    // The diffuse texture's first texel in `texels`, NO_TEXTURE if none.
     texture: u32,
     // The fraction of light a diffuse surface stops (MTL `d`); the rest passes straight on.
     opacity: f32,
-    pad: array<u32, 3>,
+    texture_width: u32,
+    texture_height: u32,
+    pad: u32,
 }
 
 // Mirrors `fisheye_rt::trace::GpuLight` (32 bytes): a point light (position) or a directional
@@ -41,16 +43,34 @@ struct Shading {
     max_depth: u32,
 }
 
-@group(1) @binding(2) var<storage, read> materials: array<Material>;
-@group(1) @binding(3) var<storage, read> lights: array<Light>;
+// The scene's lights (`shading.light_count` of LIGHT_VEC4S vec4s each), then its materials
+// (MATERIAL_VEC4S each), laid out as `Light` and `Material`: one binding for both, so that the
+// trace kernel fits the storage buffers a browser gives a stage. Read as words, the floats
+// bitcast, so no float load can touch the bits of a u32 field.
+@group(1) @binding(2) var<storage, read> surfaces: array<vec4<u32>>;
 // Per scene triangle: three vertex normals (xyz) when SMOOTH_NORMALS, then three UV pairs
 // packed in two vec4 when TEXTURES; see `fisheye_rt::trace::shading_vertices`. `vertex_at`
-// reads them from `vertex_data` (group 1, binding 4) and its further chunks, if any.
-// Per texture: first texel, width, height, unused.
-@group(1) @binding(5) var<storage, read> texture_info: array<vec4<u32>>;
-// RGBA8 sRGB texels of every texture.
-@group(1) @binding(6) var<storage, read> texels: array<u32>;
-@group(1) @binding(7) var<uniform> shading: Shading;
+// reads them from `vertex_data` (group 1, binding 3) and its further chunks, if any.
+// The RGBA8 sRGB texels of every texture, row after row; a material says where its begin.
+@group(1) @binding(4) var<storage, read> texels: array<u32>;
+@group(1) @binding(5) var<uniform> shading: Shading;
+
+// Light `i`.
+fn light_at(i: u32) -> Light {
+    let a = surfaces[LIGHT_VEC4S * i];
+    let b = surfaces[LIGHT_VEC4S * i + 1u];
+    return Light(bitcast<vec3<f32>>(a.xyz), a.w, bitcast<vec3<f32>>(b.xyz), b.w);
+}
+
+// Material `i`.
+fn material_at(i: u32) -> Material {
+    let k = LIGHT_VEC4S * shading.light_count + MATERIAL_VEC4S * i;
+    let v = array<vec4<u32>, 5>(surfaces[k], surfaces[k + 1u], surfaces[k + 2u], surfaces[k + 3u],
+        surfaces[k + 4u]);
+    return Material(bitcast<vec3<f32>>(v[0].xyz), v[0].w, bitcast<vec3<f32>>(v[1].xyz),
+        bitcast<f32>(v[1].w), bitcast<vec3<f32>>(v[2].xyz), bitcast<f32>(v[2].w),
+        bitcast<vec3<f32>>(v[3].xyz), v[3].w, bitcast<f32>(v[4].x), v[4].y, v[4].z, 0u);
+}
 
 override HAS_MIRRORS: bool;
 override HAS_GLASS: bool;
@@ -61,7 +81,8 @@ fn srgb_to_linear(c: vec3<f32>) -> vec3<f32> {
     return select(pow((c + 0.055) / 1.055, vec3<f32>(2.4)), c / 12.92, c <= vec3<f32>(0.04045));
 }
 
-fn texel(info: vec4<u32>, x: i32, y: i32) -> vec3<f32> {
+// Texel (x, y) of the texture whose first texel, width and height are `info`'s x, y, z.
+fn texel(info: vec3<u32>, x: i32, y: i32) -> vec3<f32> {
     // Repeat wrapping.
     let w = i32(info.y);
     let h = i32(info.z);
@@ -71,8 +92,8 @@ fn texel(info: vec4<u32>, x: i32, y: i32) -> vec3<f32> {
 }
 
 // Bilinear filtering in linear space, repeat wrapping, v = 0 at the bottom (OBJ convention).
-fn sample_texture(index: u32, uv: vec2<f32>) -> vec3<f32> {
-    let info = texture_info[index];
+fn sample_texture(m: Material, uv: vec2<f32>) -> vec3<f32> {
+    let info = vec3<u32>(m.texture, m.texture_width, m.texture_height);
     let size = vec2<f32>(f32(info.y), f32(info.z));
     let st = vec2<f32>(uv.x, 1.0 - uv.y) * size - 0.5;
     let base = floor(st);
@@ -108,7 +129,7 @@ fn vertex_normal(hit: Hit, n: vec3<f32>) -> vec3<f32> {
 
 fn surface_at(ray: Ray, hit: Hit) -> Surface {
     let tri = triangle_at(hit.slot);
-    var material = materials[tri.material];
+    var material = material_at(tri.material);
     let w = 1.0 - hit.u - hit.v;
     let position = hit_position(hit);
     var geometric = normalize(hit_face_normal(hit));
@@ -141,7 +162,7 @@ fn surface_at(ray: Ray, hit: Hit) -> Surface {
         let a = vertex_at(uv_base);
         let b = vertex_at(uv_base + 1u);
         let uv = w * a.xy + hit.u * a.zw + hit.v * b.xy;
-        material.diffuse *= sample_texture(material.texture, uv);
+        material.diffuse *= sample_texture(material, uv);
     }
     return Surface(position, geometric, normal, front, material, scene_triangle(hit.slot, hit.instance));
 }

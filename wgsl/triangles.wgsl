@@ -1,4 +1,4 @@
-// The scene's triangles in BVH order (group 1, binding 1) and its instances (binding 8), and
+// The scene's triangles in BVH order (group 1, binding 1) and its instances (binding 6), and
 // the ray and hit types that the tracer, the shading code and the rasterizer share.
 
 // Mirrors `fisheye_rt::bvh::GpuTriangle` (48 bytes): corners (camera-relative, or in their
@@ -41,7 +41,7 @@ struct Instance {
 // KNOT_VEC4S each (`fisheye_rt::shared::InstanceKnot`): the rotation of the placement's polar
 // decomposition M = R·A (a unit quaternion), its translation (camera-relative) and time
 // (seconds from the frame's stamp) in w, then symmetric A's xx, yy, zz, xy and xz, yz.
-@group(1) @binding(8) var<storage, read> instance_data: array<vec4<f32>>;
+@group(1) @binding(6) var<storage, read> instance_data: array<vec4<f32>>;
 
 // The scene time of the ray being traced, seconds from the frame's stamp: the camera sets it
 // as it places each primary ray (`camera_at`); secondary rays keep it.

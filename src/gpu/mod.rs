@@ -423,6 +423,7 @@ impl GpuContext {
 
     /// Runs `work` inside validation, out-of-memory and internal error scopes and turns what
     /// they catch, or a lost device, into an [`Error`] naming `during`.
+    #[cfg(not(target_arch = "wasm32"))]
     pub fn checked<T>(&self, during: &str, work: impl FnOnce() -> T) -> Result<T> {
         self.check_lost(false)?;
         let scopes = [
@@ -447,6 +448,15 @@ impl GpuContext {
             }),
             None => Ok(value),
         }
+    }
+
+    /// Runs `work`, after an error if the device was lost or earlier work failed. A web page
+    /// cannot block on error scopes' promises, so there errors reach the uncaptured-error
+    /// handler and the next check reports them.
+    #[cfg(target_arch = "wasm32")]
+    pub fn checked<T>(&self, _during: &str, work: impl FnOnce() -> T) -> Result<T> {
+        self.check_lost(false)?;
+        Ok(work())
     }
 
     /// An error if the device was lost or an error escaped the error scopes. wgpu calls the

@@ -412,7 +412,7 @@ impl Offscreen {
     pub fn frame(&self, ctx: &GpuContext, scenes: &SceneSet, pose: &Camera) -> Result<FrameTime> {
         let scene = scenes.for_method(self.setup.method);
         let q = self.queries.as_ref();
-        let started = std::time::Instant::now();
+        let started = crate::clock::Stopwatch::start();
         ctx.checked("rendering a frame", || {
             let mut encoder = ctx.device.create_command_encoder(&Default::default());
             let index = |p: Pass| self.passes.iter().position(|&x| x == p).map(|i| i as u32);
@@ -465,7 +465,7 @@ impl Offscreen {
     /// workgroup of a traced frame, or a whole cube-map frame (whose passes each need their
     /// first draw or dispatch). Returns the wall milliseconds it took: compilation, mostly.
     pub fn warm_up(&self, ctx: &GpuContext, scenes: &SceneSet, pose: &Camera) -> Result<f64> {
-        let started = std::time::Instant::now();
+        let started = crate::clock::Stopwatch::start();
         match &self.path {
             Path::Direct(pass) => {
                 let scene = scenes.for_method(self.setup.method);

@@ -10,6 +10,7 @@ pub mod gltf;
 mod lint;
 mod mesh;
 pub mod obj;
+mod view;
 
 use glam::{DAffine3, DMat3, DVec3, Vec2, Vec3};
 

@@ -60,6 +60,8 @@ fn gpu_structs_match_their_wgsl_twins() {
             ("transmission", offset_of!(GpuMaterial, transmission)),
             ("texture", offset_of!(GpuMaterial, texture)),
             ("opacity", offset_of!(GpuMaterial, opacity)),
+            ("texture_width", offset_of!(GpuMaterial, texture_width)),
+            ("texture_height", offset_of!(GpuMaterial, texture_height)),
             ("pad", offset_of!(GpuMaterial, pad)),
         ],
     );

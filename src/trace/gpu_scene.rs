@@ -260,31 +260,40 @@ impl GpuScene {
         let bvh = SceneBvh::build(scene, origin, options.bvh)?;
         let arrays = plan(bvh.nodes.len() as u64, bvh.triangles.len() as u64);
         check_bindings(ctx, &arrays, stored)?;
-        let materials: Vec<GpuMaterial> = scene
-            .materials
-            .iter()
-            .map(|m| GpuMaterial {
-                diffuse: to3(m.diffuse),
-                surface: surface_id(m.surface),
-                specular: to3(m.specular),
-                shininess: m.shininess,
-                emission: to3(m.emission),
-                ior: m.ior,
-                transmission: to3(m.transmission),
-                texture: m.diffuse_texture.unwrap_or(NO_TEXTURE),
-                opacity: m.opacity,
-                pad: [0; 3],
-            })
-            .collect();
-        let (lights, shadow_layers) = gpu_lights(scene, origin)?;
-        let mut texture_info = Vec::new();
+        // The textures' texels one after another, and where each begins.
         let mut texels: Vec<u32> = Vec::new();
+        let mut placed = Vec::new();
         if features.textures {
             for t in &scene.textures {
-                texture_info.push([texels.len() as u32, t.width, t.height, 0]);
+                placed.push((texels.len() as u32, t.width, t.height));
                 texels.extend(bytemuck::cast_slice::<u8, u32>(&t.rgba));
             }
         }
+        let materials: Vec<GpuMaterial> = scene
+            .materials
+            .iter()
+            .map(|m| {
+                let (texture, texture_width, texture_height) = m
+                    .diffuse_texture
+                    .and_then(|t| placed.get(t as usize).copied())
+                    .unwrap_or((NO_TEXTURE, 0, 0));
+                GpuMaterial {
+                    diffuse: to3(m.diffuse),
+                    surface: surface_id(m.surface),
+                    specular: to3(m.specular),
+                    shininess: m.shininess,
+                    emission: to3(m.emission),
+                    ior: m.ior,
+                    transmission: to3(m.transmission),
+                    texture,
+                    opacity: m.opacity,
+                    texture_width,
+                    texture_height,
+                    pad: 0,
+                }
+            })
+            .collect();
+        let (lights, shadow_layers) = gpu_lights(scene, origin)?;
         let shading = Shading {
             sky: to3(scene.sky),
             light_count: lights.len() as u32,
@@ -325,9 +334,10 @@ impl GpuScene {
             &arrays.vertices,
             none,
         )?;
-        let materials = storage(ctx, "fisheye.scene.materials", &materials)?;
-        let lights_buffer = storage(ctx, "fisheye.scene.lights", &lights)?;
-        let texture_info = storage(ctx, "fisheye.scene.texture_info", &texture_info)?;
+        // Lights, then materials (`light_at` and `material_at` in wgsl/surface.wgsl).
+        let mut surfaces: Vec<u32> = bytemuck::cast_slice(&lights).to_vec();
+        surfaces.extend_from_slice(bytemuck::cast_slice(&materials));
+        let surfaces = storage(ctx, "fisheye.scene.surfaces", &surfaces)?;
         let texels = storage(ctx, "fisheye.scene.texels", &texels)?;
         // Room for every instance to show at some time, and for moving ones' knots.
         let mut instance_data: Vec<[f32; 4]> = bytemuck::cast_slice(&bvh.instances).to_vec();
@@ -346,15 +356,13 @@ impl GpuScene {
             );
             // Binding order = @binding(n) order in wgsl/triangles.wgsl, wgsl/surface.wgsl and
             // the generated scene_arrays (`split::SceneArrays::bindings`: each array's first
-            // chunk at 0, 1 and 4, the others from 9 on); the rasterizer reads them in its
+            // chunk at 0, 1 and 3, the others from 7 on); the rasterizer reads them in its
             // vertex and fragment stages.
             let resources: Vec<&wgpu::Buffer> = [
                 &nodes[0],
                 &triangles[0],
-                &materials,
-                &lights_buffer,
+                &surfaces,
                 &vertices[0],
-                &texture_info,
                 &texels,
                 &uniform,
                 &instances,
@@ -367,7 +375,7 @@ impl GpuScene {
             let mut entries: Vec<_> = (0..resources.len() as u32)
                 .map(|b| storage_entry(b, true))
                 .collect();
-            entries[7] = uniform_entry(7);
+            entries[5] = uniform_entry(5);
             for entry in &mut entries {
                 entry.visibility = crate::gpu::ALL_STAGES;
             }
@@ -386,8 +394,8 @@ impl GpuScene {
                 bvh: size(&nodes)
                     + (size_of::<crate::bvh::GpuInstance>() * bvh.instances.len()) as u64,
                 geometry: size(&triangles),
-                shading: materials.size() + lights_buffer.size() + size(&vertices),
-                textures: texture_info.size() + texels.size(),
+                shading: surfaces.size() + size(&vertices),
+                textures: texels.size(),
             };
             Self {
                 layout,

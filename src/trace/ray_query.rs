@@ -5,7 +5,9 @@
 //!
 //! [`Traversal::RayQuery`]: super::Traversal::RayQuery
 
-use std::time::{Duration, Instant};
+use std::time::Duration;
+
+use crate::clock::Stopwatch;
 
 use crate::error::{Error, Result};
 use crate::gpu::{GpuContext, bind_group};
@@ -85,7 +87,7 @@ impl RayQueryScene {
         if let Some(blas) = &blas {
             tlas[0] = Some(wgpu::TlasInstance::new(blas, identity, 0, 0xff));
         }
-        let started = Instant::now();
+        let started = Stopwatch::start();
         let mut encoder = device.create_command_encoder(&Default::default());
         let entries: Vec<wgpu::BlasBuildEntry<'_>> = blas
             .iter()

@@ -3,7 +3,7 @@
 
 use std::path::PathBuf;
 
-use anyhow::{Context, Result, bail};
+use anyhow::{Result, bail};
 use clap::ValueEnum;
 use fisheye_rt::bvh::BvhQuality;
 use fisheye_rt::cube::CubeMethod;
@@ -17,7 +17,6 @@ use fisheye_rt::raster::RasterMethod;
 use fisheye_rt::renderer;
 use fisheye_rt::scene::Scene;
 use fisheye_rt::trace::{Channel, Sampling, Tone};
-use glam::DVec3;
 
 /// How the scene is built and shaded, for `render`, `bench` and `compare`.
 #[derive(clap::Args)]
@@ -158,53 +157,9 @@ pub(crate) enum ArrayFormat {
     Exr,
 }
 
-/// Parses `--camera`: `X,Y,Z:LX,LY,LZ` or `path:S`.
+/// Parses `--camera` ([`Scene::parse_camera`]).
 pub(crate) fn parse_camera(text: &str, scene: &Scene) -> Result<fisheye_rt::scene::Camera> {
-    if let Some(s) = text.strip_prefix("path:") {
-        let s: f64 = s
-            .parse()
-            .ok()
-            .filter(|s: &f64| (0.0..=1.0).contains(s))
-            .with_context(|| format!("--camera {text:?}: S must be a number in [0, 1]"))?;
-        if scene.camera_path.is_empty() {
-            bail!("--camera {text:?}: this scene has no camera path");
-        }
-        return Ok(scene.camera_on_path(s));
-    }
-    if let Some(n) = text.strip_prefix("gltf:") {
-        let n: usize = n
-            .parse()
-            .with_context(|| format!("--camera {text:?}: N must be a camera's number, from 0"))?;
-        return match scene.cameras.get(n) {
-            Some(camera) => Ok(*camera),
-            None => bail!(
-                "--camera {text:?}: the scene's file has {} camera(s)",
-                scene.cameras.len()
-            ),
-        };
-    }
-    let triple = |t: &str| -> Option<DVec3> {
-        let v: Vec<f64> = t
-            .split(',')
-            .map(|x| x.trim().parse().ok())
-            .collect::<Option<_>>()?;
-        (v.len() == 3 && v.iter().all(|x| x.is_finite())).then(|| DVec3::new(v[0], v[1], v[2]))
-    };
-    let pose = text
-        .split_once(':')
-        .and_then(|(p, l)| Some((triple(p)?, triple(l)?)))
-        .filter(|(p, l)| p != l)
-        .with_context(|| {
-            format!(
-                "--camera {text:?}: expected X,Y,Z:LX,LY,LZ (two different finite points), \
-                 path:S or gltf:N"
-            )
-        })?;
-    Ok(fisheye_rt::scene::Camera {
-        position: pose.0,
-        look_at: pose.1,
-        up: DVec3::Y,
-    })
+    scene.parse_camera(text).map_err(anyhow::Error::msg)
 }
 
 #[derive(Clone, Copy, ValueEnum)]

@@ -1,0 +1,223 @@
+// The page's script: starts the wasm module on the browser's WebGPU, exposes
+// `window.fisheye` ({ready, render(opts)}, the contract tests drive), and wires the controls:
+// scene (built-in, picked or dropped files), lens, size, rays per pixel, orbiting camera,
+// the GPU time of each frame, saving the picture as PNG.
+import init, { Fisheye, lenses } from "./fisheye_web.js";
+
+const $ = (id) => document.getElementById(id);
+const say = (text, bad = false) => {
+  $("status").textContent = text;
+  $("status").className = bad ? "bad" : "";
+};
+
+// `render`'s defaults, as `fisheye render` has them.
+const DEFAULTS = { scene: "builtin:default", lens: "canon-8-15mm@8mm", size: "1024x768", spp: 16 };
+
+const ready = (async () => {
+  if (!navigator.gpu) {
+    throw new Error(
+      "This browser has no WebGPU (navigator.gpu is missing): use a recent Chrome, Edge or " +
+        "Firefox, over https or http://localhost.",
+    );
+  }
+  await init();
+  return await Fisheye.start();
+})();
+
+// The scene's name, its bytes and the files beside it, and where to fetch more (a URL's
+// folder) or look for them (files dropped with it).
+async function sceneOf(opts) {
+  const scene = opts.scene ?? DEFAULTS.scene;
+  const files = new Map();
+  const extra = opts.files ?? [];
+  if (typeof scene === "string" && scene.startsWith("builtin:")) {
+    return { name: scene, files, extra };
+  }
+  if (typeof scene === "string" || scene instanceof URL) {
+    const url = new URL(scene, location.href);
+    const name = opts.name ?? decodeURIComponent(url.pathname.split("/").pop());
+    files.set(name, await fetchBytes(url));
+    return { name, files, base: url, extra };
+  }
+  if (scene instanceof File) {
+    files.set(opts.name ?? scene.name, new Uint8Array(await scene.arrayBuffer()));
+    return { name: opts.name ?? scene.name, files, extra };
+  }
+  if (scene instanceof ArrayBuffer || ArrayBuffer.isView(scene)) {
+    if (!opts.name) throw new Error("a scene given as bytes needs its file name: opts.name");
+    const bytes = scene instanceof ArrayBuffer ? new Uint8Array(scene) : new Uint8Array(scene.buffer);
+    files.set(opts.name, bytes);
+    return { name: opts.name, files, extra };
+  }
+  throw new Error("opts.scene: a URL, a File, an ArrayBuffer or builtin:NAME");
+}
+
+async function fetchBytes(url) {
+  const response = await fetch(url);
+  if (!response.ok) throw new Error(`${url}: ${response.status} ${response.statusText}`);
+  return new Uint8Array(await response.arrayBuffer());
+}
+
+// A file the scene names: dropped with it, or fetched beside its URL; null if neither.
+async function companion(source, name) {
+  const dropped = source.extra.find((f) => f.name === name.split("/").pop());
+  if (dropped) return new Uint8Array(await dropped.arrayBuffer());
+  if (!source.base) return null;
+  try {
+    return await fetchBytes(new URL(name, source.base));
+  } catch {
+    return null;
+  }
+}
+
+// Renders as `fisheye render` does; resolves to {width, height, rgba, gpu_ms, camera,
+// warnings}.
+async function render(opts = {}) {
+  const device = await ready;
+  const source = await sceneOf(opts);
+  const lens = opts.lens ?? DEFAULTS.lens;
+  const size = opts.size ?? DEFAULTS.size;
+  const spp = String(opts.spp ?? DEFAULTS.spp);
+  const camera = opts.camera ?? "";
+  // The loaders name the files a scene needs (MTL, textures, glTF buffers) as they read it:
+  // each round finds among the dropped files, or fetches, those it missed; once none of
+  // them can be had, the scene is loaded without them (with the tool's warnings or errors).
+  let complete = false;
+  for (;;) {
+    try {
+      const asked = { name: source.name, lens, size, spp, camera, complete };
+      return await device.render(source.files, asked);
+    } catch (error) {
+      if (complete || !error.missing?.length) throw error;
+      let found = 0;
+      for (const name of error.missing) {
+        const bytes = await companion(source, name);
+        if (bytes) {
+          source.files.set(name, bytes);
+          found++;
+        }
+      }
+      complete = found === 0;
+    }
+  }
+}
+
+window.fisheye = { ready, render, lenses: () => ready.then(() => lenses()) };
+
+// ---- the page's controls
+
+let picked = null; // {scene: File, files: File[]} from the picker or a drop
+let pose = ""; // the camera after orbiting, "X,Y,Z:LX,LY,LZ"
+let last = null;
+
+function show(image) {
+  const canvas = $("view");
+  canvas.width = image.width;
+  canvas.height = image.height;
+  const data = new ImageData(new Uint8ClampedArray(image.rgba.buffer), image.width, image.height);
+  canvas.getContext("2d").putImageData(data, 0, 0);
+}
+
+async function draw() {
+  const opts = {
+    lens: $("lens").value.trim() || DEFAULTS.lens,
+    size: $("size").value.trim() || DEFAULTS.size,
+    spp: $("spp").value.trim() || DEFAULTS.spp,
+    camera: pose,
+  };
+  if (picked) {
+    opts.scene = picked.scene;
+    opts.files = picked.files;
+  } else {
+    opts.scene = $("scene").value;
+  }
+  say("rendering…");
+  try {
+    const started = performance.now();
+    last = await render(opts);
+    show(last);
+    const total = performance.now() - started;
+    const warned = last.warnings.length ? ` (warnings: ${last.warnings.join("; ")})` : "";
+    say(
+      `${last.width}×${last.height}, ${opts.spp} rays a pixel: ${last.gpu_ms.toFixed(1)} ms ` +
+        `from submission to pixels, ${total.toFixed(0)} ms with loading and BVH${warned}`,
+    );
+  } catch (error) {
+    say(String(error.message ?? error), true);
+  }
+}
+
+function orbit(dx, dy) {
+  if (!last?.camera) return;
+  const [eye, at] = last.camera.split(":").map((t) => t.split(",").map(Number));
+  const v = eye.map((e, i) => e - at[i]);
+  const r = Math.hypot(...v);
+  let yaw = Math.atan2(v[0], v[2]) - dx * 0.01;
+  let pitch = Math.asin(v[1] / r) + dy * 0.01;
+  pitch = Math.max(-1.5, Math.min(1.5, pitch));
+  const e = [
+    at[0] + r * Math.cos(pitch) * Math.sin(yaw),
+    at[1] + r * Math.sin(pitch),
+    at[2] + r * Math.cos(pitch) * Math.cos(yaw),
+  ];
+  pose = `${e.join(",")}:${at.join(",")}`;
+}
+
+async function setUp() {
+  try {
+    const device = await ready;
+    $("adapter").textContent = device.adapter || "this browser's WebGPU adapter";
+  } catch (error) {
+    say(String(error.message ?? error), true);
+    $("render").disabled = true;
+    return;
+  }
+  const list = $("lenses");
+  for (const [spec, about] of lenses()) {
+    const option = document.createElement("option");
+    option.value = spec;
+    option.textContent = about;
+    list.append(option);
+  }
+  $("render").onclick = draw;
+  $("save").onclick = () => {
+    $("view").toBlob((blob) => {
+      const a = document.createElement("a");
+      a.href = URL.createObjectURL(blob);
+      a.download = "fisheye.png";
+      a.click();
+    }, "image/png");
+  };
+  const take = (files) => {
+    const all = [...files];
+    const scene = all.find((f) => /\.(obj|gltf|glb)$/i.test(f.name));
+    if (!scene) return say("drop an .obj (with its .mtl and textures), .gltf or .glb file", true);
+    picked = { scene, files: all };
+    pose = "";
+    $("picked").textContent = all.map((f) => f.name).join(", ");
+    draw();
+  };
+  $("file").onchange = (e) => take(e.target.files);
+  $("scene").onchange = () => {
+    picked = null;
+    pose = "";
+    $("picked").textContent = "";
+    draw();
+  };
+  document.body.ondragover = (e) => e.preventDefault();
+  document.body.ondrop = (e) => {
+    e.preventDefault();
+    take(e.dataTransfer.files);
+  };
+  let drag = null;
+  $("view").onpointerdown = (e) => (drag = [e.clientX, e.clientY]);
+  window.onpointerup = (e) => {
+    if (!drag) return;
+    orbit(e.clientX - drag[0], e.clientY - drag[1]);
+    drag = null;
+    draw();
+  };
+  draw();
+}
+
+setUp();

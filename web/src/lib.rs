@@ -1,0 +1,431 @@
+//! fisheye-rt in a web page: the library, compiled to wasm32-unknown-unknown, renders on the
+//! browser's WebGPU with the same WGSL kernels as natively, and hands the page the 8-bit sRGB
+//! image `fisheye render` writes as PNG for the same arguments. `web/main.js` wraps this in
+//! the page's `window.fisheye` (`ready`, `render(opts)`); `bash web/build` builds both into
+//! `web/dist/`.
+//!
+//! A page cannot block: the device is requested and the image read back by awaiting
+//! WebGPU's promises, never by polling.
+#![cfg(target_arch = "wasm32")]
+
+use std::cell::RefCell;
+use std::collections::HashMap;
+use std::future::Future;
+use std::path::Path;
+use std::pin::Pin;
+use std::rc::Rc;
+use std::sync::{Arc, Mutex};
+use std::task::{Context, Poll, Waker};
+
+use fisheye_rt::input::InputKind;
+use fisheye_rt::lens::ImageSize;
+use fisheye_rt::lens::glass::camera_for;
+use fisheye_rt::renderer::Renderer;
+use fisheye_rt::scene::{self, Scene};
+use fisheye_rt::trace::{Display, RenderOptions, Sampling, Tone, auto_exposure, colour_image_with};
+use js_sys::{Array, Object, Reflect, Uint8Array};
+use wasm_bindgen::prelude::*;
+
+/// The browser's WebGPU device, ready to render.
+#[wasm_bindgen]
+pub struct Fisheye {
+    device: wgpu::Device,
+    queue: wgpu::Queue,
+    adapter: String,
+    /// Errors WebGPU raised outside any scope (a page cannot wait on error scopes), in order.
+    errors: Arc<Mutex<Vec<String>>>,
+}
+
+#[wasm_bindgen]
+impl Fisheye {
+    /// Requests the browser's WebGPU adapter and a device with every limit it offers (the
+    /// tracer needs more storage buffers a stage than WebGPU's default); rejects with what is
+    /// missing.
+    pub async fn start() -> Result<Fisheye, JsError> {
+        let mut descriptor = wgpu::InstanceDescriptor::new_without_display_handle();
+        descriptor.backends = wgpu::Backends::BROWSER_WEBGPU;
+        let instance = wgpu::Instance::new(descriptor);
+        let adapter = instance
+            .request_adapter(&wgpu::RequestAdapterOptions {
+                power_preference: wgpu::PowerPreference::HighPerformance,
+                ..Default::default()
+            })
+            .await
+            .map_err(|e| JsError::new(&format!("this browser gives no WebGPU adapter ({e})")))?;
+        let info = adapter.get_info();
+        let adapter_name = match info.driver.is_empty() {
+            true => info.name.clone(),
+            false => format!("{} ({})", info.name, info.driver),
+        };
+        let has = adapter.limits();
+        let mut short = Vec::new();
+        fisheye_rt::renderer::required_limits().check_limits_with_fail_fn(
+            &has,
+            false,
+            |name, need, offers| {
+                short.push(format!(
+                    "{name}: the tracer needs {need}, it offers {offers}"
+                ))
+            },
+        );
+        if !short.is_empty() {
+            return Err(JsError::new(&format!(
+                "this browser's WebGPU adapter ({adapter_name}) is too small: {}",
+                short.join("; ")
+            )));
+        }
+        let (device, queue) = adapter
+            .request_device(&wgpu::DeviceDescriptor {
+                label: Some("fisheye.web"),
+                required_features: wgpu::Features::empty(),
+                required_limits: has,
+                experimental_features: wgpu::ExperimentalFeatures::disabled(),
+                memory_hints: wgpu::MemoryHints::Performance,
+                trace: wgpu::Trace::Off,
+            })
+            .await
+            .map_err(|e| JsError::new(&format!("WebGPU refused a device: {e}")))?;
+        let errors = Arc::new(Mutex::new(Vec::new()));
+        let sink = errors.clone();
+        device.on_uncaptured_error(Arc::new(move |error: wgpu::Error| {
+            sink.lock().unwrap().push(error.to_string());
+        }));
+        Ok(Fisheye {
+            device,
+            queue,
+            adapter: adapter_name,
+            errors,
+        })
+    }
+
+    /// The adapter's name (and driver, where the browser says).
+    #[wasm_bindgen(getter)]
+    pub fn adapter(&self) -> String {
+        self.adapter.clone()
+    }
+
+    /// Renders as `fisheye render` does what `opts` asks: `{name, lens, size, spp, camera,
+    /// complete}`, strings but the last: the scene `name` (`builtin:NAME`, or a file in `files`
+    /// ending `.obj`, `.gltf`, `.glb` or `.toml`; `files` maps names to their bytes, the
+    /// scene's and those it names) through `lens` at `size` (`WxH`) with `spp`
+    /// (`render --spp`'s forms) from `camera` (`render --camera`'s forms; the scene's own if
+    /// empty).
+    /// Resolves to `{width, height, rgba, gpu_ms, camera, warnings}`: the PNG's 8-bit sRGB
+    /// pixels, the milliseconds from submission to the pixels' arrival on the CPU, the pose
+    /// (as `camera` takes it) and what the loaders warned of. Rejects with an `Error` whose
+    /// message says what is wrong. Until `complete`, a scene that names files not in `files`
+    /// (an OBJ's MTL, textures, glTF buffers) is refused with an `Error` whose `missing` lists
+    /// them, even where it would load without them (the page fetches them and tries again);
+    /// once `complete`, those still missing are missing, as they are to `fisheye render`.
+    pub fn render(&self, files: js_sys::Map, opts: Object) -> js_sys::Promise {
+        let (device, queue, errors) =
+            (self.device.clone(), self.queue.clone(), self.errors.clone());
+        let mut bytes = HashMap::new();
+        files.for_each(&mut |value, key| {
+            if let (Some(key), Some(value)) = (key.as_string(), value.dyn_ref::<Uint8Array>()) {
+                bytes.insert(key, value.to_vec());
+            }
+        });
+        let text = |key: &str| {
+            Reflect::get(&opts, &key.into())
+                .ok()
+                .and_then(|v| v.as_string())
+                .unwrap_or_default()
+        };
+        let request = Request {
+            name: text("name"),
+            files: bytes,
+            lens: text("lens"),
+            size: text("size"),
+            spp: text("spp"),
+            camera: text("camera"),
+            complete: Reflect::get(&opts, &"complete".into()).is_ok_and(|v| v.is_truthy()),
+        };
+        wasm_bindgen_futures::future_to_promise(async move {
+            let image = request.render(&device, &queue, &errors).await?;
+            let out = Object::new();
+            let set = |key: &str, value: JsValue| Reflect::set(&out, &key.into(), &value);
+            set("width", image.size.width.into())?;
+            set("height", image.size.height.into())?;
+            set("rgba", Uint8Array::from(&image.rgba[..]).into())?;
+            set("gpu_ms", image.gpu_ms.into())?;
+            set("camera", image.camera.into())?;
+            let warnings: Array = image.warnings.into_iter().map(JsValue::from).collect();
+            set("warnings", warnings.into())?;
+            Ok(out.into())
+        })
+    }
+}
+
+/// What `render` was asked.
+struct Request {
+    name: String,
+    files: HashMap<String, Vec<u8>>,
+    lens: String,
+    size: String,
+    spp: String,
+    camera: String,
+    complete: bool,
+}
+
+/// A rendered image as the PNG holds it.
+struct Image {
+    size: ImageSize,
+    rgba: Vec<u8>,
+    gpu_ms: f64,
+    /// The pose it was seen from, as `camera` takes it.
+    camera: String,
+    /// What loading the scene warned of.
+    warnings: Vec<String>,
+}
+
+/// A JavaScript `Error` with `message`.
+fn error(message: impl std::fmt::Display) -> JsValue {
+    js_sys::Error::new(&message.to_string()).into()
+}
+
+impl Request {
+    async fn render(
+        &self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        errors: &Mutex<Vec<String>>,
+    ) -> Result<Image, JsValue> {
+        let size: ImageSize = self.size.parse().map_err(|e| error(format!("size: {e}")))?;
+        let sampling: Sampling = self.spp.parse().map_err(|e| error(format!("spp: {e}")))?;
+        let camera = camera_for(&self.lens, size).map_err(|e| error(format!("lens: {e}")))?;
+        let (mut scene, warnings) = self.scene()?;
+        scene.frame_for(&camera);
+        if !self.camera.is_empty() {
+            let pose = scene.parse_camera(&self.camera).map_err(error)?;
+            scene.set_camera(pose);
+        }
+        let (spp, adaptive) = sampling.options(false);
+        let options = RenderOptions {
+            spp,
+            adaptive,
+            ..RenderOptions::default()
+        };
+        let format = wgpu::TextureFormat::Rgba32Float;
+        let renderer =
+            Renderer::new(device, queue, &scene, &camera, &options, format).map_err(error)?;
+        let (width, height) = (size.width, size.height);
+        let extent = wgpu::Extent3d {
+            width,
+            height,
+            depth_or_array_layers: 1,
+        };
+        let target = device.create_texture(&wgpu::TextureDescriptor {
+            label: Some("fisheye.web.image"),
+            size: extent,
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format,
+            usage: wgpu::TextureUsages::STORAGE_BINDING | wgpu::TextureUsages::COPY_SRC,
+            view_formats: &[],
+        });
+        // Rows padded to WebGPU's copy alignment.
+        let row = (16 * width).next_multiple_of(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT);
+        let staging = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("fisheye.web.read_back"),
+            size: u64::from(row) * u64::from(height),
+            usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
+            mapped_at_creation: false,
+        });
+        let pose = scene.camera;
+        let mut encoder = device.create_command_encoder(&Default::default());
+        renderer
+            .encode(&mut encoder, &pose, &target)
+            .map_err(error)?;
+        encoder.copy_texture_to_buffer(
+            target.as_image_copy(),
+            wgpu::TexelCopyBufferInfo {
+                buffer: &staging,
+                layout: wgpu::TexelCopyBufferLayout {
+                    offset: 0,
+                    bytes_per_row: Some(row),
+                    rows_per_image: Some(height),
+                },
+            },
+            extent,
+        );
+        let started = js_sys::Date::now();
+        queue.submit([encoder.finish()]);
+        let mapped = Mapped::default();
+        let done = mapped.clone();
+        staging
+            .slice(..)
+            .map_async(wgpu::MapMode::Read, move |result| done.set(result));
+        mapped
+            .await
+            .map_err(|e| error(format!("reading the image back: {e}")))?;
+        let gpu_ms = js_sys::Date::now() - started;
+        if let Some(first) = errors.lock().unwrap().drain(..).next() {
+            return Err(error(format!("WebGPU: {first}")));
+        }
+        let mut colour = Vec::with_capacity(size.pixels());
+        {
+            let data = staging
+                .slice(..)
+                .get_mapped_range()
+                .map_err(|e| error(format!("reading the image back: {e}")))?;
+            for r in data.chunks(row as usize) {
+                colour.extend(bytemuck::pod_collect_to_vec::<u8, [f32; 4]>(
+                    &r[..16 * width as usize],
+                ));
+            }
+        }
+        staging.unmap();
+        // As `fisheye render`'s PNG: bare meshes, lit by the headlight and sun it adds, at the
+        // exposure that maps their log-average luminance to middle grey; the ACES curve.
+        let exposure = match scene.headlight {
+            Some(_) => auto_exposure(&colour),
+            None => 0.0,
+        };
+        let display = Display {
+            exposure,
+            tone: Tone::Aces,
+        };
+        Ok(Image {
+            size,
+            rgba: colour_image_with(size, &colour, &display).into_raw(),
+            gpu_ms,
+            warnings,
+            camera: format!(
+                "{},{},{}:{},{},{}",
+                pose.position.x,
+                pose.position.y,
+                pose.position.z,
+                pose.look_at.x,
+                pose.look_at.y,
+                pose.look_at.z
+            ),
+        })
+    }
+
+    /// The scene `name` names, its files read from `files`, and the loader's warnings.
+    fn scene(&self) -> Result<(Scene, Vec<String>), JsValue> {
+        if self.name.starts_with("builtin:") {
+            return scene::load(&self.name)
+                .map(|l| (l.scene, l.warnings))
+                .map_err(error);
+        }
+        let missing = RefCell::new(Vec::new());
+        let read = |path: &Path, _: InputKind| -> std::io::Result<Vec<u8>> {
+            let key = file_key(path);
+            self.files.get(&key).cloned().ok_or_else(|| {
+                missing.borrow_mut().push(key.clone());
+                std::io::Error::new(std::io::ErrorKind::NotFound, format!("{key} was not given"))
+            })
+        };
+        let path = Path::new(&self.name);
+        let extension = path
+            .extension()
+            .and_then(|e| e.to_str())
+            .map(str::to_ascii_lowercase);
+        let loaded = match extension.as_deref() {
+            Some("obj") => scene::obj::load_obj_from(path, &read),
+            Some("gltf" | "glb") => scene::gltf::load_gltf_from(path, &read, None),
+            Some("toml") => scene::file::load_scene_file_from(path, &read),
+            _ => {
+                return Err(error(format!(
+                    "{}: expected an OBJ file (.obj), a glTF file (.gltf, .glb), a scene file \
+                     (.toml) or builtin:NAME",
+                    self.name
+                )));
+            }
+        };
+        let missing = missing.take();
+        let out = match (loaded, self.complete || missing.is_empty()) {
+            (Ok(l), true) => return Ok((l.scene, l.warnings)),
+            (Ok(_), false) => error(format!(
+                "{} names files that were not given: {}",
+                self.name,
+                missing.join(", ")
+            )),
+            (Err(e), _) => error(e),
+        };
+        let names: Array = missing.into_iter().map(JsValue::from).collect();
+        let _ = Reflect::set(&out, &"missing".into(), &names);
+        Err(out)
+    }
+}
+
+/// A path the loaders ask for, as the page names its files: `/`-separated, no `./`.
+fn file_key(path: &Path) -> String {
+    let parts: Vec<String> = path
+        .components()
+        .filter(|c| !matches!(c, std::path::Component::CurDir))
+        .map(|c| c.as_os_str().to_string_lossy().into_owned())
+        .collect();
+    parts.join("/")
+}
+
+/// The outcome of `map_async`, awaited: its callback fills the slot and wakes the task.
+#[derive(Clone, Default)]
+struct Mapped(Rc<RefCell<Slot>>);
+
+type MapResult = Result<(), wgpu::BufferAsyncError>;
+
+#[derive(Default)]
+struct Slot {
+    result: Option<MapResult>,
+    waker: Option<Waker>,
+}
+
+impl Mapped {
+    fn set(&self, result: MapResult) {
+        let mut slot = self.0.borrow_mut();
+        slot.result = Some(result);
+        if let Some(waker) = slot.waker.take() {
+            waker.wake();
+        }
+    }
+}
+
+impl Future for Mapped {
+    type Output = MapResult;
+
+    fn poll(self: Pin<&mut Self>, cx: &mut Context<'_>) -> Poll<Self::Output> {
+        let mut slot = self.0.borrow_mut();
+        match slot.result.take() {
+            Some(result) => Poll::Ready(result),
+            None => {
+                slot.waker = Some(cx.waker().clone());
+                Poll::Pending
+            }
+        }
+    }
+}
+
+/// Lens specs to start from, each with what it is: the presets (real lenses), each classic
+/// model over 180° (rectilinear narrower), and an example of each calibrated model (its
+/// numbers for a 512×512 image).
+#[wasm_bindgen]
+pub fn lenses() -> Array {
+    use fisheye_rt::lens::{CalibratedModel, PRESETS};
+    let mut out: Vec<(String, String)> = PRESETS
+        .iter()
+        .map(|p| (p.name.to_string(), p.description.to_string()))
+        .collect();
+    for model in ["equidistant", "equisolid", "stereographic", "orthographic"] {
+        out.push((
+            format!("{model}:f=0.5,fov=180"),
+            format!("{model} model, 180°"),
+        ));
+    }
+    out.push((
+        "rectilinear:f=0.5".into(),
+        "rectilinear (pinhole) model".into(),
+    ));
+    for ((name, keys), example) in CalibratedModel::NAMES.iter().zip(CalibratedModel::EXAMPLES) {
+        out.push((
+            example.to_string(),
+            format!("{name} calibration ({keys}), 512×512"),
+        ));
+    }
+    out.into_iter()
+        .map(|(spec, about)| JsValue::from(Array::of2(&spec.into(), &about.into())))
+        .collect()
+}
