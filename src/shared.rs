@@ -17,10 +17,9 @@ pub const WORKGROUP_1D: u32 = 64;
 pub const TRAVERSAL_STACK: u32 = 32;
 
 /// Storage buffers the trace kernel binds: the direction table and three outputs (group 0),
-/// and the scene's six (group 1: nodes, triangles, lights and materials, shading vertices,
-/// textures, instances). wgpu's default limit is 8, so a device made for the tracer must ask
-/// for more (`renderer::required_limits`); browsers' adapters mostly offer 10.
-pub const TRACE_STORAGE_BUFFERS: u32 = 10;
+/// and the scene's four (group 1: nodes, triangles, records, shading vertices): WebGPU's and
+/// wgpu's default limit.
+pub const TRACE_STORAGE_BUFFERS: u32 = 8;
 
 /// Storage buffers the adaptive kernels bind beyond the trace kernel's: the per-pixel state
 /// and the work list (`trace::AdaptivePass`).
@@ -331,9 +330,9 @@ pub fn wgsl_constants() -> Vec<(String, u32)> {
     out
 }
 
-/// The `vec4`s of a [`GpuLight`] in the scene's surface buffer (lights, then materials).
+/// The `vec4`s of a [`GpuLight`] in the scene's records (instances, lights, materials, texels).
 pub const LIGHT_VEC4S: u32 = 2;
-/// The `vec4`s of a [`GpuMaterial`] in the scene's surface buffer.
+/// The `vec4`s of a [`GpuMaterial`] in the scene's records.
 pub const MATERIAL_VEC4S: u32 = 5;
 const _: () = assert!(std::mem::size_of::<GpuLight>() == 16 * LIGHT_VEC4S as usize);
 const _: () = assert!(std::mem::size_of::<GpuMaterial>() == 16 * MATERIAL_VEC4S as usize);
@@ -356,7 +355,7 @@ pub struct GpuMaterial {
     pub ior: f32,
     /// `Tf`.
     pub transmission: [f32; 3],
-    /// The diffuse texture's first texel in the scene's texels, or [`NO_TEXTURE`].
+    /// The diffuse texture's first texel (a word of the scene's records), or [`NO_TEXTURE`].
     pub texture: u32,
     /// `d`.
     pub opacity: f32,
@@ -383,7 +382,7 @@ pub struct GpuLight {
     pub shadow_layer: u32,
 }
 
-/// Per-scene shading constants (32 bytes).
+/// Per-scene shading constants (48 bytes).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, PartialEq, Pod, Zeroable)]
 pub struct Shading {
@@ -395,6 +394,12 @@ pub struct Shading {
     pub ambient: [f32; 3],
     /// Deepest secondary ray.
     pub max_depth: u32,
+    /// Where the lights begin in the scene's records (`vec4`s).
+    pub lights_at: u32,
+    /// Where the materials begin there.
+    pub materials_at: u32,
+    /// Padding.
+    pub pad: [u32; 2],
 }
 
 /// The camera pose of a frame (2,160 bytes): the camera-to-world rotation's columns (camera x,

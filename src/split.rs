@@ -19,8 +19,8 @@ pub const TRIANGLE_BYTES: u64 = 48;
 pub const VERTEX_BYTES: u64 = 16;
 
 /// Where the bindings beyond each array's first begin in group 1 (the scene's group): its
-/// fixed bindings are 0 to 6 (see `trace::GpuScene`).
-pub const FIRST_EXTRA_BINDING: u32 = 7;
+/// fixed bindings are 0 to 4 (see `trace::GpuScene`).
+pub const FIRST_EXTRA_BINDING: u32 = 5;
 
 /// How one array is stored: in `chunks` bindings of `1 << shift` elements each (the last one
 /// shorter). One chunk holds the whole array, whatever its length.
@@ -238,7 +238,7 @@ mod tests {
         assert_eq!(arrays.extra_bindings(), 6);
         assert_eq!(
             arrays.bindings(),
-            [vec![0, 7, 8, 9], vec![1, 10, 11, 12], vec![3]]
+            [vec![0, 5, 6, 7], vec![1, 8, 9, 10], vec![3]]
         );
     }
 

@@ -102,7 +102,12 @@ async function render(opts = {}) {
   }
 }
 
-window.fisheye = { ready, render, lenses: () => ready.then(() => lenses()) };
+// The WGSL lens twin against the f64 reference (compiled to wasm) at every pixel of `lens` at
+// `size`, on this device: {lens, rays, max_error, max_ratio, max_error_well_conditioned,
+// holds, why}.
+const lensTwin = async (lens, size) => (await ready).lens_twin(lens, size);
+
+window.fisheye = { ready, render, lensTwin, lenses: () => ready.then(() => lenses()) };
 
 // ---- the page's controls
 

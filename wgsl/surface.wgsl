@@ -32,7 +32,7 @@ struct Light {
     shadow_layer: u32,
 }
 
-// Mirrors `fisheye_rt::trace::Shading` (32 bytes).
+// Mirrors `fisheye_rt::trace::Shading` (48 bytes).
 struct Shading {
     // Radiance of escaping rays.
     sky: vec3<f32>,
@@ -41,32 +41,31 @@ struct Shading {
     ambient: vec3<f32>,
     // Secondary rays nest at most this deep (≤ MAX_DEPTH_LIMIT).
     max_depth: u32,
+    // Where the lights and the materials begin in `records` (vec4s).
+    lights_at: u32,
+    materials_at: u32,
+    pad: vec2<u32>,
 }
 
-// The scene's lights (`shading.light_count` of LIGHT_VEC4S vec4s each), then its materials
-// (MATERIAL_VEC4S each), laid out as `Light` and `Material`: one binding for both, so that the
-// trace kernel fits the storage buffers a browser gives a stage. Read as words, the floats
-// bitcast, so no float load can touch the bits of a u32 field.
-@group(1) @binding(2) var<storage, read> surfaces: array<vec4<u32>>;
 // Per scene triangle: three vertex normals (xyz) when SMOOTH_NORMALS, then three UV pairs
 // packed in two vec4 when TEXTURES; see `fisheye_rt::trace::shading_vertices`. `vertex_at`
 // reads them from `vertex_data` (group 1, binding 3) and its further chunks, if any.
-// The RGBA8 sRGB texels of every texture, row after row; a material says where its begin.
-@group(1) @binding(4) var<storage, read> texels: array<u32>;
-@group(1) @binding(5) var<uniform> shading: Shading;
+@group(1) @binding(4) var<uniform> shading: Shading;
 
-// Light `i`.
+// The scene's lights, materials and texels are in `records` (`triangles.wgsl`), where
+// `shading` says: light `i` in LIGHT_VEC4S vec4s, laid out as `Light`.
 fn light_at(i: u32) -> Light {
-    let a = surfaces[LIGHT_VEC4S * i];
-    let b = surfaces[LIGHT_VEC4S * i + 1u];
+    let k = shading.lights_at + LIGHT_VEC4S * i;
+    let a = records[k];
+    let b = records[k + 1u];
     return Light(bitcast<vec3<f32>>(a.xyz), a.w, bitcast<vec3<f32>>(b.xyz), b.w);
 }
 
-// Material `i`.
+// Material `i`, in MATERIAL_VEC4S vec4s laid out as `Material`.
 fn material_at(i: u32) -> Material {
-    let k = LIGHT_VEC4S * shading.light_count + MATERIAL_VEC4S * i;
-    let v = array<vec4<u32>, 5>(surfaces[k], surfaces[k + 1u], surfaces[k + 2u], surfaces[k + 3u],
-        surfaces[k + 4u]);
+    let k = shading.materials_at + MATERIAL_VEC4S * i;
+    let v = array<vec4<u32>, 5>(records[k], records[k + 1u], records[k + 2u], records[k + 3u],
+        records[k + 4u]);
     return Material(bitcast<vec3<f32>>(v[0].xyz), v[0].w, bitcast<vec3<f32>>(v[1].xyz),
         bitcast<f32>(v[1].w), bitcast<vec3<f32>>(v[2].xyz), bitcast<f32>(v[2].w),
         bitcast<vec3<f32>>(v[3].xyz), v[3].w, bitcast<f32>(v[4].x), v[4].y, v[4].z, 0u);
@@ -81,14 +80,16 @@ fn srgb_to_linear(c: vec3<f32>) -> vec3<f32> {
     return select(pow((c + 0.055) / 1.055, vec3<f32>(2.4)), c / 12.92, c <= vec3<f32>(0.04045));
 }
 
-// Texel (x, y) of the texture whose first texel, width and height are `info`'s x, y, z.
+// Texel (x, y), an RGBA8 sRGB word in `records`, of the texture whose first texel (as a word
+// of `records`), width and height are `info`'s x, y, z.
 fn texel(info: vec3<u32>, x: i32, y: i32) -> vec3<f32> {
     // Repeat wrapping.
     let w = i32(info.y);
     let h = i32(info.z);
     let xi = u32(((x % w) + w) % w);
     let yi = u32(((y % h) + h) % h);
-    return srgb_to_linear(unpack4x8unorm(texels[info.x + yi * info.y + xi]).rgb);
+    let word = info.x + yi * info.y + xi;
+    return srgb_to_linear(unpack4x8unorm(records[word >> 2u][word & 3u]).rgb);
 }
 
 // Bilinear filtering in linear space, repeat wrapping, v = 0 at the bottom (OBJ convention).

@@ -1,5 +1,6 @@
-// The scene's triangles in BVH order (group 1, binding 1) and its instances (binding 6), and
-// the ray and hit types that the tracer, the shading code and the rasterizer share.
+// The scene's triangles in BVH order (group 1, binding 1) and its records (binding 2: the
+// instances, with moving ones' knots, then what `surface.wgsl` reads), and the ray and hit
+// types that the tracer, the shading code and the rasterizer share.
 
 // Mirrors `fisheye_rt::bvh::GpuTriangle` (48 bytes): corners (camera-relative, or in their
 // mesh's space in an instanced scene), the stored triangle it came from and its material.
@@ -31,17 +32,27 @@ struct Instance {
     id_base: u32,
     normal_z: vec3<f32>,
     first: u32,
-    // A moving instance's knots (x: the vec4 they start at in `instance_data`, y: how many;
+    // A moving instance's knots (x: the vec4 they start at in `records`, y: how many;
     // with fewer than 2 the fields above place it), and whether it shows (z: 1, or 0 where its
     // placement flattens it).
     motion: vec4<u32>,
 }
 
-// The instances as `Instance`s of INSTANCE_VEC4S vec4s each, then moving instances' knots,
+// The scene's records: first the instances as `Instance`s of INSTANCE_VEC4S vec4s each, then
+// moving instances' knots,
 // KNOT_VEC4S each (`fisheye_rt::shared::InstanceKnot`): the rotation of the placement's polar
 // decomposition M = R·A (a unit quaternion), its translation (camera-relative) and time
 // (seconds from the frame's stamp) in w, then symmetric A's xx, yy, zz, xy and xz, yz.
-@group(1) @binding(6) var<storage, read> instance_data: array<vec4<f32>>;
+// Then the lights, the materials and the textures' texels (`surface.wgsl`): all the trace
+// kernel reads of a scene but its nodes, triangles and vertices, in one binding, so that it
+// binds no more than the 8 storage buffers WebGPU gives a stage. Read as words, floats
+// bitcast, so that no float load touches the bits of a u32 field.
+@group(1) @binding(2) var<storage, read> records: array<vec4<u32>>;
+
+// The vec4 of floats at `k` in `records`.
+fn record(k: u32) -> vec4<f32> {
+    return bitcast<vec4<f32>>(records[k]);
+}
 
 // The scene time of the ray being traced, seconds from the frame's stamp: the camera sets it
 // as it places each primary ray (`camera_at`); secondary rays keep it.
@@ -72,12 +83,12 @@ fn hit_instance(hit: Hit) -> Instance {
 fn stored_instance(k: u32) -> Instance {
     let b = k * INSTANCE_VEC4S;
     return Instance(
-        array<vec4<f32>, 3>(instance_data[b], instance_data[b + 1u], instance_data[b + 2u]),
-        array<vec4<f32>, 3>(instance_data[b + 3u], instance_data[b + 4u], instance_data[b + 5u]),
-        instance_data[b + 6u].xyz, bitcast<u32>(instance_data[b + 6u].w),
-        instance_data[b + 7u].xyz, bitcast<u32>(instance_data[b + 7u].w),
-        instance_data[b + 8u].xyz, bitcast<u32>(instance_data[b + 8u].w),
-        bitcast<vec4<u32>>(instance_data[b + 9u]),
+        array<vec4<f32>, 3>(record(b), record(b + 1u), record(b + 2u)),
+        array<vec4<f32>, 3>(record(b + 3u), record(b + 4u), record(b + 5u)),
+        record(b + 6u).xyz, records[b + 6u].w,
+        record(b + 7u).xyz, records[b + 7u].w,
+        record(b + 8u).xyz, records[b + 8u].w,
+        records[b + 9u],
     );
 }
 
@@ -90,25 +101,25 @@ fn place_moving(i: ptr<function, Instance>, t: f32) {
     var hi = (*i).motion.y;
     while hi - lo > 1u {
         let mid = (lo + hi) / 2u;
-        if instance_data[first + mid * KNOT_VEC4S + 1u].w <= t {
+        if record(first + mid * KNOT_VEC4S + 1u).w <= t {
             lo = mid;
         } else {
             hi = mid;
         }
     }
     let a = first + lo * KNOT_VEC4S;
-    var q = instance_data[a];
-    var p = instance_data[a + 1u].xyz;
-    var diagonal = instance_data[a + 2u];
-    var off = instance_data[a + 3u].xy;
+    var q = record(a);
+    var p = record(a + 1u).xyz;
+    var diagonal = record(a + 2u);
+    var off = record(a + 3u).xy;
     if lo + 1u < (*i).motion.y {
         let b = a + KNOT_VEC4S;
-        let ta = instance_data[a + 1u].w;
-        let s = clamp((t - ta) / (instance_data[b + 1u].w - ta), 0.0, 1.0);
-        q = slerp(q, instance_data[b], s);
-        p = mix(p, instance_data[b + 1u].xyz, s);
-        diagonal = mix(diagonal, instance_data[b + 2u], s);
-        off = mix(off, instance_data[b + 3u].xy, s);
+        let ta = record(a + 1u).w;
+        let s = clamp((t - ta) / (record(b + 1u).w - ta), 0.0, 1.0);
+        q = slerp(q, record(b), s);
+        p = mix(p, record(b + 1u).xyz, s);
+        diagonal = mix(diagonal, record(b + 2u), s);
+        off = mix(off, record(b + 3u).xy, s);
     }
     let sym = mat3x3<f32>(
         vec3<f32>(diagonal.x, diagonal.w, off.x),
@@ -180,7 +191,7 @@ fn scene_triangle(slot: u32, instance: u32) -> u32 {
     if INSTANCED {
         // Its id base and first stored triangle, which do not move.
         let b = instance * INSTANCE_VEC4S;
-        return bitcast<u32>(instance_data[b + 7u].w) + stored - bitcast<u32>(instance_data[b + 8u].w);
+        return records[b + 7u].w + stored - records[b + 8u].w;
     }
     return stored;
 }

@@ -225,10 +225,15 @@ impl LensRays {
             ctx.queue.submit([encoder.finish()]);
         })?;
         let raw: Vec<[f32; 4]> = ctx.read_buffer(&self.directions)?;
-        Ok(raw
-            .into_iter()
-            .map(|v| flagged(v, v[3]).then(|| Vec3::new(v[0], v[1], v[2])))
-            .collect())
+        Ok(Self::decode(&raw))
+    }
+
+    /// The directions in the table's contents, as [`LensRays::compute`] gives them (for a
+    /// caller that reads the table back itself, as a web page must).
+    pub fn decode(raw: &[[f32; 4]]) -> Vec<Option<Vec3>> {
+        raw.iter()
+            .map(|v| flagged(*v, v[3]).then(|| Vec3::new(v[0], v[1], v[2])))
+            .collect()
     }
 }
 

@@ -17,6 +17,7 @@ pub mod points;
 pub mod prescription;
 mod shutter;
 mod spec;
+pub mod twin;
 
 pub use calibrated::{CalibratedLens, CalibratedModel, Intrinsics, newton_bound, solve};
 pub use camera::{DirectionFormula, ImageSize, LensCamera, MAX_IMAGE_SIDE};

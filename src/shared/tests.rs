@@ -85,6 +85,9 @@ fn gpu_structs_match_their_wgsl_twins() {
             ("light_count", offset_of!(Shading, light_count)),
             ("ambient", offset_of!(Shading, ambient)),
             ("max_depth", offset_of!(Shading, max_depth)),
+            ("lights_at", offset_of!(Shading, lights_at)),
+            ("materials_at", offset_of!(Shading, materials_at)),
+            ("pad", offset_of!(Shading, pad)),
         ],
     );
     assert_wgsl_layout(

@@ -10,7 +10,8 @@ use crate::gpu::{GpuContext, bind_buffers, storage_entry, uniform_entry};
 use crate::scene::{Camera, Features, Scene};
 use crate::shared::TRACE_STORAGE_BUFFERS;
 use crate::shared::{
-    Frame, GpuLight, GpuMaterial, LIGHT_KINDS, MAX_DEPTH_LIMIT, NO_TEXTURE, Shading,
+    Frame, GpuLight, GpuMaterial, LIGHT_KINDS, LIGHT_VEC4S, MATERIAL_VEC4S, MAX_DEPTH_LIMIT,
+    NO_TEXTURE, Shading,
 };
 use crate::split::{SceneArrays, Split};
 use bytemuck::Pod;
@@ -138,12 +139,7 @@ fn chunked_storage<T: Pod>(
 }
 
 /// A storage buffer holding `data`, or one zero element where `data` is empty (bindings may
-/// not be empty), checked against the binding limit.
-fn storage<T: Pod>(ctx: &GpuContext, label: &str, data: &[T]) -> Result<wgpu::Buffer> {
-    storage_for(ctx, label, data, wgpu::BufferUsages::empty())
-}
-
-/// As [`storage`], with `extra` usages.
+/// not be empty), checked against the binding limit, with `extra` usages.
 fn storage_for<T: Pod>(
     ctx: &GpuContext,
     label: &str,
@@ -201,7 +197,7 @@ pub struct GpuScene {
     /// The camera-to-world rotation.
     pub(super) frame: Frame,
     /// Where instances move: their top level, and the buffers [`GpuScene::place_at`] writes
-    /// it to (the nodes' first chunk, the instances).
+    /// it to (the nodes' first chunk, the records, which begin with the instances).
     moving: Option<(crate::bvh::TopLevel, wgpu::Buffer, wgpu::Buffer)>,
 }
 
@@ -260,12 +256,24 @@ impl GpuScene {
         let bvh = SceneBvh::build(scene, origin, options.bvh)?;
         let arrays = plan(bvh.nodes.len() as u64, bvh.triangles.len() as u64);
         check_bindings(ctx, &arrays, stored)?;
-        // The textures' texels one after another, and where each begins.
+        // The scene's records (`records` in wgsl/triangles.wgsl), in vec4s of words: the
+        // instances, with room for every one to show at some time and for moving ones' knots;
+        // the lights; the materials; the textures' texels one after another.
+        let mut records: Vec<[u32; 4]> = bytemuck::cast_slice(&bvh.instances).to_vec();
+        if let Some(top) = &bvh.top {
+            let knots = top.knot_capacity(scene) as u32 * crate::shared::KNOT_VEC4S;
+            records.resize((top.knots_at() + knots) as usize, [0; 4]);
+        }
+        let instance_bytes = 16 * records.len() as u64;
+        let (lights, shadow_layers) = gpu_lights(scene, origin)?;
+        let lights_at = records.len() as u32;
+        let materials_at = lights_at + LIGHT_VEC4S * lights.len() as u32;
+        let texels_at = 4 * (materials_at + MATERIAL_VEC4S * scene.materials.len() as u32);
         let mut texels: Vec<u32> = Vec::new();
         let mut placed = Vec::new();
         if features.textures {
             for t in &scene.textures {
-                placed.push((texels.len() as u32, t.width, t.height));
+                placed.push((texels_at + texels.len() as u32, t.width, t.height));
                 texels.extend(bytemuck::cast_slice::<u8, u32>(&t.rgba));
             }
         }
@@ -293,12 +301,19 @@ impl GpuScene {
                 }
             })
             .collect();
-        let (lights, shadow_layers) = gpu_lights(scene, origin)?;
+        records.extend_from_slice(bytemuck::cast_slice(&lights));
+        records.extend_from_slice(bytemuck::cast_slice(&materials));
+        let texel_bytes = 4 * texels.len() as u64;
+        texels.resize(texels.len().next_multiple_of(4), 0);
+        records.extend(texels.chunks_exact(4).map(|w| [w[0], w[1], w[2], w[3]]));
         let shading = Shading {
             sky: to3(scene.sky),
             light_count: lights.len() as u32,
             ambient: to3(scene.ambient),
             max_depth: options.max_depth,
+            lights_at,
+            materials_at,
+            pad: [0; 2],
         };
         let frame = frame_for(origin, &scene.camera);
 
@@ -334,18 +349,7 @@ impl GpuScene {
             &arrays.vertices,
             none,
         )?;
-        // Lights, then materials (`light_at` and `material_at` in wgsl/surface.wgsl).
-        let mut surfaces: Vec<u32> = bytemuck::cast_slice(&lights).to_vec();
-        surfaces.extend_from_slice(bytemuck::cast_slice(&materials));
-        let surfaces = storage(ctx, "fisheye.scene.surfaces", &surfaces)?;
-        let texels = storage(ctx, "fisheye.scene.texels", &texels)?;
-        // Room for every instance to show at some time, and for moving ones' knots.
-        let mut instance_data: Vec<[f32; 4]> = bytemuck::cast_slice(&bvh.instances).to_vec();
-        if let Some(top) = &bvh.top {
-            let knots = top.knot_capacity(scene) as u32 * crate::shared::KNOT_VEC4S;
-            instance_data.resize((top.knots_at() + knots) as usize, [0.0; 4]);
-        }
-        let instances = storage_for(ctx, "fisheye.scene.instances", &instance_data, rewritten)?;
+        let records = storage_for(ctx, "fisheye.scene.records", &records, rewritten)?;
         let scene = ctx.checked("uploading the scene", || {
             let device = &ctx.device;
             let uniform = crate::gpu::buffer_init(
@@ -356,26 +360,19 @@ impl GpuScene {
             );
             // Binding order = @binding(n) order in wgsl/triangles.wgsl, wgsl/surface.wgsl and
             // the generated scene_arrays (`split::SceneArrays::bindings`: each array's first
-            // chunk at 0, 1 and 3, the others from 7 on); the rasterizer reads them in its
+            // chunk at 0, 1 and 3, the others from 5 on); the rasterizer reads them in its
             // vertex and fragment stages.
-            let resources: Vec<&wgpu::Buffer> = [
-                &nodes[0],
-                &triangles[0],
-                &surfaces,
-                &vertices[0],
-                &texels,
-                &uniform,
-                &instances,
-            ]
-            .into_iter()
-            .chain(nodes[1..].iter())
-            .chain(triangles[1..].iter())
-            .chain(vertices[1..].iter())
-            .collect();
+            let resources: Vec<&wgpu::Buffer> =
+                [&nodes[0], &triangles[0], &records, &vertices[0], &uniform]
+                    .into_iter()
+                    .chain(nodes[1..].iter())
+                    .chain(triangles[1..].iter())
+                    .chain(vertices[1..].iter())
+                    .collect();
             let mut entries: Vec<_> = (0..resources.len() as u32)
                 .map(|b| storage_entry(b, true))
                 .collect();
-            entries[5] = uniform_entry(5);
+            entries[4] = uniform_entry(4);
             for entry in &mut entries {
                 entry.visibility = crate::gpu::ALL_STAGES;
             }
@@ -390,12 +387,10 @@ impl GpuScene {
             let size =
                 |buffers: &[wgpu::Buffer]| buffers.iter().map(wgpu::Buffer::size).sum::<u64>();
             let bytes = SceneBytes {
-                // The instances' buffer holds one unused element in a flat scene.
-                bvh: size(&nodes)
-                    + (size_of::<crate::bvh::GpuInstance>() * bvh.instances.len()) as u64,
+                bvh: size(&nodes) + instance_bytes,
                 geometry: size(&triangles),
-                shading: surfaces.size() + size(&vertices),
-                textures: texels.size(),
+                shading: records.size() - instance_bytes - texel_bytes + size(&vertices),
+                textures: texel_bytes,
             };
             Self {
                 layout,
@@ -415,9 +410,7 @@ impl GpuScene {
                 bvh_build_time: bvh.build_time,
                 bytes,
                 frame,
-                moving: bvh
-                    .top
-                    .map(|top| (top, nodes[0].clone(), instances.clone())),
+                moving: bvh.top.map(|top| (top, nodes[0].clone(), records.clone())),
             }
         })?;
         // Surfaces a failed acceleration-structure build here rather than at the first frame.
@@ -443,7 +436,7 @@ impl GpuScene {
             return Ok(());
         }
         // Only a scene flattened for ray queries moves without a top level.
-        let Some((top, nodes, instances)) = &self.moving else {
+        let Some((top, nodes, records)) = &self.moving else {
             return Err(Error::Limit(
                 "moving instances are placed by the BVH traversal; ray queries take the scene \
                  flattened once (use the software traversal)"
@@ -455,12 +448,12 @@ impl GpuScene {
             .write_buffer(nodes, 0, bytemuck::cast_slice(&built.nodes));
         if !built.instances.is_empty() {
             ctx.queue
-                .write_buffer(instances, 0, bytemuck::cast_slice(&built.instances));
+                .write_buffer(records, 0, bytemuck::cast_slice(&built.instances));
         }
         if !built.knots.is_empty() {
             let at = u64::from(top.knots_at()) * 16;
             ctx.queue
-                .write_buffer(instances, at, bytemuck::cast_slice(&built.knots));
+                .write_buffer(records, at, bytemuck::cast_slice(&built.knots));
         }
         Ok(())
     }

@@ -17,9 +17,12 @@ use std::rc::Rc;
 use std::sync::{Arc, Mutex};
 use std::task::{Context, Poll, Waker};
 
+use fisheye_rt::gpu::GpuContext;
 use fisheye_rt::input::InputKind;
-use fisheye_rt::lens::ImageSize;
 use fisheye_rt::lens::glass::camera_for;
+use fisheye_rt::lens::gpu::LensRays;
+use fisheye_rt::lens::twin::TwinCheck;
+use fisheye_rt::lens::{ImageSize, LensCamera, parse_spec};
 use fisheye_rt::renderer::Renderer;
 use fisheye_rt::scene::{self, Scene};
 use fisheye_rt::trace::{Display, RenderOptions, Sampling, Tone, auto_exposure, colour_image_with};
@@ -95,6 +98,19 @@ impl Fisheye {
             queue,
             adapter: adapter_name,
             errors,
+        })
+    }
+
+    /// Checks the WGSL lens code against the f64 reference at every pixel of `lens` (a spec)
+    /// at `size` (`WxH`), on this device: resolves to `{lens, rays, max_error, max_ratio,
+    /// max_error_well_conditioned, holds, why}` (radians; `max_ratio` is the largest error
+    /// over its pixel's bound, `holds` whether the twin keeps its bounds and `why` not);
+    /// rejects where the masks differ or a direction is not finite.
+    pub fn lens_twin(&self, lens: String, size: String) -> js_sys::Promise {
+        let (device, queue, errors) =
+            (self.device.clone(), self.queue.clone(), self.errors.clone());
+        wasm_bindgen_futures::future_to_promise(async move {
+            lens_twin(&device, &queue, &errors, &lens, &size).await
         })
     }
 
@@ -251,32 +267,14 @@ impl Request {
             extent,
         );
         let started = js_sys::Date::now();
-        queue.submit([encoder.finish()]);
-        let mapped = Mapped::default();
-        let done = mapped.clone();
-        staging
-            .slice(..)
-            .map_async(wgpu::MapMode::Read, move |result| done.set(result));
-        mapped
-            .await
-            .map_err(|e| error(format!("reading the image back: {e}")))?;
+        let data = submit_and_read(queue, encoder, &staging, errors).await?;
         let gpu_ms = js_sys::Date::now() - started;
-        if let Some(first) = errors.lock().unwrap().drain(..).next() {
-            return Err(error(format!("WebGPU: {first}")));
-        }
         let mut colour = Vec::with_capacity(size.pixels());
-        {
-            let data = staging
-                .slice(..)
-                .get_mapped_range()
-                .map_err(|e| error(format!("reading the image back: {e}")))?;
-            for r in data.chunks(row as usize) {
-                colour.extend(bytemuck::pod_collect_to_vec::<u8, [f32; 4]>(
-                    &r[..16 * width as usize],
-                ));
-            }
+        for r in data.chunks(row as usize) {
+            colour.extend(bytemuck::pod_collect_to_vec::<u8, [f32; 4]>(
+                &r[..16 * width as usize],
+            ));
         }
-        staging.unmap();
         // As `fisheye render`'s PNG: bare meshes, lit by the headlight and sun it adds, at the
         // exposure that maps their log-average luminance to middle grey; the ACES curve.
         let exposure = match scene.headlight {
@@ -360,6 +358,80 @@ fn file_key(path: &Path) -> String {
         .map(|c| c.as_os_str().to_string_lossy().into_owned())
         .collect();
     parts.join("/")
+}
+
+/// Submits `encoder`, whose last command fills `staging` (`MAP_READ`), and resolves to
+/// `staging`'s bytes once they are on the CPU; rejects with the first WebGPU error raised
+/// meanwhile.
+async fn submit_and_read(
+    queue: &wgpu::Queue,
+    encoder: wgpu::CommandEncoder,
+    staging: &wgpu::Buffer,
+    errors: &Mutex<Vec<String>>,
+) -> Result<Vec<u8>, JsValue> {
+    queue.submit([encoder.finish()]);
+    let mapped = Mapped::default();
+    let done = mapped.clone();
+    staging
+        .slice(..)
+        .map_async(wgpu::MapMode::Read, move |result| done.set(result));
+    mapped
+        .await
+        .map_err(|e| error(format!("reading back from the GPU: {e}")))?;
+    if let Some(first) = errors.lock().unwrap().drain(..).next() {
+        return Err(error(format!("WebGPU: {first}")));
+    }
+    let bytes = staging
+        .slice(..)
+        .get_mapped_range()
+        .map_err(|e| error(format!("reading back from the GPU: {e}")))?
+        .to_vec();
+    staging.unmap();
+    Ok(bytes)
+}
+
+/// The WGSL lens twin against the f64 reference in the page: every pixel's direction of
+/// `lens` (a spec) at `size` (`WxH`), computed by the lens kernel on this device and read
+/// back, compared with the library's f64 reference, compiled to wasm, by
+/// `fisheye_rt::lens::twin` (as `tests/lens_gpu.rs` compares them natively).
+async fn lens_twin(
+    device: &wgpu::Device,
+    queue: &wgpu::Queue,
+    errors: &Mutex<Vec<String>>,
+    lens: &str,
+    size: &str,
+) -> Result<JsValue, JsValue> {
+    let size: ImageSize = size.parse().map_err(|e| error(format!("size: {e}")))?;
+    let spec = parse_spec(lens).map_err(|e| error(format!("lens: {e}")))?;
+    let camera = LensCamera::new(spec, size);
+    let ctx = GpuContext::from_device(device, queue);
+    let rays = LensRays::new(&ctx, &camera).map_err(error)?;
+    let staging = device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("fisheye.web.directions"),
+        size: rays.directions.size(),
+        usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
+        mapped_at_creation: false,
+    });
+    let mut encoder = device.create_command_encoder(&Default::default());
+    rays.encode(&mut encoder, None);
+    encoder.copy_buffer_to_buffer(&rays.directions, 0, &staging, 0, staging.size());
+    let bytes = submit_and_read(queue, encoder, &staging, errors).await?;
+    let gpu = LensRays::decode(&bytemuck::pod_collect_to_vec::<u8, [f32; 4]>(&bytes));
+    let check = TwinCheck::new(&camera, &gpu).map_err(error)?;
+    let out = Object::new();
+    let set = |key: &str, value: JsValue| Reflect::set(&out, &key.into(), &value);
+    set("lens", camera.lens.to_string().into())?;
+    set("rays", (check.valid as u32).into())?;
+    set("max_error", check.max_error.into())?;
+    set("max_ratio", check.max_ratio.into())?;
+    set(
+        "max_error_well_conditioned",
+        check.max_error_well_conditioned.into(),
+    )?;
+    let verdict = check.holds();
+    set("holds", verdict.is_ok().into())?;
+    set("why", verdict.err().unwrap_or_default().into())?;
+    Ok(out.into())
 }
 
 /// The outcome of `map_async`, awaited: its callback fills the slot and wakes the task.

@@ -185,6 +185,33 @@ for (const [k, c] of cases.entries()) {
   }
 }
 
+// The lens twins in the page: the WGSL lens code on SwiftShader against the f64 reference
+// compiled to wasm, at every pixel, within `fisheye_rt::lens::twin`'s bounds (those
+// tests/lens_gpu.rs holds lavapipe to): every classic model, every preset, every calibrated
+// model's example.
+const twins = await page.evaluate(() => window.fisheye.lenses());
+const twinSpecs = [
+  "rectilinear:f=0.5",
+  "stereographic:f=0.3",
+  "equidistant:f=0.3",
+  "equisolid:f=0.45",
+  "orthographic:f=0.66",
+  "general:f=0.5,k1=0.5,k2=0.5",
+  "general:f=0.5,k1=0.5,k2=-0.5",
+  ...twins.map(([spec]) => spec).filter((spec) => !spec.includes(":") || spec.includes("fx=") || spec.includes("cx=")),
+];
+for (const spec of twinSpecs) {
+  const size = spec.startsWith("radtan") ? "752x480" : spec.includes("cx=") ? "512x512" : "256x192";
+  const twin = await page
+    .evaluate(([l, s]) => window.fisheye.lensTwin(l, s), [spec, size])
+    .catch((e) => ({ holds: false, why: String(e.message ?? e), rays: 0 }));
+  check(
+    twin.holds && twin.rays > 1000,
+    `lens twin ${spec.split(":")[0]} at ${size}: ${twin.rays} rays, max error ` +
+      `${twin.max_error?.toExponential(2)} rad, ${twin.max_ratio?.toFixed(2)} of the bound ${twin.why}`,
+  );
+}
+
 // The MTL beside the OBJ was fetched: the Cornell box's red wall is red, as natively (the
 // comparison above); and no warning said a file was missing.
 const cornell = await pageRender(cases[2]);
@@ -224,6 +251,22 @@ const refusedLens = await page.evaluate(() =>
 check(refusedLens.includes("fisheye-from-nowhere"), `an unknown lens is named: ${refusedLens}`);
 const after = await pageRender({ scene: "builtin:default", lens: "canon-8-15mm@8mm", size: "64x48", spp: 1 });
 check(after.width === 64 && after.height === 48, "the page renders after bad input");
+
+// With TIMINGS=N, each of the book's timed frames is rendered N times and the median of all
+// but the first printed (submission to pixels).
+if (process.env.TIMINGS) {
+  const timed = [
+    { scene: "builtin:default", lens: "samyang-7.5mm", size: "256x192", spp: 4 },
+    { scene: "builtin:default", lens: "canon-8-15mm@8mm", size: "1024x768", spp: 1 },
+  ];
+  for (const opts of timed) {
+    const ms = [];
+    for (let i = 0; i < Number(process.env.TIMINGS); i++) ms.push((await pageRender(opts)).gpu_ms);
+    const later = ms.slice(1).sort((a, b) => a - b);
+    const median = later[Math.floor(later.length / 2)];
+    console.log(`timing ${opts.lens} ${opts.size} spp ${opts.spp}: first ${ms[0].toFixed(0)} ms, median of the rest ${median.toFixed(0)} ms`);
+  }
+}
 
 // With SCREENSHOT=FILE, the page as a user sees it after rendering the default room (the
 // README's picture).
