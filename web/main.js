@@ -70,25 +70,28 @@ async function companion(source, name) {
   }
 }
 
-// Renders as `fisheye render` does; resolves to {width, height, rgba, gpu_ms, camera,
-// warnings}.
-async function render(opts = {}) {
+// A view of what `opts` asks (the scene loaded, its BVH built and uploaded, the kernels
+// made), whose `frame(camera, progressive)` renders it; `steps` is the most frames a
+// progressive refinement takes.
+async function open(opts = {}) {
   const device = await ready;
   const source = await sceneOf(opts);
-  const lens = opts.lens ?? DEFAULTS.lens;
-  const size = opts.size ?? DEFAULTS.size;
-  const spp = String(opts.spp ?? DEFAULTS.spp);
-  const camera = opts.camera ?? "";
+  const asked = {
+    name: source.name,
+    lens: opts.lens ?? DEFAULTS.lens,
+    size: opts.size ?? DEFAULTS.size,
+    spp: String(opts.spp ?? DEFAULTS.spp),
+    camera: opts.camera ?? "",
+    complete: false,
+  };
   // The loaders name the files a scene needs (MTL, textures, glTF buffers) as they read it:
   // each round finds among the dropped files, or fetches, those it missed; once none of
   // them can be had, the scene is loaded without them (with the tool's warnings or errors).
-  let complete = false;
   for (;;) {
     try {
-      const asked = { name: source.name, lens, size, spp, camera, complete };
-      return await device.render(source.files, asked);
+      return await device.open(source.files, asked);
     } catch (error) {
-      if (complete || !error.missing?.length) throw error;
+      if (asked.complete || !error.missing?.length) throw error;
       let found = 0;
       for (const name of error.missing) {
         const bytes = await companion(source, name);
@@ -97,9 +100,16 @@ async function render(opts = {}) {
           found++;
         }
       }
-      complete = found === 0;
+      asked.complete = found === 0;
     }
   }
+}
+
+// Renders as `fisheye render` does; resolves to {width, height, rgba, gpu_ms, camera,
+// warnings}.
+async function render(opts = {}) {
+  const view = await open(opts);
+  return await view.frame("", false);
 }
 
 // The WGSL lens twin against the f64 reference (compiled to wasm) at every pixel of `lens` at
@@ -107,12 +117,15 @@ async function render(opts = {}) {
 // holds, why}.
 const lensTwin = async (lens, size) => (await ready).lens_twin(lens, size);
 
-window.fisheye = { ready, render, lensTwin, lenses: () => ready.then(() => lenses()) };
+window.fisheye = { ready, render, open, lensTwin, lenses: () => ready.then(() => lenses()) };
 
 // ---- the page's controls
 
 let picked = null; // {scene: File, files: File[]} from the picker or a drop
-let pose = ""; // the camera after orbiting, "X,Y,Z:LX,LY,LZ"
+let view = null; // the open view, and its progress
+let pose = ""; // where the camera is, "X,Y,Z:LX,LY,LZ" ("" until the first frame)
+let step = 0;
+let busy = false;
 let last = null;
 
 function show(image) {
@@ -123,12 +136,12 @@ function show(image) {
   canvas.getContext("2d").putImageData(data, 0, 0);
 }
 
-async function draw() {
+// Opens the view the controls ask for, then refines it frame by frame.
+async function reopen() {
   const opts = {
     lens: $("lens").value.trim() || DEFAULTS.lens,
     size: $("size").value.trim() || DEFAULTS.size,
     spp: $("spp").value.trim() || DEFAULTS.spp,
-    camera: pose,
   };
   if (picked) {
     opts.scene = picked.scene;
@@ -136,41 +149,67 @@ async function draw() {
   } else {
     opts.scene = $("scene").value;
   }
-  say("rendering…");
+  say("loading the scene and building its BVH…");
+  view = null;
   try {
     const started = performance.now();
-    last = await render(opts);
+    view = await open(opts);
+    say(`ready in ${(performance.now() - started).toFixed(0)} ms; rendering…`);
+  } catch (error) {
+    say(String(error.message ?? error), true);
+    return;
+  }
+  pose = "";
+  step = 0;
+  tick();
+}
+
+// The next frame while the view has steps left at this pose: the first at a pose is whole (or
+// coarse, with adaptive sampling), each later one sharpens it.
+async function tick() {
+  if (busy || !view || step >= view.steps) return;
+  busy = true;
+  try {
+    last = await view.frame(pose, true);
+    pose = last.camera;
+    step++;
     show(last);
-    const total = performance.now() - started;
     const warned = last.warnings.length ? ` (warnings: ${last.warnings.join("; ")})` : "";
+    const progress = view.steps > 1 ? `, frame ${step} of at most ${view.steps}` : "";
     say(
-      `${last.width}×${last.height}, ${opts.spp} rays a pixel: ${last.gpu_ms.toFixed(1)} ms ` +
-        `from submission to pixels, ${total.toFixed(0)} ms with loading and BVH${warned}`,
+      `${last.width}×${last.height}${progress}: ${last.gpu_ms.toFixed(1)} ms from submission ` +
+        `to pixels${warned}`,
     );
   } catch (error) {
     say(String(error.message ?? error), true);
+    step = view.steps;
   }
+  busy = false;
+  requestAnimationFrame(tick);
 }
 
+// Turns the camera about its look-at point by a drag of (dx, dy) pixels; refinement restarts.
 function orbit(dx, dy) {
-  if (!last?.camera) return;
-  const [eye, at] = last.camera.split(":").map((t) => t.split(",").map(Number));
+  if (!pose) return;
+  const [eye, at] = pose.split(":").map((t) => t.split(",").map(Number));
   const v = eye.map((e, i) => e - at[i]);
   const r = Math.hypot(...v);
-  let yaw = Math.atan2(v[0], v[2]) - dx * 0.01;
-  let pitch = Math.asin(v[1] / r) + dy * 0.01;
-  pitch = Math.max(-1.5, Math.min(1.5, pitch));
+  const yaw = Math.atan2(v[0], v[2]) - dx * 0.01;
+  const pitch = Math.max(-1.5, Math.min(1.5, Math.asin(v[1] / r) + dy * 0.01));
   const e = [
     at[0] + r * Math.cos(pitch) * Math.sin(yaw),
     at[1] + r * Math.sin(pitch),
     at[2] + r * Math.cos(pitch) * Math.cos(yaw),
   ];
   pose = `${e.join(",")}:${at.join(",")}`;
+  step = 0;
+  tick();
 }
 
 async function setUp() {
+  let device;
   try {
-    const device = await ready;
+    device = await ready;
     $("adapter").textContent = device.adapter || "this browser's WebGPU adapter";
   } catch (error) {
     say(String(error.message ?? error), true);
@@ -184,7 +223,9 @@ async function setUp() {
     option.textContent = about;
     list.append(option);
   }
-  $("render").onclick = draw;
+  // Progressive refinement needs adaptive sampling, which binds 10 storage buffers.
+  if (device.storage_buffers < 10) $("spp").value = DEFAULTS.spp;
+  $("render").onclick = reopen;
   $("save").onclick = () => {
     $("view").toBlob((blob) => {
       const a = document.createElement("a");
@@ -198,16 +239,14 @@ async function setUp() {
     const scene = all.find((f) => /\.(obj|gltf|glb)$/i.test(f.name));
     if (!scene) return say("drop an .obj (with its .mtl and textures), .gltf or .glb file", true);
     picked = { scene, files: all };
-    pose = "";
     $("picked").textContent = all.map((f) => f.name).join(", ");
-    draw();
+    reopen();
   };
   $("file").onchange = (e) => take(e.target.files);
   $("scene").onchange = () => {
     picked = null;
-    pose = "";
     $("picked").textContent = "";
-    draw();
+    reopen();
   };
   document.body.ondragover = (e) => e.preventDefault();
   document.body.ondrop = (e) => {
@@ -216,13 +255,13 @@ async function setUp() {
   };
   let drag = null;
   $("view").onpointerdown = (e) => (drag = [e.clientX, e.clientY]);
-  window.onpointerup = (e) => {
-    if (!drag) return;
+  window.onpointermove = (e) => {
+    if (!drag || busy) return;
     orbit(e.clientX - drag[0], e.clientY - drag[1]);
-    drag = null;
-    draw();
+    drag = [e.clientX, e.clientY];
   };
-  draw();
+  window.onpointerup = () => (drag = null);
+  reopen();
 }
 
 setUp();

@@ -332,7 +332,7 @@ fn classify(@builtin(global_invocation_id) id: vec3<u32>, @builtin(local_invocat
                 let d = corner(c11);
                 refine = !(same_surface(a, b) && same_surface(a, c) && same_surface(b, d)
                     && same_surface(c, d) && same_surface(a, d) && same_surface(b, c))
-                    || lattice_near(l, true) && !block_mask_is(first, end, true);
+                    || (lattice_near(l, true) && !block_mask_is(first, end, true));
             }
         }
         for (var y = first.y; y < end.y; y++) {

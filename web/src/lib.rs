@@ -1,8 +1,8 @@
 //! fisheye-rt in a web page: the library, compiled to wasm32-unknown-unknown, renders on the
 //! browser's WebGPU with the same WGSL kernels as natively, and hands the page the 8-bit sRGB
-//! image `fisheye render` writes as PNG for the same arguments. `web/main.js` wraps this in
-//! the page's `window.fisheye` (`ready`, `render(opts)`); `bash web/build` builds both into
-//! `web/dist/`.
+//! image `fisheye render` writes as PNG for the same arguments, or a progressive refinement
+//! of it frame by frame. `web/main.js` wraps this in the page's `window.fisheye` (`ready`,
+//! `render(opts)`, `open(opts)`); `bash web/build` builds both into `web/dist/`.
 //!
 //! A page cannot block: the device is requested and the image read back by awaiting
 //! WebGPU's promises, never by polling.
@@ -114,26 +114,31 @@ impl Fisheye {
         })
     }
 
+    /// The storage buffers a shader stage may bind on this device: adaptive sampling (and so
+    /// progressive refinement) needs 10, the trace kernel 8.
+    #[wasm_bindgen(getter)]
+    pub fn storage_buffers(&self) -> u32 {
+        self.device.limits().max_storage_buffers_per_shader_stage
+    }
+
     /// The adapter's name (and driver, where the browser says).
     #[wasm_bindgen(getter)]
     pub fn adapter(&self) -> String {
         self.adapter.clone()
     }
 
-    /// Renders as `fisheye render` does what `opts` asks: `{name, lens, size, spp, camera,
-    /// complete}`, strings but the last: the scene `name` (`builtin:NAME`, or a file in `files`
-    /// ending `.obj`, `.gltf`, `.glb` or `.toml`; `files` maps names to their bytes, the
-    /// scene's and those it names) through `lens` at `size` (`WxH`) with `spp`
-    /// (`render --spp`'s forms) from `camera` (`render --camera`'s forms; the scene's own if
-    /// empty).
-    /// Resolves to `{width, height, rgba, gpu_ms, camera, warnings}`: the PNG's 8-bit sRGB
-    /// pixels, the milliseconds from submission to the pixels' arrival on the CPU, the pose
-    /// (as `camera` takes it) and what the loaders warned of. Rejects with an `Error` whose
-    /// message says what is wrong. Until `complete`, a scene that names files not in `files`
-    /// (an OBJ's MTL, textures, glTF buffers) is refused with an `Error` whose `missing` lists
-    /// them, even where it would load without them (the page fetches them and tries again);
-    /// once `complete`, those still missing are missing, as they are to `fisheye render`.
-    pub fn render(&self, files: js_sys::Map, opts: Object) -> js_sys::Promise {
+    /// Opens a view of what `opts` asks, as `fisheye render` would render it: `{name, lens,
+    /// size, spp, camera, complete}`, strings but the last: the scene `name` (`builtin:NAME`,
+    /// or a file in `files` ending `.obj`, `.gltf`, `.glb` or `.toml`; `files` maps names to
+    /// their bytes, the scene's and those it names) through `lens` at `size` (`WxH`) with
+    /// `spp` (`render --spp`'s forms) from `camera` (`render --camera`'s forms; the scene's
+    /// own if empty). The scene is loaded, its BVH built and uploaded, the kernels made; a
+    /// [`View`] renders frames of it. Rejects with an `Error` whose message says what is
+    /// wrong. Until `complete`, a scene that names files not in `files` (an OBJ's MTL,
+    /// textures, glTF buffers) is refused with an `Error` whose `missing` lists them, even
+    /// where it would load without them (the page fetches them and tries again); once
+    /// `complete`, those still missing are missing, as they are to `fisheye render`.
+    pub fn open(&self, files: js_sys::Map, opts: Object) -> js_sys::Promise {
         let (device, queue, errors) =
             (self.device.clone(), self.queue.clone(), self.errors.clone());
         let mut bytes = HashMap::new();
@@ -158,7 +163,47 @@ impl Fisheye {
             complete: Reflect::get(&opts, &"complete".into()).is_ok_and(|v| v.is_truthy()),
         };
         wasm_bindgen_futures::future_to_promise(async move {
-            let image = request.render(&device, &queue, &errors).await?;
+            let view = request.open(device, queue, errors)?;
+            Ok(JsValue::from(View {
+                inner: Rc::new(view),
+            }))
+        })
+    }
+}
+
+/// A scene through a lens on the device, ready for frames.
+#[wasm_bindgen]
+pub struct View {
+    inner: Rc<ViewInner>,
+}
+
+struct ViewInner {
+    device: wgpu::Device,
+    queue: wgpu::Queue,
+    errors: Arc<Mutex<Vec<String>>>,
+    scene: Scene,
+    warnings: Vec<String>,
+    size: ImageSize,
+    renderer: Renderer,
+    target: wgpu::Texture,
+    /// The frames a progressive refinement takes at most (1 where it is not progressive).
+    steps: u32,
+}
+
+#[wasm_bindgen]
+impl View {
+    /// A frame from `camera` (`render --camera`'s forms; the view's first pose if empty):
+    /// the whole frame, or with `progressive` the next step of a progressive refinement
+    /// (`Renderer::encode_progressive`: with adaptive sampling the first frame at a pose is
+    /// the coarse one and each frame after it at the same pose sharpens it, until the whole
+    /// frame, bit for bit, after at most [`View::steps`]; a new pose starts again). Resolves
+    /// to `{width, height, rgba, gpu_ms, camera, warnings}`: the PNG's 8-bit sRGB pixels, the
+    /// milliseconds from submission to the pixels' arrival on the CPU, the pose (as `camera`
+    /// takes it) and what loading the scene warned of. Record one frame at a time.
+    pub fn frame(&self, camera: String, progressive: bool) -> js_sys::Promise {
+        let inner = self.inner.clone();
+        wasm_bindgen_futures::future_to_promise(async move {
+            let image = inner.frame(&camera, progressive).await?;
             let out = Object::new();
             let set = |key: &str, value: JsValue| Reflect::set(&out, &key.into(), &value);
             set("width", image.size.width.into())?;
@@ -166,14 +211,22 @@ impl Fisheye {
             set("rgba", Uint8Array::from(&image.rgba[..]).into())?;
             set("gpu_ms", image.gpu_ms.into())?;
             set("camera", image.camera.into())?;
-            let warnings: Array = image.warnings.into_iter().map(JsValue::from).collect();
+            let warnings: Array = inner.warnings.iter().map(JsValue::from).collect();
             set("warnings", warnings.into())?;
             Ok(out.into())
         })
     }
+
+    /// The frames a progressive refinement takes at most: 2 + the most samples a pixel with
+    /// adaptive sampling (the coarse frame, the estimate, then about one ray a pixel a
+    /// frame), 1 with uniform sampling (its whole frame at once).
+    #[wasm_bindgen(getter)]
+    pub fn steps(&self) -> u32 {
+        self.inner.steps
+    }
 }
 
-/// What `render` was asked.
+/// What `open` was asked.
 struct Request {
     name: String,
     files: HashMap<String, Vec<u8>>,
@@ -191,8 +244,6 @@ struct Image {
     gpu_ms: f64,
     /// The pose it was seen from, as `camera` takes it.
     camera: String,
-    /// What loading the scene warned of.
-    warnings: Vec<String>,
 }
 
 /// A JavaScript `Error` with `message`.
@@ -201,18 +252,19 @@ fn error(message: impl std::fmt::Display) -> JsValue {
 }
 
 impl Request {
-    async fn render(
+    fn open(
         &self,
-        device: &wgpu::Device,
-        queue: &wgpu::Queue,
-        errors: &Mutex<Vec<String>>,
-    ) -> Result<Image, JsValue> {
+        device: wgpu::Device,
+        queue: wgpu::Queue,
+        errors: Arc<Mutex<Vec<String>>>,
+    ) -> Result<ViewInner, JsValue> {
         let size: ImageSize = self.size.parse().map_err(|e| error(format!("size: {e}")))?;
         let sampling: Sampling = self.spp.parse().map_err(|e| error(format!("spp: {e}")))?;
         let camera = camera_for(&self.lens, size).map_err(|e| error(format!("lens: {e}")))?;
         let (mut scene, warnings) = self.scene()?;
         scene.frame_for(&camera);
         if !self.camera.is_empty() {
+            // Before the upload, as `fisheye render --camera`: a headlight goes with it.
             let pose = scene.parse_camera(&self.camera).map_err(error)?;
             scene.set_camera(pose);
         }
@@ -224,16 +276,14 @@ impl Request {
         };
         let format = wgpu::TextureFormat::Rgba32Float;
         let renderer =
-            Renderer::new(device, queue, &scene, &camera, &options, format).map_err(error)?;
-        let (width, height) = (size.width, size.height);
-        let extent = wgpu::Extent3d {
-            width,
-            height,
-            depth_or_array_layers: 1,
-        };
+            Renderer::new(&device, &queue, &scene, &camera, &options, format).map_err(error)?;
         let target = device.create_texture(&wgpu::TextureDescriptor {
             label: Some("fisheye.web.image"),
-            size: extent,
+            size: wgpu::Extent3d {
+                width: size.width,
+                height: size.height,
+                depth_or_array_layers: 1,
+            },
             mip_level_count: 1,
             sample_count: 1,
             dimension: wgpu::TextureDimension::D2,
@@ -241,64 +291,16 @@ impl Request {
             usage: wgpu::TextureUsages::STORAGE_BINDING | wgpu::TextureUsages::COPY_SRC,
             view_formats: &[],
         });
-        // Rows padded to WebGPU's copy alignment.
-        let row = (16 * width).next_multiple_of(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT);
-        let staging = device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("fisheye.web.read_back"),
-            size: u64::from(row) * u64::from(height),
-            usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
-            mapped_at_creation: false,
-        });
-        let pose = scene.camera;
-        let mut encoder = device.create_command_encoder(&Default::default());
-        renderer
-            .encode(&mut encoder, &pose, &target)
-            .map_err(error)?;
-        encoder.copy_texture_to_buffer(
-            target.as_image_copy(),
-            wgpu::TexelCopyBufferInfo {
-                buffer: &staging,
-                layout: wgpu::TexelCopyBufferLayout {
-                    offset: 0,
-                    bytes_per_row: Some(row),
-                    rows_per_image: Some(height),
-                },
-            },
-            extent,
-        );
-        let started = js_sys::Date::now();
-        let data = submit_and_read(queue, encoder, &staging, errors).await?;
-        let gpu_ms = js_sys::Date::now() - started;
-        let mut colour = Vec::with_capacity(size.pixels());
-        for r in data.chunks(row as usize) {
-            colour.extend(bytemuck::pod_collect_to_vec::<u8, [f32; 4]>(
-                &r[..16 * width as usize],
-            ));
-        }
-        // As `fisheye render`'s PNG: bare meshes, lit by the headlight and sun it adds, at the
-        // exposure that maps their log-average luminance to middle grey; the ACES curve.
-        let exposure = match scene.headlight {
-            Some(_) => auto_exposure(&colour),
-            None => 0.0,
-        };
-        let display = Display {
-            exposure,
-            tone: Tone::Aces,
-        };
-        Ok(Image {
-            size,
-            rgba: colour_image_with(size, &colour, &display).into_raw(),
-            gpu_ms,
+        Ok(ViewInner {
+            device,
+            queue,
+            errors,
+            scene,
             warnings,
-            camera: format!(
-                "{},{},{}:{},{},{}",
-                pose.position.x,
-                pose.position.y,
-                pose.position.z,
-                pose.look_at.x,
-                pose.look_at.y,
-                pose.look_at.z
-            ),
+            size,
+            renderer,
+            target,
+            steps: if adaptive.is_some() { 2 + spp } else { 1 },
         })
     }
 
@@ -347,6 +349,75 @@ impl Request {
         let names: Array = missing.into_iter().map(JsValue::from).collect();
         let _ = Reflect::set(&out, &"missing".into(), &names);
         Err(out)
+    }
+}
+
+impl ViewInner {
+    async fn frame(&self, camera: &str, progressive: bool) -> Result<Image, JsValue> {
+        let pose = match camera {
+            "" => self.scene.camera,
+            text => self.scene.parse_camera(text).map_err(error)?,
+        };
+        let (size, device) = (self.size, &self.device);
+        // Rows padded to WebGPU's copy alignment.
+        let row = (16 * size.width).next_multiple_of(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT);
+        let staging = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("fisheye.web.read_back"),
+            size: u64::from(row) * u64::from(size.height),
+            usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
+            mapped_at_creation: false,
+        });
+        let mut encoder = device.create_command_encoder(&Default::default());
+        let encoded = match progressive {
+            true => self.renderer.encode_progressive(&mut encoder, &pose, &self.target),
+            false => self.renderer.encode(&mut encoder, &pose, &self.target),
+        };
+        encoded.map_err(error)?;
+        encoder.copy_texture_to_buffer(
+            self.target.as_image_copy(),
+            wgpu::TexelCopyBufferInfo {
+                buffer: &staging,
+                layout: wgpu::TexelCopyBufferLayout {
+                    offset: 0,
+                    bytes_per_row: Some(row),
+                    rows_per_image: Some(size.height),
+                },
+            },
+            self.target.size(),
+        );
+        let started = js_sys::Date::now();
+        let data = submit_and_read(&self.queue, encoder, &staging, &self.errors).await?;
+        let gpu_ms = js_sys::Date::now() - started;
+        let mut colour = Vec::with_capacity(size.pixels());
+        for r in data.chunks(row as usize) {
+            colour.extend(bytemuck::pod_collect_to_vec::<u8, [f32; 4]>(
+                &r[..16 * size.width as usize],
+            ));
+        }
+        // As `fisheye render`'s PNG: bare meshes, lit by the headlight and sun it adds, at the
+        // exposure that maps their log-average luminance to middle grey; the ACES curve.
+        let exposure = match self.scene.headlight {
+            Some(_) => auto_exposure(&colour),
+            None => 0.0,
+        };
+        let display = Display {
+            exposure,
+            tone: Tone::Aces,
+        };
+        Ok(Image {
+            size,
+            rgba: colour_image_with(size, &colour, &display).into_raw(),
+            gpu_ms,
+            camera: format!(
+                "{},{},{}:{},{},{}",
+                pose.position.x,
+                pose.position.y,
+                pose.position.z,
+                pose.look_at.x,
+                pose.look_at.y,
+                pose.look_at.z
+            ),
+        })
     }
 }
 

@@ -212,6 +212,38 @@ for (const spec of twinSpecs) {
   );
 }
 
+// Progressive refinement: a view with adaptive sampling shows the coarse frame first and
+// sharpens it frame by frame at the same pose, ending with the whole adaptive frame bit for
+// bit (as `fisheye render --spp auto` makes it natively); a new pose starts again.
+const progressive = await page.evaluate(async () => {
+  const opts = { scene: "builtin:default", lens: "samyang-7.5mm", size: "128x96", spp: "auto" };
+  const view = await window.fisheye.open(opts);
+  const whole = await (await window.fisheye.open(opts)).frame("", false);
+  const same = (a, b) => a.rgba.length === b.rgba.length && a.rgba.every((v, i) => v === b.rgba[i]);
+  const frames = [];
+  for (let k = 0; k < view.steps; k++) frames.push(await view.frame("", true));
+  const moved = await view.frame("0,1.5,2:0,1.2,-3", true);
+  const back = await view.frame("", true);
+  return {
+    steps: view.steps,
+    coarseDiffers: !same(frames[0], whole),
+    lastIsWhole: same(frames[frames.length - 1], whole),
+    firstSameAsWhole: frames.findIndex((f) => same(f, whole)),
+    movedDiffers: !same(moved, whole),
+    restarted: same(back, frames[0]),
+  };
+});
+check(
+  progressive.coarseDiffers && progressive.lastIsWhole && progressive.movedDiffers && progressive.restarted,
+  `progressive refinement: ${progressive.steps} frames at most, the first coarse, the whole ` +
+    `frame bit for bit from frame ${progressive.firstSameAsWhole + 1}; a move restarts it`,
+);
+compare(
+  nativeRender("builtin:default", { lens: "samyang-7.5mm", size: "128x96", spp: "auto" }, "auto"),
+  await pageRender({ scene: "builtin:default", lens: "samyang-7.5mm", size: "128x96", spp: "auto" }),
+  "builtin:default through samyang-7.5mm at 128x96, spp auto (adaptive)",
+);
+
 // The MTL beside the OBJ was fetched: the Cornell box's red wall is red, as natively (the
 // comparison above); and no warning said a file was missing.
 const cornell = await pageRender(cases[2]);
@@ -274,12 +306,12 @@ if (process.env.SCREENSHOT) {
   const fresh = await browser.newPage({ viewport: { width: 1000, height: 790 } });
   await fresh.goto(site);
   // The page renders the default room as it opens; then at the picture's size.
-  const rendered = () => /rays a pixel/.test(document.getElementById("status").textContent);
+  const rendered = () => /submission/.test(document.getElementById("status").textContent);
   await fresh.waitForFunction(rendered, null, { timeout: 300000 });
   await fresh.fill("#size", "800x560");
   await fresh.fill("#spp", "4");
   await fresh.click("#render");
-  await fresh.waitForFunction(() => document.getElementById("status").textContent.startsWith("800"), null, {
+  await fresh.waitForFunction(() => document.getElementById("status").textContent.startsWith("800×560:"), null, {
     timeout: 300000,
   });
   await fresh.screenshot({ path: process.env.SCREENSHOT });
