@@ -71,10 +71,12 @@ fn shading_vectors_per_triangle(f: Features) -> usize {
     3 * usize::from(f.smooth_normals) + 2 * usize::from(f.textures)
 }
 
-/// Refuses a scene whose textures would not fit one storage binding of the adapter, with the
-/// numbers, before the BVH is built for nothing. (Triangles, nodes and shading data are split
-/// across as many bindings as they need: [`check_bindings`].)
-fn check_textures(ctx: &GpuContext, scene: &Scene, features: Features) -> Result<()> {
+/// Refuses a scene whose records (its textures, with its instances, lights and materials:
+/// one storage binding) would not fit one storage binding of the adapter, with the numbers,
+/// before the BVH is built for nothing. (Triangles, nodes and shading vertices are split
+/// across as many bindings as they need: [`check_bindings`]; moving instances' knots, known
+/// once the BVH is, are checked with the upload.)
+fn check_records(ctx: &GpuContext, scene: &Scene, features: Features) -> Result<()> {
     let limit = ctx.device.limits().max_storage_buffer_binding_size;
     let texels: u64 = scene
         .textures
@@ -82,12 +84,17 @@ fn check_textures(ctx: &GpuContext, scene: &Scene, features: Features) -> Result
         .filter(|_| features.textures)
         .map(|t| 4 * u64::from(t.width) * u64::from(t.height))
         .sum();
-    if texels > limit {
+    let others = size_of::<crate::bvh::GpuInstance>() * scene.instances.len()
+        + size_of::<GpuLight>() * scene.lights.len()
+        + size_of::<GpuMaterial>() * scene.materials.len();
+    if texels + others as u64 > limit {
         return Err(Error::Limit(format!(
-            "the scene's {} textures take {:.1} MiB, above this adapter's limit of {:.0} MiB \
-             per storage binding; use smaller textures",
+            "the scene's {} textures take {:.1} MiB, and with its instances, lights and \
+             materials {:.1} MiB, above this adapter's limit of {:.0} MiB per storage binding, \
+             which they share; use smaller textures",
             scene.textures.len(),
             mib(texels),
+            mib(texels + others as u64),
             mib(limit)
         )));
     }
@@ -243,7 +250,7 @@ impl GpuScene {
             scene
         };
         let features = scene.features();
-        check_textures(ctx, scene, features)?;
+        check_records(ctx, scene, features)?;
         let binding_limit = ctx.device.limits().max_storage_buffer_binding_size;
         let stored = scene.triangles.len() as u64;
         let vertex_vectors = stored * shading_vectors_per_triangle(features) as u64;

@@ -369,7 +369,9 @@ impl ViewInner {
         });
         let mut encoder = device.create_command_encoder(&Default::default());
         let encoded = match progressive {
-            true => self.renderer.encode_progressive(&mut encoder, &pose, &self.target),
+            true => self
+                .renderer
+                .encode_progressive(&mut encoder, &pose, &self.target),
             false => self.renderer.encode(&mut encoder, &pose, &self.target),
         };
         encoded.map_err(error)?;
