@@ -52,6 +52,18 @@ async function sceneOf(opts) {
   throw new Error("opts.scene: a URL, a File, an ArrayBuffer or builtin:NAME");
 }
 
+// A calibration file's name and bytes, given as a URL, a File or bytes (named by `name`).
+async function calibrationOf(calib, name) {
+  if (typeof calib === "string" || calib instanceof URL) {
+    const url = new URL(calib, location.href);
+    return { name: name ?? decodeURIComponent(url.pathname.split("/").pop()), bytes: await fetchBytes(url) };
+  }
+  if (calib instanceof File) return { name: name ?? calib.name, bytes: new Uint8Array(await calib.arrayBuffer()) };
+  if (calib instanceof ArrayBuffer) return { name: name ?? "calibration", bytes: new Uint8Array(calib) };
+  if (ArrayBuffer.isView(calib)) return { name: name ?? "calibration", bytes: new Uint8Array(calib.buffer) };
+  throw new Error("opts.calib: a URL, a File or an ArrayBuffer");
+}
+
 async function fetchBytes(url) {
   const response = await fetch(url);
   if (!response.ok) throw new Error(`${url}: ${response.status} ${response.statusText}`);
@@ -72,7 +84,9 @@ async function companion(source, name) {
 
 // A view of what `opts` asks (the scene loaded, its BVH built and uploaded, the kernels
 // made), whose `frame(camera, progressive)` renders it; `steps` is the most frames a
-// progressive refinement takes.
+// progressive refinement takes. `opts` are `render`'s: {scene, name?, files?, lens, size,
+// spp, camera?, calib?, calibName?, calibCamera?}; a calibration file (Kalibr, OpenCV,
+// Basalt: a URL, File or bytes) gives the lens and size, as `render --calib FILE`.
 async function open(opts = {}) {
   const device = await ready;
   const source = await sceneOf(opts);
@@ -84,6 +98,12 @@ async function open(opts = {}) {
     camera: opts.camera ?? "",
     complete: false,
   };
+  if (opts.calib) {
+    const calibration = await calibrationOf(opts.calib, opts.calibName);
+    asked.calib = calibration.bytes;
+    asked.calib_name = calibration.name;
+    asked.calib_camera = opts.calibCamera ?? 0;
+  }
   // The loaders name the files a scene needs (MTL, textures, glTF buffers) as they read it:
   // each round finds among the dropped files, or fetches, those it missed; once none of
   // them can be had, the scene is loaded without them (with the tool's warnings or errors).
@@ -122,6 +142,7 @@ window.fisheye = { ready, render, open, lensTwin, lenses: () => ready.then(() =>
 // ---- the page's controls
 
 let picked = null; // {scene: File, files: File[]} from the picker or a drop
+let calibration = null; // a calibration File, which gives the lens and size
 let view = null; // the open view, and its progress
 let pose = ""; // where the camera is, "X,Y,Z:LX,LY,LZ" ("" until the first frame)
 let step = 0;
@@ -149,6 +170,7 @@ async function reopen() {
   } else {
     opts.scene = $("scene").value;
   }
+  if (calibration) opts.calib = calibration;
   say("loading the scene and building its BVH…");
   view = null;
   try {
@@ -243,6 +265,15 @@ async function setUp() {
     reopen();
   };
   $("file").onchange = (e) => take(e.target.files);
+  $("calib").onchange = (e) => {
+    calibration = e.target.files[0] ?? null;
+    reopen();
+  };
+  $("lens").onchange = () => {
+    calibration = null;
+    $("calib").value = "";
+    reopen();
+  };
   $("scene").onchange = () => {
     picked = null;
     $("picked").textContent = "";

@@ -22,7 +22,7 @@ use fisheye_rt::input::InputKind;
 use fisheye_rt::lens::glass::camera_for;
 use fisheye_rt::lens::gpu::LensRays;
 use fisheye_rt::lens::twin::TwinCheck;
-use fisheye_rt::lens::{ImageSize, LensCamera, parse_spec};
+use fisheye_rt::lens::{ImageSize, LensCamera, calib, parse_spec};
 use fisheye_rt::renderer::Renderer;
 use fisheye_rt::scene::{self, Scene};
 use fisheye_rt::trace::{Display, RenderOptions, Sampling, Tone, auto_exposure, colour_image_with};
@@ -128,11 +128,12 @@ impl Fisheye {
     }
 
     /// Opens a view of what `opts` asks, as `fisheye render` would render it: `{name, lens,
-    /// size, spp, camera, complete}`, strings but the last: the scene `name` (`builtin:NAME`,
-    /// or a file in `files` ending `.obj`, `.gltf`, `.glb` or `.toml`; `files` maps names to
-    /// their bytes, the scene's and those it names) through `lens` at `size` (`WxH`) with
-    /// `spp` (`render --spp`'s forms) from `camera` (`render --camera`'s forms; the scene's
-    /// own if empty). The scene is loaded, its BVH built and uploaded, the kernels made; a
+    /// size, spp, camera, calib, calib_name, calib_camera, complete}`: the scene `name`
+    /// (`builtin:NAME`, or a file in `files` ending `.obj`, `.gltf`, `.glb` or `.toml`;
+    /// `files` maps names to their bytes, the scene's and those it names) through `lens` at
+    /// `size` (`WxH`), or through camera `calib_camera` (from 0) of the calibration file whose
+    /// bytes are `calib` (a `Uint8Array`) and name `calib_name`, with `spp` (`render --spp`'s
+    /// forms) from `camera` (`render --camera`'s forms; the scene's own if empty). The scene is loaded, its BVH built and uploaded, the kernels made; a
     /// [`View`] renders frames of it. Rejects with an `Error` whose message says what is
     /// wrong. Until `complete`, a scene that names files not in `files` (an OBJ's MTL,
     /// textures, glTF buffers) is refused with an `Error` whose `missing` lists them, even
@@ -160,6 +161,14 @@ impl Fisheye {
             size: text("size"),
             spp: text("spp"),
             camera: text("camera"),
+            calib: Reflect::get(&opts, &"calib".into())
+                .ok()
+                .and_then(|v| v.dyn_into::<Uint8Array>().ok())
+                .map(|bytes| (text("calib_name"), bytes.to_vec())),
+            calib_camera: Reflect::get(&opts, &"calib_camera".into())
+                .ok()
+                .and_then(|v| v.as_f64())
+                .unwrap_or(0.0) as usize,
             complete: Reflect::get(&opts, &"complete".into()).is_ok_and(|v| v.is_truthy()),
         };
         wasm_bindgen_futures::future_to_promise(async move {
@@ -234,6 +243,10 @@ struct Request {
     size: String,
     spp: String,
     camera: String,
+    /// A calibration file's name and contents, whose camera `calib_camera` (from 0) replaces
+    /// `lens` and `size`, as `render --calib FILE --calib-camera N`.
+    calib: Option<(String, Vec<u8>)>,
+    calib_camera: usize,
     complete: bool,
 }
 
@@ -258,9 +271,9 @@ impl Request {
         queue: wgpu::Queue,
         errors: Arc<Mutex<Vec<String>>>,
     ) -> Result<ViewInner, JsValue> {
-        let size: ImageSize = self.size.parse().map_err(|e| error(format!("size: {e}")))?;
         let sampling: Sampling = self.spp.parse().map_err(|e| error(format!("spp: {e}")))?;
-        let camera = camera_for(&self.lens, size).map_err(|e| error(format!("lens: {e}")))?;
+        let camera = self.camera()?;
+        let size = camera.size;
         let (mut scene, warnings) = self.scene()?;
         scene.frame_for(&camera);
         if !self.camera.is_empty() {
@@ -302,6 +315,23 @@ impl Request {
             target,
             steps: if adaptive.is_some() { 2 + spp } else { 1 },
         })
+    }
+
+    /// The camera: the calibration's, else `lens` at `size`.
+    fn camera(&self) -> Result<LensCamera, JsValue> {
+        let Some((name, bytes)) = &self.calib else {
+            let size: ImageSize = self.size.parse().map_err(|e| error(format!("size: {e}")))?;
+            return camera_for(&self.lens, size).map_err(|e| error(format!("lens: {e}")));
+        };
+        let cameras = calib::read_from(Path::new(name), bytes.clone()).map_err(error)?;
+        let Some(c) = cameras.get(self.calib_camera) else {
+            return Err(error(format!(
+                "{name} holds {} camera(s); camera {} is not one",
+                cameras.len(),
+                self.calib_camera
+            )));
+        };
+        Ok(c.camera())
     }
 
     /// The scene `name` names, its files read from `files`, and the loader's warnings.

@@ -102,10 +102,16 @@ async function pageRender(opts) {
   }, sent);
 }
 
-// `fisheye render`'s PNG for the same arguments, decoded.
+// `fisheye render`'s PNG for the same arguments (a calibration served at /scenes/... read
+// from the repository), decoded.
 function nativeRender(scene, opts, name) {
   const out = path.join(scratch, `${name}.png`);
-  const args = ["render", scene, "--lens", opts.lens, "--size", opts.size];
+  const args = ["render", scene];
+  if (opts.calib) {
+    args.push("--calib", path.join(repo, opts.calib), "--calib-camera", String(opts.calibCamera));
+  } else {
+    args.push("--lens", opts.lens, "--size", opts.size);
+  }
   args.push("--spp", String(opts.spp), "-o", out);
   const run = spawnSync(bin, args, { encoding: "utf8" });
   if (run.status !== 0) throw new Error(`${bin} ${args.join(" ")}: ${run.stderr}`);
@@ -210,6 +216,19 @@ for (const spec of twinSpecs) {
     `lens twin ${spec.split(":")[0]} at ${size}: ${twin.rays} rays, max error ` +
       `${twin.max_error?.toExponential(2)} rad, ${twin.max_ratio?.toFixed(2)} of the bound ${twin.why}`,
   );
+}
+
+// A calibration file (a Kalibr rig's camera 1, by URL) gives the lens and size, as
+// `render --calib FILE --calib-camera 1`.
+{
+  const opts = { scene: "builtin:default", calib: "/scenes/dataset/surround-rig.yaml", calibCamera: 1, spp: 1 };
+  const what = "builtin:default through surround-rig.yaml's camera 1 (Kalibr), spp 1";
+  try {
+    const native = nativeRender("builtin:default", { ...opts, calib: opts.calib.slice(1) }, "calib");
+    compare(native, await pageRender(opts), what);
+  } catch (error) {
+    check(false, `${what}: ${error.message ?? error}`);
+  }
 }
 
 // Progressive refinement: a view with adaptive sampling shows the coarse frame first and

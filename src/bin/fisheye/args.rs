@@ -12,7 +12,7 @@ use fisheye_rt::dataset::labels::Label;
 use fisheye_rt::lens::calib::{self, CalibFormat};
 use fisheye_rt::lens::glass::camera_for;
 use fisheye_rt::lens::gpu::DirectionSource;
-use fisheye_rt::lens::{DirectionFormula, ImageSize, LensCamera, Shutter};
+use fisheye_rt::lens::{DirectionFormula, ImageSize, LensCamera};
 use fisheye_rt::raster::RasterMethod;
 use fisheye_rt::renderer;
 use fisheye_rt::scene::Scene;
@@ -216,10 +216,7 @@ impl CalibArgs {
                         self.calib_camera
                     );
                 };
-                LensCamera::new(c.lens, c.size).with_shutter(Shutter {
-                    line_delay: c.line_delay,
-                    ..Shutter::GLOBAL
-                })
+                c.camera()
             }
             None => {
                 let Some(spec) = lens else {

@@ -234,14 +234,7 @@ fn render(args: &RenderArgs) -> Result<()> {
     let cameras: Vec<(LensCamera, DAffine3)> = match (&args.rig, &args.lens) {
         (Some(path), _) => calib::read_rig(path)?
             .into_iter()
-            .map(|c| {
-                let camera = LensCamera::new(c.calibration.lens, c.calibration.size);
-                let camera = camera.with_shutter(Shutter {
-                    line_delay: c.calibration.line_delay,
-                    ..Shutter::GLOBAL
-                });
-                (camera, c.body_from_camera)
-            })
+            .map(|c| (c.calibration.camera(), c.body_from_camera))
             .collect(),
         (None, Some(spec)) => vec![(camera_for(spec, args.size)?, DAffine3::IDENTITY)],
         (None, None) => bail!("give the cameras: --rig CALIBRATION or --lens SPEC"),

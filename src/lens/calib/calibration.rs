@@ -1,7 +1,7 @@
 //! A calibration as files hold it ([`Calibration`]: a lens and its image size) and the
 //! formats they come in ([`CalibFormat`]).
 
-use crate::lens::{CalibratedLens, ImageSize};
+use crate::lens::{CalibratedLens, ImageSize, LensCamera, Shutter};
 
 /// One calibrated camera of a file: its lens and the image size it was calibrated at.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -13,6 +13,17 @@ pub struct Calibration {
     /// Seconds between two rows' readouts of a rolling shutter (Kalibr's `line_delay`, which
     /// only its camchains hold); 0 for a global shutter.
     pub line_delay: f64,
+}
+
+impl Calibration {
+    /// The camera it describes: its lens at its image size, with its rolling shutter's line
+    /// delay (a global shutter where it has none).
+    pub fn camera(&self) -> LensCamera {
+        LensCamera::new(self.lens, self.size).with_shutter(Shutter {
+            line_delay: self.line_delay,
+            ..Shutter::GLOBAL
+        })
+    }
 }
 
 /// A calibration file format.

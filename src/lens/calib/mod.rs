@@ -36,7 +36,15 @@ use crate::error::LensError;
 
 /// Reads every camera of a calibration file (format detected from its content).
 pub fn read(path: &Path) -> Result<Vec<Calibration>, LensError> {
-    let (text, format) = read_text(path)?;
+    let bytes = crate::input::read(path, crate::input::InputKind::Calibration)
+        .map_err(|e| bad_file(path)(format!("cannot read it: {e}")))?;
+    read_from(path, bytes)
+}
+
+/// As [`read`], from the file's contents (`path` names it in errors): for a caller that has
+/// the bytes, as a web page does.
+pub fn read_from(path: &Path, bytes: Vec<u8>) -> Result<Vec<Calibration>, LensError> {
+    let (text, format) = text_of(path, bytes)?;
     let cameras = parse(&text, format).map_err(bad_file(path))?;
     if cameras.is_empty() {
         return Err(bad_file(path)("it holds no camera".into()));
@@ -94,9 +102,14 @@ fn bad_file(path: &Path) -> impl Fn(String) -> LensError {
 
 /// A calibration file's text and format.
 fn read_text(path: &Path) -> Result<(String, CalibFormat), LensError> {
-    let bad = bad_file(path);
     let bytes = crate::input::read(path, crate::input::InputKind::Calibration)
-        .map_err(|e| bad(format!("cannot read it: {e}")))?;
+        .map_err(|e| bad_file(path)(format!("cannot read it: {e}")))?;
+    text_of(path, bytes)
+}
+
+/// A calibration file's contents as text, and its format.
+fn text_of(path: &Path, bytes: Vec<u8>) -> Result<(String, CalibFormat), LensError> {
+    let bad = bad_file(path);
     let text = String::from_utf8(bytes).map_err(|e| {
         bad(format!(
             "not UTF-8 text (byte {})",
