@@ -148,6 +148,7 @@ let pose = ""; // where the camera is, "X,Y,Z:LX,LY,LZ" ("" until the first fram
 let step = 0;
 let busy = false;
 let last = null;
+let opening = 0; // which reopen() is the latest: an older one that finishes later is dropped
 
 function show(image) {
   const canvas = $("view");
@@ -173,12 +174,15 @@ async function reopen() {
   if (calibration) opts.calib = calibration;
   say("loading the scene and building its BVH…");
   view = null;
+  const mine = ++opening;
   try {
     const started = performance.now();
-    view = await open(opts);
+    const opened = await open(opts);
+    if (mine !== opening) return;
+    view = opened;
     say(`ready in ${(performance.now() - started).toFixed(0)} ms; rendering…`);
   } catch (error) {
-    say(String(error.message ?? error), true);
+    if (mine === opening) say(String(error.message ?? error), true);
     return;
   }
   pose = "";
@@ -189,22 +193,29 @@ async function reopen() {
 // The next frame while the view has steps left at this pose: the first at a pose is whole (or
 // coarse, with adaptive sampling), each later one sharpens it.
 async function tick() {
-  if (busy || !view || step >= view.steps) return;
+  const current = view;
+  if (busy || !current || step >= current.steps) return;
   busy = true;
   try {
-    last = await view.frame(pose, true);
-    pose = last.camera;
-    step++;
-    show(last);
-    const warned = last.warnings.length ? ` (warnings: ${last.warnings.join("; ")})` : "";
-    const progress = view.steps > 1 ? `, frame ${step} of at most ${view.steps}` : "";
-    say(
-      `${last.width}×${last.height}${progress}: ${last.gpu_ms.toFixed(1)} ms from submission ` +
-        `to pixels${warned}`,
-    );
+    const frame = await current.frame(pose, true);
+    // A frame of a view that has been replaced meanwhile is dropped.
+    if (current === view) {
+      last = frame;
+      pose = last.camera;
+      step++;
+      show(last);
+      const warned = last.warnings.length ? ` (warnings: ${last.warnings.join("; ")})` : "";
+      const progress = current.steps > 1 ? `, frame ${step} of at most ${current.steps}` : "";
+      say(
+        `${last.width}×${last.height}${progress}: ${last.gpu_ms.toFixed(1)} ms from ` +
+          `submission to pixels${warned}`,
+      );
+    }
   } catch (error) {
-    say(String(error.message ?? error), true);
-    step = view.steps;
+    if (current === view) {
+      say(String(error.message ?? error), true);
+      step = current.steps;
+    }
   }
   busy = false;
   requestAnimationFrame(tick);
