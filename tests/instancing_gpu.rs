@@ -303,14 +303,21 @@ fn scenes_split_across_bindings_render_bit_identically() {
         // Bindings of a third of the triangles' bytes: three chunks of them or more, and more
         // of the shading data (80 bytes a triangle). The instanced scene's few nodes are split
         // too, at half their bytes (the flattened one's would take too many bindings: lavapipe
-        // has 48 a stage). The rest of the scene's buffers (the texture's 16 KiB) and the
-        // 64x48 outputs (in bands) fit.
+        // has 48 a stage). The rest of the scene's buffers fit (the records: the texture's 16
+        // KiB with the instances, lights and materials, in one binding), and the 64x48 outputs
+        // (in bands).
         let nodes = 80 * whole.bvh_nodes as u64;
         let third = whole.bytes.geometry / 3;
+        let records = whole.bytes.textures as usize
+            + size_of::<fisheye_rt::bvh::GpuInstance>() * scene.instances.len().max(1)
+            + size_of::<fisheye_rt::trace::GpuLight>() * scene.lights.len()
+            + size_of::<fisheye_rt::trace::GpuMaterial>() * scene.materials.len();
+        // With 2 KiB to spare: the upload knows the records' exact size.
+        let floor = records as u64 + 2048;
         let limit = if scene.is_instanced() {
-            third.min(nodes / 2).max(1 << 14)
+            third.min(nodes / 2).max(floor)
         } else {
-            third
+            third.max(floor)
         };
         let small = GpuContext::with_binding_limit(limit).unwrap();
         let split = GpuScene::new(&small, scene, &options).unwrap();
