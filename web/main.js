@@ -1,5 +1,6 @@
 // The page's script: starts the wasm module on the browser's WebGPU, exposes
-// `window.fisheye` ({ready, render(opts)}, the contract tests drive), and wires the controls:
+// `window.fisheye` ({ready, render(opts), open(opts), lensTwin, lenses}: the contract tests
+// and other pages drive), and wires the controls:
 // scene (built-in, picked or dropped files), lens, size, rays per pixel, orbiting camera,
 // the GPU time of each frame, saving the picture as PNG.
 import init, { Fisheye, lenses } from "./fisheye_web.js";
@@ -45,7 +46,7 @@ async function sceneOf(opts) {
   }
   if (scene instanceof ArrayBuffer || ArrayBuffer.isView(scene)) {
     if (!opts.name) throw new Error("a scene given as bytes needs its file name: opts.name");
-    const bytes = scene instanceof ArrayBuffer ? new Uint8Array(scene) : new Uint8Array(scene.buffer);
+    const bytes = scene instanceof ArrayBuffer ? new Uint8Array(scene) : viewBytes(scene);
     files.set(opts.name, bytes);
     return { name: opts.name, files, extra };
   }
@@ -60,9 +61,12 @@ async function calibrationOf(calib, name) {
   }
   if (calib instanceof File) return { name: name ?? calib.name, bytes: new Uint8Array(await calib.arrayBuffer()) };
   if (calib instanceof ArrayBuffer) return { name: name ?? "calibration", bytes: new Uint8Array(calib) };
-  if (ArrayBuffer.isView(calib)) return { name: name ?? "calibration", bytes: new Uint8Array(calib.buffer) };
+  if (ArrayBuffer.isView(calib)) return { name: name ?? "calibration", bytes: viewBytes(calib) };
   throw new Error("opts.calib: a URL, a File or an ArrayBuffer");
 }
+
+// The bytes a typed array or DataView looks at (not its whole buffer).
+const viewBytes = (view) => new Uint8Array(view.buffer, view.byteOffset, view.byteLength);
 
 async function fetchBytes(url) {
   const response = await fetch(url);

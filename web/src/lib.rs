@@ -41,9 +41,9 @@ pub struct Fisheye {
 
 #[wasm_bindgen]
 impl Fisheye {
-    /// Requests the browser's WebGPU adapter and a device with every limit it offers (the
-    /// tracer needs more storage buffers a stage than WebGPU's default); rejects with what is
-    /// missing.
+    /// Requests the browser's WebGPU adapter and a device with every limit it offers
+    /// (adaptive sampling binds more storage buffers a stage than WebGPU's default); rejects
+    /// with what is missing where it is below what the trace kernel needs.
     pub async fn start() -> Result<Fisheye, JsError> {
         let mut descriptor = wgpu::InstanceDescriptor::new_without_display_handle();
         descriptor.backends = wgpu::Backends::BROWSER_WEBGPU;
@@ -290,20 +290,7 @@ impl Request {
         let format = wgpu::TextureFormat::Rgba32Float;
         let renderer =
             Renderer::new(&device, &queue, &scene, &camera, &options, format).map_err(error)?;
-        let target = device.create_texture(&wgpu::TextureDescriptor {
-            label: Some("fisheye.web.image"),
-            size: wgpu::Extent3d {
-                width: size.width,
-                height: size.height,
-                depth_or_array_layers: 1,
-            },
-            mip_level_count: 1,
-            sample_count: 1,
-            dimension: wgpu::TextureDimension::D2,
-            format,
-            usage: wgpu::TextureUsages::STORAGE_BINDING | wgpu::TextureUsages::COPY_SRC,
-            view_formats: &[],
-        });
+        let target = renderer.target_texture(&device);
         Ok(ViewInner {
             device,
             queue,
