@@ -54,7 +54,12 @@ impl Fisheye {
                 ..Default::default()
             })
             .await
-            .map_err(|e| JsError::new(&format!("this browser gives no WebGPU adapter ({e})")))?;
+            .map_err(|e| {
+                JsError::new(&format!(
+                    "this browser gives the page no WebGPU adapter: WebGPU is off or not \
+                     supported here ({e})"
+                ))
+            })?;
         let info = adapter.get_info();
         let adapter_name = match info.driver.is_empty() {
             true => info.name.clone(),
@@ -206,7 +211,9 @@ impl View {
     /// (`Renderer::encode_progressive`: with adaptive sampling the first frame at a pose is
     /// the coarse one and each frame after it at the same pose sharpens it, until the whole
     /// frame, bit for bit, after at most [`View::steps`]; a new pose starts again). Resolves
-    /// to `{width, height, rgba, gpu_ms, camera, warnings}`: the PNG's 8-bit sRGB pixels, the
+    /// to `{width, height, rgba, ids, gpu_ms, camera, warnings}`: the PNG's 8-bit sRGB pixels,
+    /// the scene triangle at each pixel's centre (`--outputs id`'s, as a `Uint32Array`; with
+    /// adaptive sampling only the traced pixels' are there, the rest `NO_HIT`), the
     /// milliseconds from submission to the pixels' arrival on the CPU, the pose (as `camera`
     /// takes it) and what loading the scene warned of. Record one frame at a time.
     pub fn frame(&self, camera: String, progressive: bool) -> js_sys::Promise {
@@ -218,6 +225,7 @@ impl View {
             set("width", image.size.width.into())?;
             set("height", image.size.height.into())?;
             set("rgba", Uint8Array::from(&image.rgba[..]).into())?;
+            set("ids", js_sys::Uint32Array::from(&image.ids[..]).into())?;
             set("gpu_ms", image.gpu_ms.into())?;
             set("camera", image.camera.into())?;
             let warnings: Array = inner.warnings.iter().map(JsValue::from).collect();
@@ -254,6 +262,8 @@ struct Request {
 struct Image {
     size: ImageSize,
     rgba: Vec<u8>,
+    /// The scene triangle at each pixel's centre (`NO_HIT` where none), row-major.
+    ids: Vec<u32>,
     gpu_ms: f64,
     /// The pose it was seen from, as `camera` takes it.
     camera: String,
@@ -404,9 +414,24 @@ impl ViewInner {
             },
             self.target.size(),
         );
+        // The scene triangle at each pixel's centre, as `--outputs id` (traced frames only).
+        let ids = self.renderer.outputs().map(|[_, _, ids]| {
+            let staging = device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("fisheye.web.ids"),
+                size: ids.size(),
+                usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
+                mapped_at_creation: false,
+            });
+            encoder.copy_buffer_to_buffer(ids, 0, &staging, 0, ids.size());
+            staging
+        });
         let started = js_sys::Date::now();
         let data = submit_and_read(&self.queue, encoder, &staging, &self.errors).await?;
         let gpu_ms = js_sys::Date::now() - started;
+        let ids = match ids {
+            Some(staging) => bytemuck::pod_collect_to_vec::<u8, u32>(&map_read(&staging).await?),
+            None => Vec::new(),
+        };
         let mut colour = Vec::with_capacity(size.pixels());
         for r in data.chunks(row as usize) {
             colour.extend(bytemuck::pod_collect_to_vec::<u8, [f32; 4]>(
@@ -426,6 +451,7 @@ impl ViewInner {
         Ok(Image {
             size,
             rgba: colour_image_with(size, &colour, &display).into_raw(),
+            ids,
             gpu_ms,
             camera: format!(
                 "{},{},{}:{},{},{}",
@@ -460,6 +486,15 @@ async fn submit_and_read(
     errors: &Mutex<Vec<String>>,
 ) -> Result<Vec<u8>, JsValue> {
     queue.submit([encoder.finish()]);
+    let bytes = map_read(staging).await?;
+    if let Some(first) = errors.lock().unwrap().drain(..).next() {
+        return Err(error(format!("WebGPU: {first}")));
+    }
+    Ok(bytes)
+}
+
+/// `staging`'s bytes (`MAP_READ`, filled by work already submitted), once on the CPU.
+async fn map_read(staging: &wgpu::Buffer) -> Result<Vec<u8>, JsValue> {
     let mapped = Mapped::default();
     let done = mapped.clone();
     staging
@@ -468,9 +503,6 @@ async fn submit_and_read(
     mapped
         .await
         .map_err(|e| error(format!("reading back from the GPU: {e}")))?;
-    if let Some(first) = errors.lock().unwrap().drain(..).next() {
-        return Err(error(format!("WebGPU: {first}")));
-    }
     let bytes = staging
         .slice(..)
         .get_mapped_range()

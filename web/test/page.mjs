@@ -62,13 +62,22 @@ const browser = await chromium.launch({
 // base64-encoded across the page boundary.
 const context = await browser.newContext();
 await context.addInitScript(() => {
-  window.packed = (r, ms) => {
+  const base64 = (bytes) => {
     let text = "";
-    for (let i = 0; i < r.rgba.length; i += 8192) {
-      text += String.fromCharCode(...r.rgba.subarray(i, i + 8192));
+    for (let i = 0; i < bytes.length; i += 8192) {
+      text += String.fromCharCode(...bytes.subarray(i, i + 8192));
     }
-    return { width: r.width, height: r.height, gpu_ms: r.gpu_ms, ms, warnings: r.warnings, rgba: btoa(text) };
+    return btoa(text);
   };
+  window.packed = (r, ms) => ({
+    width: r.width,
+    height: r.height,
+    gpu_ms: r.gpu_ms,
+    ms,
+    warnings: r.warnings,
+    rgba: base64(r.rgba),
+    ids: r.ids ? base64(new Uint8Array(r.ids.buffer, r.ids.byteOffset, r.ids.byteLength)) : "",
+  });
 });
 const page = await context.newPage();
 const logged = [];
@@ -103,8 +112,18 @@ async function pageRender(opts) {
   }, sent);
 }
 
+// A .npy file of little-endian u32s (`--outputs id`), as numpy's format lays it out.
+function readIds(file) {
+  const b = fs.readFileSync(file);
+  const v1 = b[6] === 1;
+  const start = (v1 ? 10 : 12) + (v1 ? b.readUInt16LE(8) : b.readUInt32LE(8));
+  const header = b.subarray(v1 ? 10 : 12, start).toString("latin1");
+  if (!header.includes("'<u4'")) throw new Error(`${file}: not u32s: ${header}`);
+  return new Uint32Array(b.buffer.slice(b.byteOffset + start, b.byteOffset + b.length));
+}
+
 // `fisheye render`'s PNG for the same arguments (a calibration served at /scenes/... read
-// from the repository), decoded.
+// from the repository), decoded, with its ids (`--outputs id`) where sampling is uniform.
 function nativeRender(scene, opts, name) {
   const out = path.join(scratch, `${name}.png`);
   const args = ["render", scene];
@@ -114,9 +133,13 @@ function nativeRender(scene, opts, name) {
     args.push("--lens", opts.lens, "--size", opts.size);
   }
   args.push("--spp", String(opts.spp), "-o", out);
+  const uniform = /^[0-9]+$/.test(String(opts.spp));
+  if (uniform) args.push("--outputs", "id");
   const run = spawnSync(bin, args, { encoding: "utf8" });
   if (run.status !== 0) throw new Error(`${bin} ${args.join(" ")}: ${run.stderr}`);
-  return PNG.sync.read(fs.readFileSync(out));
+  const png = PNG.sync.read(fs.readFileSync(out));
+  png.ids = uniform ? readIds(out.replace(/\.png$/, ".id.npy")) : null;
+  return png;
 }
 
 function compare(native, web, what) {
@@ -144,12 +167,24 @@ function compare(native, web, what) {
   }
   const share = beyond / pixels;
   const mean = sum / (3 * pixels);
+  // Ids at the pixels' centres, where both have them: a grazing ray may hit the other
+  // triangle of an edge, so as many may differ as colours may.
+  let ids = "";
+  let idsOk = true;
+  if (native.ids && web.ids) {
+    const w = Buffer.from(web.ids, "base64");
+    const theirs = new Uint32Array(w.buffer, w.byteOffset, w.byteLength / 4);
+    let differ = 0;
+    for (let p = 0; p < pixels; p++) if (native.ids[p] !== theirs[p]) differ++;
+    idsOk = theirs.length === pixels && differ / pixels <= 0.005;
+    ids = `, ${differ} ids differ`;
+  }
   check(
-    share <= 0.005 && mean < 0.1 && masks / pixels <= 0.0005 && lit > pixels / 10,
+    share <= 0.005 && mean < 0.1 && masks / pixels <= 0.0005 && lit > pixels / 10 && idsOk,
     `${what}: ${(100 * share).toFixed(3)}% of pixels beyond 2 levels, mean ` +
-      `${mean.toFixed(4)}, ${masks} mask pixels differ, ${((100 * lit) / pixels).toFixed(0)}% ` +
-      `lit; ${web.ms.toFixed(0)} ms in the page (${web.gpu_ms.toFixed(0)} ms submission to ` +
-      `pixels)`,
+      `${mean.toFixed(4)}, ${masks} mask pixels differ${ids}, ` +
+      `${((100 * lit) / pixels).toFixed(0)}% lit; ${web.ms.toFixed(0)} ms in the page ` +
+      `(${web.gpu_ms.toFixed(0)} ms submission to pixels)`,
   );
 }
 
@@ -352,6 +387,29 @@ const refusedLens = await page.evaluate(() =>
 check(refusedLens.includes("fisheye-from-nowhere"), `an unknown lens is named: ${refusedLens}`);
 const after = await pageRender({ scene: "builtin:default", lens: "canon-8-15mm@8mm", size: "64x48", spp: 1 });
 check(after.width === 64 && after.height === 48, "the page renders after bad input");
+
+// A browser without WebGPU (Chromium without --enable-unsafe-webgpu, headless on Linux):
+// `ready` rejects with a message, which the page shows, rather than a dead page.
+{
+  const plain = await chromium.launch({
+    executablePath: process.env.CHROMIUM ?? "/usr/bin/chromium",
+    args: ["--no-sandbox", "--no-first-run", "--disable-background-networking", "--disable-component-update", "--disable-sync"],
+  });
+  const without = await plain.newPage();
+  await without.goto(site);
+  const said = await without.evaluate(() =>
+    window.fisheye.ready.then(
+      () => "ready",
+      (e) => String(e.message ?? e),
+    ),
+  );
+  await without.waitForFunction(() => document.getElementById("status").className === "bad", null, {
+    timeout: 60000,
+  });
+  const shown = await without.textContent("#status");
+  check(said !== "ready" && /WebGPU/.test(said) && shown === said, `without WebGPU the page says: ${said}`);
+  await plain.close();
+}
 
 // With TIMINGS=N, each of the book's timed frames is rendered N times and the median of all
 // but the first printed (submission to pixels).
