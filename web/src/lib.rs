@@ -200,6 +200,12 @@ struct ViewInner {
     size: ImageSize,
     renderer: Renderer,
     target: wgpu::Texture,
+    /// Where each frame's image is copied to be read: rows of `row` bytes (WebGPU's copy
+    /// alignment), made once with the view.
+    read_back: wgpu::Buffer,
+    row: u32,
+    /// Where its ids are (traced frames only).
+    ids_read_back: Option<wgpu::Buffer>,
     /// The frames a progressive refinement takes at most (1 where it is not progressive).
     steps: u32,
 }
@@ -215,7 +221,8 @@ impl View {
     /// the scene triangle at each pixel's centre (`--outputs id`'s, as a `Uint32Array`; with
     /// adaptive sampling only the traced pixels' are there, the rest `NO_HIT`), the
     /// milliseconds from submission to the pixels' arrival on the CPU, the pose (as `camera`
-    /// takes it) and what loading the scene warned of. Record one frame at a time.
+    /// takes it) and what loading the scene warned of. One frame at a time: frames share the
+    /// view's read-back buffers.
     pub fn frame(&self, camera: String, progressive: bool) -> js_sys::Promise {
         let inner = self.inner.clone();
         wasm_bindgen_futures::future_to_promise(async move {
@@ -301,6 +308,22 @@ impl Request {
         let renderer =
             Renderer::new(&device, &queue, &scene, &camera, &options, format).map_err(error)?;
         let target = renderer.target_texture(&device);
+        let read_back = |label, size| {
+            device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some(label),
+                size,
+                usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
+                mapped_at_creation: false,
+            })
+        };
+        let row = (16 * size.width).next_multiple_of(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT);
+        let image = read_back(
+            "fisheye.web.read_back",
+            u64::from(row) * u64::from(size.height),
+        );
+        let ids = renderer
+            .outputs()
+            .map(|[_, _, ids]| read_back("fisheye.web.ids", ids.size()));
         Ok(ViewInner {
             device,
             queue,
@@ -310,6 +333,9 @@ impl Request {
             size,
             renderer,
             target,
+            read_back: image,
+            row,
+            ids_read_back: ids,
             steps: if adaptive.is_some() { 2 + spp } else { 1 },
         })
     }
@@ -385,16 +411,8 @@ impl ViewInner {
             "" => self.scene.camera,
             text => self.scene.parse_camera(text).map_err(error)?,
         };
-        let (size, device) = (self.size, &self.device);
-        // Rows padded to WebGPU's copy alignment.
-        let row = (16 * size.width).next_multiple_of(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT);
-        let staging = device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("fisheye.web.read_back"),
-            size: u64::from(row) * u64::from(size.height),
-            usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
-            mapped_at_creation: false,
-        });
-        let mut encoder = device.create_command_encoder(&Default::default());
+        let (size, row) = (self.size, self.row);
+        let mut encoder = self.device.create_command_encoder(&Default::default());
         let encoded = match progressive {
             true => self
                 .renderer
@@ -405,7 +423,7 @@ impl ViewInner {
         encoder.copy_texture_to_buffer(
             self.target.as_image_copy(),
             wgpu::TexelCopyBufferInfo {
-                buffer: &staging,
+                buffer: &self.read_back,
                 layout: wgpu::TexelCopyBufferLayout {
                     offset: 0,
                     bytes_per_row: Some(row),
@@ -415,21 +433,14 @@ impl ViewInner {
             self.target.size(),
         );
         // The scene triangle at each pixel's centre, as `--outputs id` (traced frames only).
-        let ids = self.renderer.outputs().map(|[_, _, ids]| {
-            let staging = device.create_buffer(&wgpu::BufferDescriptor {
-                label: Some("fisheye.web.ids"),
-                size: ids.size(),
-                usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
-                mapped_at_creation: false,
-            });
-            encoder.copy_buffer_to_buffer(ids, 0, &staging, 0, ids.size());
-            staging
-        });
+        if let (Some([_, _, ids]), Some(staging)) = (self.renderer.outputs(), &self.ids_read_back) {
+            encoder.copy_buffer_to_buffer(ids, 0, staging, 0, ids.size());
+        }
         let started = js_sys::Date::now();
-        let data = submit_and_read(&self.queue, encoder, &staging, &self.errors).await?;
+        let data = submit_and_read(&self.queue, encoder, &self.read_back, &self.errors).await?;
         let gpu_ms = js_sys::Date::now() - started;
-        let ids = match ids {
-            Some(staging) => bytemuck::pod_collect_to_vec::<u8, u32>(&map_read(&staging).await?),
+        let ids = match &self.ids_read_back {
+            Some(staging) => bytemuck::pod_collect_to_vec::<u8, u32>(&map_read(staging).await?),
             None => Vec::new(),
         };
         let mut colour = Vec::with_capacity(size.pixels());
