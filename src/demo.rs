@@ -7,6 +7,7 @@ use crate::gpu::{GpuContext, dispatch_over_image, storage_entry, uniform_entry};
 use crate::lens::LensCamera;
 use crate::lens::gpu::{DirectionSource, LensRays, lens_constants, params_buffer};
 use crate::shader;
+use crate::split::SceneArrays;
 
 /// The demo pass for one camera: owns its pipeline, layout, output and (for the table
 /// source) the direction table, computed once at creation.
@@ -27,47 +28,41 @@ impl LensDemo {
         let table = LensRays::for_source(ctx, camera, source)?;
         ctx.checked("creating the lens demo", || {
             let device = &ctx.device;
-            // Declared in binding order: lens and table (wgsl/primary.wgsl), then the pixels
-            // (wgsl/lens_demo.wgsl). Explicit, because the table binding is dead code when
-            // directions are computed.
+            // The lens (wgsl/primary.wgsl), the table where directions are read from one
+            // (wgsl/primary_table.wgsl), the pixels (wgsl/lens_demo.wgsl).
+            let mut entries = vec![uniform_entry(0), storage_entry(2, false)];
+            entries.extend(table.is_some().then(|| storage_entry(1, true)));
             let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
                 label: Some("fisheye.lens_demo"),
-                entries: &[
-                    uniform_entry(0),
-                    storage_entry(1, true),
-                    storage_entry(2, false),
-                ],
+                entries: &entries,
             });
-            let mut constants = lens_constants(camera).to_vec();
-            constants.push(("DIRECTION_SOURCE", f64::from(source as u32)));
-            let pipeline =
-                shader::compute_pipeline(device, "lens_demo", "main", &constants, &[&layout]);
+            let pipeline = shader::scene_pipeline(
+                device,
+                "lens_demo",
+                (&SceneArrays::default(), source.swaps()),
+                "main",
+                &lens_constants(camera),
+                &[&layout],
+            );
             let pixels = device.create_buffer(&wgpu::BufferDescriptor {
                 label: Some("fisheye.lens_demo.pixels"),
                 size: bytes,
                 usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
                 mapped_at_creation: false,
             });
-            // Without a table the binding still needs a buffer; a 16-byte one is never read.
-            let placeholder;
-            let table_buffer = match &table {
-                Some(rays) => &rays.directions,
-                None => {
-                    placeholder = device.create_buffer(&wgpu::BufferDescriptor {
-                        label: Some("fisheye.lens_demo.no_table"),
-                        size: 16,
-                        usage: wgpu::BufferUsages::STORAGE,
-                        mapped_at_creation: false,
-                    });
-                    &placeholder
-                }
-            };
             let params = params_buffer(device, camera);
-            let bind_group = crate::gpu::bind_buffers(
+            let resources = [
+                (0, params.as_entire_binding()),
+                (2, pixels.as_entire_binding()),
+            ];
+            let table = table
+                .as_ref()
+                .map(|t| (1, t.directions.as_entire_binding()));
+            let bind_group = crate::gpu::bind_group_at(
                 device,
                 "fisheye.lens_demo",
                 &layout,
-                &[&params, table_buffer, &pixels],
+                resources.into_iter().chain(table),
             );
             Self {
                 pipeline,

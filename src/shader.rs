@@ -1,7 +1,9 @@
 //! WGSL assembly: every shader file is embedded, `#import NAME` lines pull in shared files
 //! (each once, dependencies first), and constants defined once in Rust ([`crate::shared`]) are
 //! prepended as WGSL `const` lines. Pipeline specialisations (lens model, direction formula) are WGSL
-//! `override`s, set per pipeline. One module is generated rather than embedded:
+//! `override`s, set per pipeline, or files swapped in for others when a pipeline is composed
+//! (the direction table's `primary_table` for `primary`). One module is generated rather than
+//! embedded:
 //! `scene_arrays`, the scene's arrays split across as many storage bindings as the scene
 //! needs ([`crate::split`]), so kernels that read a scene are composed for it
 //! ([`compose_for`]).
@@ -15,7 +17,7 @@ use crate::split::SceneArrays;
 const SCENE_ARRAYS: &str = "scene_arrays";
 
 /// Every WGSL file of the project, by name (its file stem under `wgsl/`).
-pub const FILES: [(&str, &str); 33] = [
+pub const FILES: [(&str, &str); 34] = [
     ("math", include_str!("../wgsl/math.wgsl")),
     ("quaternion", include_str!("../wgsl/quaternion.wgsl")),
     ("calibrated", include_str!("../wgsl/calibrated.wgsl")),
@@ -37,6 +39,7 @@ pub const FILES: [(&str, &str); 33] = [
     ("glass", include_str!("../wgsl/glass.wgsl")),
     ("glass_probe", include_str!("../wgsl/glass_probe.wgsl")),
     ("primary", include_str!("../wgsl/primary.wgsl")),
+    ("primary_table", include_str!("../wgsl/primary_table.wgsl")),
     ("lens_rays", include_str!("../wgsl/lens_rays.wgsl")),
     ("lens_points", include_str!("../wgsl/lens_points.wgsl")),
     ("lens_demo", include_str!("../wgsl/lens_demo.wgsl")),
@@ -119,13 +122,18 @@ impl Composition {
 /// `#swap A B` line makes later `#import A`s pull in `B` instead), then the entry file; a
 /// scene's arrays each in one binding.
 pub fn compose(entry: &str) -> String {
-    compose_for(entry, &SceneArrays::default())
+    compose_for(entry, &SceneArrays::default(), &[])
 }
 
-/// As [`compose`], for a scene whose arrays are split as `arrays` says.
-pub fn compose_for(entry: &str, arrays: &SceneArrays) -> String {
+/// As [`compose`], for a scene whose arrays are split as `arrays` says, with `swaps` in force
+/// from the start (`(A, B)` as a `#swap A B` line would).
+pub fn compose_for(entry: &str, arrays: &SceneArrays, swaps: &[(&str, &str)]) -> String {
     let mut c = Composition {
         arrays: *arrays,
+        swaps: swaps
+            .iter()
+            .map(|&(from, to)| (from.into(), to.into()))
+            .collect(),
         ..Default::default()
     };
     c.append(entry);
@@ -149,7 +157,7 @@ pub fn compose_for(entry: &str, arrays: &SceneArrays) -> String {
 /// Creates the shader module for `entry`, labelled `fisheye.<entry>`, for a scene whose
 /// arrays are split as `arrays` says (the default for kernels that read no scene).
 pub fn module(device: &wgpu::Device, entry: &str, arrays: &SceneArrays) -> wgpu::ShaderModule {
-    module_from(device, entry, compose_for(entry, arrays))
+    module_from(device, entry, compose_for(entry, arrays, &[]))
 }
 
 fn module_from(device: &wgpu::Device, entry: &str, source: String) -> wgpu::ShaderModule {
@@ -174,16 +182,17 @@ pub fn compute_pipeline(
 }
 
 /// As [`compute_pipeline`], for a kernel that reads a scene whose arrays are split as
-/// `arrays` says.
+/// `arrays` says (the default for one that reads none), composed with `swaps` (see
+/// [`compose_for`]).
 pub fn scene_pipeline(
     device: &wgpu::Device,
     file: &str,
-    arrays: &SceneArrays,
+    (arrays, swaps): (&SceneArrays, &[(&str, &str)]),
     entry_point: &str,
     constants: &[(&str, f64)],
     layouts: &[&wgpu::BindGroupLayout],
 ) -> wgpu::ComputePipeline {
-    let source = compose_for(file, arrays);
+    let source = compose_for(file, arrays, swaps);
     pipeline_from(device, file, source, entry_point, constants, layouts)
 }
 
@@ -293,7 +302,7 @@ mod tests {
         let sources = FILES.iter().map(|(name, _)| (*name, compose(name))).chain(
             readers
                 .iter()
-                .map(|name| (*name, compose_for(name, &split))),
+                .map(|name| (*name, compose_for(name, &split, &[]))),
         );
         for (name, source) in sources {
             let module = naga::front::wgsl::parse_str(&source)
@@ -334,6 +343,24 @@ mod tests {
             let header = format!("// ---- wgsl/{shared}.wgsl\n");
             assert_eq!(source.matches(&header).count(), 1, "{shared}");
         }
+    }
+
+    /// A pipeline reading the direction table is composed with `primary_table` in place of
+    /// `primary`: the table's binding is in that kernel alone.
+    #[test]
+    fn the_direction_table_is_bound_only_where_it_is_read() {
+        let table = "@group(0) @binding(1) var<storage, read> table";
+        let computed = compose("trace");
+        assert!(computed.contains("// ---- wgsl/primary.wgsl"));
+        assert!(!computed.contains(table));
+        let read = compose_for(
+            "trace",
+            &SceneArrays::default(),
+            &[("primary", "primary_table")],
+        );
+        assert!(read.contains("// ---- wgsl/primary_table.wgsl"));
+        assert!(!read.contains("// ---- wgsl/primary.wgsl"));
+        assert_eq!(read.matches(table).count(), 1);
     }
 
     #[test]

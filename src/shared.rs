@@ -16,14 +16,16 @@ pub const WORKGROUP_1D: u32 = 64;
 /// is refused at build time rather than traversed wrongly.
 pub const TRAVERSAL_STACK: u32 = 32;
 
-/// Storage buffers the trace kernel binds: the direction table and three outputs (group 0),
-/// and the scene's four (group 1: nodes, triangles, records, shading vertices): WebGPU's and
-/// wgpu's default limit.
-pub const TRACE_STORAGE_BUFFERS: u32 = 8;
+/// Storage buffers the trace kernel binds: three outputs (group 0) and the scene's four
+/// (group 1: nodes, triangles, records, shading vertices), and the direction table where it
+/// reads one ([`DirectionSource::storage_buffers`]): within WebGPU's and wgpu's default
+/// limit of 8.
+pub const TRACE_STORAGE_BUFFERS: u32 = 7;
 
-/// Storage buffers the adaptive kernels bind beyond the trace kernel's: the per-pixel state
-/// and the work list (`trace::AdaptivePass`).
-pub const ADAPTIVE_STORAGE_BUFFERS: u32 = 2;
+/// Storage buffers the adaptive kernels bind beyond the trace kernel's: the work buffer (the
+/// per-pixel state and the work list, `trace::AdaptivePass`). With computed directions they
+/// bind 8, WebGPU's default limit.
+pub const ADAPTIVE_STORAGE_BUFFERS: u32 = 1;
 
 /// Side of the blocks of pixels whose corners adaptive sampling traces first: one ray per
 /// `ADAPTIVE_BLOCK`² pixels where the image is smooth.
@@ -155,22 +157,31 @@ impl LensKind {
     }
 }
 
-/// Where a kernel that consumes ray directions gets them: the `DIRECTION_SOURCE` override.
+/// Where a kernel that consumes ray directions gets them: `wgsl/primary.wgsl`, or
+/// `wgsl/primary_table.wgsl` in its place.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-#[repr(u32)]
 pub enum DirectionSource {
     /// Evaluate the lens per pixel, every frame.
-    Computed = 0,
+    Computed,
     /// Read the direction table that `LensRays` computed once.
-    Table = 1,
+    Table,
 }
 
 impl DirectionSource {
-    /// The WGSL constant naming this source.
-    pub fn const_name(&self) -> String {
+    /// The files a kernel reading its directions from here is composed with in place of
+    /// others (`shader::compose_for`).
+    pub fn swaps(self) -> &'static [(&'static str, &'static str)] {
         match self {
-            Self::Computed => "DIRECTIONS_COMPUTED".into(),
-            Self::Table => "DIRECTIONS_TABLE".into(),
+            Self::Computed => &[],
+            Self::Table => &[("primary", "primary_table")],
+        }
+    }
+
+    /// The storage buffers it binds: the table, or none.
+    pub fn storage_buffers(self) -> u32 {
+        match self {
+            Self::Computed => 0,
+            Self::Table => 1,
         }
     }
 
@@ -324,9 +335,6 @@ pub fn wgsl_constants() -> Vec<(String, u32)> {
     .map(|(n, v)| (n.to_string(), v))
     .collect();
     out.extend(LensKind::ALL.iter().map(|k| (k.const_name(), *k as u32)));
-    for source in [DirectionSource::Computed, DirectionSource::Table] {
-        out.push((source.const_name(), source as u32));
-    }
     out
 }
 

@@ -10,11 +10,16 @@ use fisheye_rt::scene::{Camera, Scene, builtin};
 use fisheye_rt::trace::{Adaptive, GpuScene, RenderOptions, TracePass, render};
 use glam::DVec3;
 
+/// The default adapter, found the plain wgpu way.
+fn adapter() -> wgpu::Adapter {
+    let instance = wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle());
+    pollster::block_on(instance.request_adapter(&Default::default()))
+        .expect("these tests need a GPU adapter (or lavapipe)")
+}
+
 /// A device and queue made the plain wgpu way, with no optional features and `limits`.
 fn device_with(limits: wgpu::Limits) -> (wgpu::Device, wgpu::Queue) {
-    let instance = wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle());
-    let adapter = pollster::block_on(instance.request_adapter(&Default::default()))
-        .expect("these tests need a GPU adapter (or lavapipe)");
+    let adapter = adapter();
     let descriptor = wgpu::DeviceDescriptor {
         required_limits: limits,
         ..Default::default()
@@ -215,7 +220,7 @@ fn a_device_below_the_required_limits_is_refused_naming_the_limit() {
         .err()
         .expect("refused")
         .to_string();
-    let needs = fisheye_rt::shared::TRACE_STORAGE_BUFFERS;
+    let needs = fisheye_rt::renderer::required_limits().max_storage_buffers_per_shader_stage;
     let said = format!(
         "max_storage_buffers_per_shader_stage is {}, the renderer needs {needs}",
         needs - 1
@@ -224,14 +229,15 @@ fn a_device_below_the_required_limits_is_refused_naming_the_limit() {
 }
 
 /// A scene split across storage bindings needs one more storage buffer per chunk beyond each
-/// array's first: on a device with exactly the documented storage buffers (and bindings of
-/// 1 MiB and 4 KiB, so that the grid's 12 triangles take one and a scene of 30,000 triangles
-/// two) the first uploads and the second is refused with the chunks, the buffers and the
-/// limit; a device with one storage buffer more uploads it.
+/// array's first: on a device with exactly the trace kernel's storage buffers (and bindings
+/// of 1 MiB and 4 KiB, so that the grid's 12 triangles take one and a scene of 30,000
+/// triangles two) the first uploads and the second is refused with the chunks, the buffers
+/// and the limit; a device with one storage buffer more uploads it.
 #[test]
 fn split_scenes_need_the_storage_buffers_they_name() {
     use fisheye_rt::scene::{Material, MeshBuilder};
     let mut limits = fisheye_rt::renderer::required_limits();
+    limits.max_storage_buffers_per_shader_stage = fisheye_rt::shared::TRACE_STORAGE_BUFFERS;
     // 1 MiB and 4 KiB: room for the grid's 1 MiB texture with its materials and lights.
     limits.max_storage_buffer_binding_size = (1 << 20) + 4096;
     let options = RenderOptions::default();
@@ -323,13 +329,7 @@ fn unwritable_targets_are_errors_naming_what_is_wanted() {
 /// frame, and a move starts again; frames with uniform sampling are whole from the first.
 #[test]
 fn progressive_frames_sharpen_while_still_and_restart_on_a_move() {
-    // Adaptive sampling's kernels bind its state and work list beyond the trace kernel's.
-    let base = fisheye_rt::renderer::required_limits();
-    let (device, queue) = device_with(wgpu::Limits {
-        max_storage_buffers_per_shader_stage: base.max_storage_buffers_per_shader_stage
-            + fisheye_rt::shared::ADAPTIVE_STORAGE_BUFFERS,
-        ..base
-    });
+    let (device, queue) = own_device();
     let (scene, camera) = view("default", "samyang-7.5mm", 64, 48);
     let format = wgpu::TextureFormat::Rgba32Float;
     let sampled = |spp: u32, adaptive: bool| RenderOptions {
@@ -377,5 +377,56 @@ fn progressive_frames_sharpen_while_still_and_restart_on_a_move() {
         }
         assert_same("the still frames' end", &still, &image(&last));
         assert_same("a frame after that", &frame(&home), &still);
+    }
+}
+
+/// Each kernel binds what it says, and runs where the device gives that many storage buffers
+/// a stage: on a device with the trace kernel's 7, uniform sampling runs and adaptive
+/// sampling and the direction table are refused, naming 8; on one with WebGPU's default 8
+/// (the renderer's required limits) both run, with the images they make on a device with
+/// every storage buffer lavapipe has, bit for bit.
+#[test]
+fn every_kernel_runs_within_the_storage_buffers_it_names() {
+    use fisheye_rt::lens::gpu::DirectionSource;
+    use fisheye_rt::shared::{ADAPTIVE_STORAGE_BUFFERS, TRACE_STORAGE_BUFFERS};
+    let (scene, camera) = view("default", "samyang-7.5mm", 48, 36);
+    let adaptive = RenderOptions {
+        spp: 4,
+        adaptive: Some(Adaptive {
+            threshold: Adaptive::DEFAULT_THRESHOLD,
+            ground_truth: true,
+        }),
+        ..RenderOptions::default()
+    };
+    let table = RenderOptions {
+        directions: DirectionSource::Table,
+        ..RenderOptions::default()
+    };
+    let on = |buffers: u32, options: &RenderOptions| {
+        let (device, queue) = device_with(wgpu::Limits {
+            max_storage_buffers_per_shader_stage: buffers,
+            ..fisheye_rt::renderer::required_limits()
+        });
+        let ctx = GpuContext::from_device(&device, &queue);
+        render(&ctx, &scene, &camera, options).map_err(|e| e.to_string())
+    };
+    let fewest = TRACE_STORAGE_BUFFERS;
+    assert!(on(fewest, &RenderOptions::default()).is_ok());
+    for (options, kernel) in [
+        (&adaptive, "adaptive sampling"),
+        (&table, "the trace kernel"),
+    ] {
+        let message = on(fewest, options).expect_err("refused");
+        let said = format!("{kernel} binds 8 storage buffers, above this device's limit of 7");
+        assert!(message.contains(&said), "{message}");
+    }
+    assert_eq!(TRACE_STORAGE_BUFFERS + ADAPTIVE_STORAGE_BUFFERS, 8);
+    let most = adapter().limits().max_storage_buffers_per_shader_stage;
+    assert!(most > 8, "lavapipe gives more than WebGPU's default");
+    for options in [&adaptive, &table] {
+        let small = on(8, options).unwrap();
+        let large = on(most, options).unwrap();
+        assert_same("colour", &small.colour, &large.colour);
+        assert_eq!(small.ids, large.ids);
     }
 }

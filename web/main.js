@@ -22,7 +22,10 @@ const ready = (async () => {
     );
   }
   await init();
-  return await Fisheye.start();
+  // ?limits=default: a device with WebGPU's default limits alone, as a small one (a phone)
+  // gives, to try the page as it runs there.
+  const defaults = new URLSearchParams(location.search).get("limits") === "default";
+  return await Fisheye.start(defaults);
 })();
 
 // The scene's name, its bytes and the files beside it, and where to fetch more (a URL's
@@ -260,8 +263,6 @@ async function setUp() {
     option.textContent = about;
     list.append(option);
   }
-  // Progressive refinement needs adaptive sampling, which binds 10 storage buffers.
-  if (device.storage_buffers < 10) $("spp").value = DEFAULTS.spp;
   $("render").onclick = reopen;
   $("save").onclick = () => {
     $("view").toBlob((blob) => {

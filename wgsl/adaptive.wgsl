@@ -47,13 +47,12 @@ struct AdaptiveParams {
     blocks: vec2<u32>,
 }
 
-// Per pixel: x the rays its colour took (the spp map), y what its centre ray saw (KEY_*).
-@group(0) @binding(7) var<storage, read_write> state: array<vec2<u32>>;
 // The list's length (ADAPTIVE_COUNT) and the part of it to trace (ADAPTIVE_FIRST to
 // ADAPTIVE_END, set by `adaptive_args.wgsl`), then the list of pixel indices from
-// ADAPTIVE_HEADER on.
-@group(0) @binding(8) var<storage, read_write> work: array<atomic<u32>>;
-@group(0) @binding(9) var<uniform> adaptive: AdaptiveParams;
+// ADAPTIVE_HEADER on (room for every pixel), then each pixel's state (`state_slot`). One
+// buffer, so that the kernels bind as few storage buffers as WebGPU's default allows.
+@group(0) @binding(7) var<storage, read_write> work: array<atomic<u32>>;
+@group(0) @binding(8) var<uniform> adaptive: AdaptiveParams;
 
 // What `trace_list` does with the pixels listed: a pipeline for each (the modes' kernels
 // differ in size, and one kernel holding all four would be as slow as the largest).
@@ -79,6 +78,29 @@ fn size() -> vec2<u32> {
 
 fn index_of(p: vec2<u32>) -> u32 {
     return p.y * lens.width + p.x;
+}
+
+// Where pixel `index`'s state is in `work`: the rays its colour took (the spp map), then what
+// its centre ray saw (KEY_*).
+fn state_slot(index: u32) -> u32 {
+    return ADAPTIVE_HEADER + lens.width * lens.height + 2u * index;
+}
+
+fn key_at(index: u32) -> u32 {
+    return atomicLoad(&work[state_slot(index) + 1u]);
+}
+
+fn set_key(index: u32, key: u32) {
+    atomicStore(&work[state_slot(index) + 1u], key);
+}
+
+fn set_state(index: u32, rays: u32, key: u32) {
+    atomicStore(&work[state_slot(index)], rays);
+    set_key(index, key);
+}
+
+fn add_rays(index: u32, rays: u32) {
+    atomicAdd(&work[state_slot(index)], rays);
 }
 
 // The material and instance of a primary hit, as one number below the KEY_* values.
@@ -143,7 +165,7 @@ fn trace_list(
         let c = supersampled(pixel, index);
         colour_out[index] = c;
         let count = f32(SAMPLES_PER_SIDE * SAMPLES_PER_SIDE);
-        state[index].x += u32(round(c.w * count));
+        add_rays(index, u32(round(c.w * count)));
         return;
     }
     if mode == MODE_ESTIMATE {
@@ -151,9 +173,9 @@ fn trace_list(
         // samples lies from the mean of all: here in displayed colour, where the threshold is.
         let s = samples(pixel, index, ADAPTIVE_ESTIMATE_SIDE);
         colour_out[index] = s.colour;
-        state[index].x += u32(round(s.colour.w * f32(ADAPTIVE_ESTIMATE_SIDE * ADAPTIVE_ESTIMATE_SIDE)));
+        add_rays(index, u32(round(s.colour.w * f32(ADAPTIVE_ESTIMATE_SIDE * ADAPTIVE_ESTIMATE_SIDE))));
         if largest(abs(shown(s.colour.rgb) - shown(s.half))) >= adaptive.threshold {
-            state[index].y = KEY_MORE;
+            set_key(index, KEY_MORE);
         }
         return;
     }
@@ -161,7 +183,7 @@ fn trace_list(
     if ray.w == 0.0 {
         if mode == MODE_CENTRE {
             colour_out[index] = vec4<f32>(0.0);
-            state[index] = vec2<u32>(0u, KEY_MASKED);
+            set_state(index, 0u, KEY_MASKED);
         }
         geometry_out[index] = vec4<f32>(0.0);
         ids_out[index] = NO_HIT;
@@ -177,7 +199,7 @@ fn trace_list(
     colour_out[index] = vec4<f32>(traced.colour, 1.0);
     geometry_out[index] = geometry_of(traced);
     ids_out[index] = traced.triangle;
-    state[index] = vec2<u32>(1u, surface_key(traced));
+    set_state(index, 1u, surface_key(traced));
 }
 
 // What a block's corner saw: its key, and its hit's normal and position (relative to the
@@ -192,7 +214,7 @@ fn corner(p: vec2<u32>) -> Corner {
     let i = index_of(p);
     let g = geometry_out[i];
     let ray = centre_ray(p, primary_ray(p).xyz);
-    return Corner(state[i].y, g, ray.origin + ray.dir * g.w);
+    return Corner(key_at(i), g, ray.origin + ray.dir * g.w);
 }
 
 // Whether two traced, unmasked corners see one smooth stretch of one surface: the same
@@ -222,7 +244,7 @@ fn lattice_near(l: vec2<u32>, masked: bool) -> bool {
     let last = vec2<i32>(adaptive.lattice) - 1;
     for (var y = max(first.y, 0); y <= min(first.y + 3, last.y); y++) {
         for (var x = max(first.x, 0); x <= min(first.x + 3, last.x); x++) {
-            let key = state[index_of(lattice_pixel(vec2<u32>(u32(x), u32(y))))].y;
+            let key = key_at(index_of(lattice_pixel(vec2<u32>(u32(x), u32(y)))));
             if (key == KEY_MASKED) == masked {
                 return true;
             }
@@ -261,19 +283,19 @@ fn edge_bend(a: vec2<u32>, b: vec2<u32>) -> f32 {
     let before = vec2<i32>(a) - d;
     let after = vec2<i32>(b) + d;
     let last = vec2<i32>(adaptive.lattice) - 1;
-    let key_a = state[index_of(lattice_pixel(a))].y;
-    let key_b = state[index_of(lattice_pixel(b))].y;
+    let key_a = key_at(index_of(lattice_pixel(a)));
+    let key_b = key_at(index_of(lattice_pixel(b)));
     var has = vec2<bool>(false);
     var cb = vec3<f32>(0.0);
     var ca = vec3<f32>(0.0);
     if all(before >= vec2<i32>(0)) {
         let i = index_of(lattice_pixel(vec2<u32>(before)));
-        has.x = state[i].y == key_a;
+        has.x = key_at(i) == key_a;
         cb = shown(colour_out[i].rgb);
     }
     if all(after <= last) {
         let i = index_of(lattice_pixel(vec2<u32>(after)));
-        has.y = state[i].y == key_b;
+        has.y = key_at(i) == key_b;
         ca = shown(colour_out[i].rgb);
     }
     let sa = shown(colour_out[index_of(lattice_pixel(a))].rgb);
@@ -308,10 +330,10 @@ fn classify(@builtin(global_invocation_id) id: vec3<u32>, @builtin(local_invocat
     var listed = 0u;
     if inside {
         let keys = vec4<u32>(
-            state[index_of(c00)].y,
-            state[index_of(c10)].y,
-            state[index_of(c01)].y,
-            state[index_of(c11)].y,
+            key_at(index_of(c00)),
+            key_at(index_of(c10)),
+            key_at(index_of(c01)),
+            key_at(index_of(c11)),
         );
         let masked = keys == vec4<u32>(KEY_MASKED);
         let l = id.xy;
@@ -346,7 +368,7 @@ fn classify(@builtin(global_invocation_id) id: vec3<u32>, @builtin(local_invocat
         return;
     }
     let span = vec2<f32>(max(far - first, vec2<u32>(1u)));
-    let all_masked = state[index_of(c00)].y == KEY_MASKED;
+    let all_masked = key_at(index_of(c00)) == KEY_MASKED;
     for (var y = first.y; y < end.y; y++) {
         for (var x = first.x; x < end.x; x++) {
             let p = vec2<u32>(x, y);
@@ -363,14 +385,14 @@ fn classify(@builtin(global_invocation_id) id: vec3<u32>, @builtin(local_invocat
             ids_out[i] = NO_HIT;
             if all_masked {
                 colour_out[i] = vec4<f32>(0.0);
-                state[i] = vec2<u32>(0u, KEY_MASKED);
+                set_state(i, 0u, KEY_MASKED);
                 continue;
             }
             let f = vec2<f32>(p - first) / span;
             let top = mix(colour_out[index_of(c00)], colour_out[index_of(c10)], f.x);
             let bottom = mix(colour_out[index_of(c01)], colour_out[index_of(c11)], f.x);
             colour_out[i] = vec4<f32>(mix(top, bottom, f.y).rgb, 1.0);
-            state[i] = vec2<u32>(0u, KEY_UNTRACED);
+            set_state(i, 0u, KEY_UNTRACED);
         }
     }
 }
@@ -392,14 +414,14 @@ fn curvature(before: vec3<f32>, c: vec3<f32>, after: vec3<f32>, has: vec2<bool>)
 
 // Whether pixel `p` and its neighbour at `q` are on different sides of the lens's edge.
 fn mask_edge(p: vec2<u32>, q: vec2<u32>) -> bool {
-    return (state[index_of(p)].y == KEY_MASKED) != (state[index_of(q)].y == KEY_MASKED);
+    return (key_at(index_of(p)) == KEY_MASKED) != (key_at(index_of(q)) == KEY_MASKED);
 }
 
 @compute @workgroup_size(WORKGROUP_2D, WORKGROUP_2D)
 fn select_pixels(@builtin(global_invocation_id) id: vec3<u32>, @builtin(local_invocation_index) local: u32) {
     let p = id.xy;
     var pick = false;
-    if all(p < size()) && state[index_of(p)].y != KEY_UNTRACED {
+    if all(p < size()) && key_at(index_of(p)) != KEY_UNTRACED {
         // The colour's bend across the pixel along each axis (see `bend`): a one-ray pixel
         // is its box filter's value where the colour changes linearly across it.
         let c = shown(colour_out[index_of(p)].rgb);
@@ -426,7 +448,7 @@ fn select_pixels(@builtin(global_invocation_id) id: vec3<u32>, @builtin(local_in
 
 // Lists the pixels whose state says `key`.
 fn list_keyed(p: vec2<u32>, key: u32, local: u32) {
-    list_if(all(p < size()) && state[index_of(p)].y == key, index_of(p), local);
+    list_if(all(p < size()) && key_at(index_of(p)) == key, index_of(p), local);
 }
 
 @compute @workgroup_size(WORKGROUP_2D, WORKGROUP_2D)

@@ -1,7 +1,7 @@
 // Draws what a lens sees of the direction sphere: colour by direction, a 10° latitude and
 // longitude grid (y up) and rings every 30° off the optical axis; one invocation per pixel,
 // dispatched over the image in WORKGROUP_2D × WORKGROUP_2D tiles. Directions are computed per
-// pixel or read from the direction table (the DIRECTION_SOURCE override), which is what the
+// pixel or read from the direction table (`primary_table.wgsl` swapped in), which is what the
 // lens benchmark compares.
 #import primary
 

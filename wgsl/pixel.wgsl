@@ -1,7 +1,7 @@
 // What every per-pixel tracing kernel shares (`trace.wgsl`, `adaptive.wgsl`): the outputs,
-// and a pixel's supersampled colour. Group 0's bindings 3 to 5; the lens and the direction
-// table (bindings 0 and 1) come from `primary.wgsl`, the frame (binding 2) from `frame.wgsl`,
-// the glass (binding 6, zero without) from `glass.wgsl`.
+// and a pixel's supersampled colour. Group 0's bindings 3 to 5; the lens (binding 0) and, where
+// directions are read from a table, the table (binding 1) come from `primary.wgsl`, the frame
+// (binding 2) from `frame.wgsl`, the glass (binding 6, zero without) from `glass.wgsl`.
 #import primary
 #import sampling
 #import glass

@@ -17,8 +17,8 @@ pub use faces::{
 
 use crate::error::{Error, Result};
 use crate::gpu::{
-    GpuContext, Span, bind_buffers, bind_group, dispatch_over_image, layer_view, storage_entry,
-    texture_array, uniform_entry,
+    GpuContext, Span, bind_buffers, bind_group, bind_group_at, dispatch_over_image, layer_view,
+    storage_entry, texture_array, uniform_entry,
 };
 use crate::lens::gpu::{DirectionSource, lens_constants, params_buffer};
 use crate::lens::{ImageSize, LensCamera};
@@ -282,10 +282,9 @@ impl CubeMap {
             let device = &ctx.device;
             let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
                 label: Some("fisheye.cube_sample"),
-                // Lens and table as wgsl/primary.wgsl declares them, faces, output.
+                // The lens as wgsl/primary.wgsl declares it, faces, output.
                 entries: &[
                     uniform_entry(0),
-                    storage_entry(1, true),
                     wgpu::BindGroupLayoutEntry {
                         binding: 2,
                         visibility: wgpu::ShaderStages::COMPUTE,
@@ -299,11 +298,7 @@ impl CubeMap {
                     storage_entry(3, false),
                 ],
             });
-            let mut constants = lens_constants(camera).to_vec();
-            constants.push((
-                "DIRECTION_SOURCE",
-                f64::from(DirectionSource::Computed as u32),
-            ));
+            let constants = lens_constants(camera);
             let sampler =
                 shader::compute_pipeline(device, "cube_sample", "main", &constants, &[&layout]);
             let buffer = |label: &str, bytes: u64, usage: wgpu::BufferUsages| {
@@ -320,18 +315,16 @@ impl CubeMap {
                 16 * camera.size.pixels() as u64,
                 U::STORAGE | U::COPY_SRC,
             );
-            let no_table = buffer("fisheye.cube.no_table", 16, U::STORAGE);
             let lens = params_buffer(device, camera);
             let faces_view = layer_view(&cube, None);
-            let bind_group = bind_group(
+            let bind_group = bind_group_at(
                 device,
                 "fisheye.cube_sample",
                 &layout,
                 [
-                    lens.as_entire_binding(),
-                    no_table.as_entire_binding(),
-                    wgpu::BindingResource::TextureView(&faces_view),
-                    colour.as_entire_binding(),
+                    (0, lens.as_entire_binding()),
+                    (2, wgpu::BindingResource::TextureView(&faces_view)),
+                    (3, colour.as_entire_binding()),
                 ],
             );
             Self {

@@ -42,13 +42,20 @@ pub fn bind_group<'a>(
     layout: &wgpu::BindGroupLayout,
     resources: impl IntoIterator<Item = wgpu::BindingResource<'a>>,
 ) -> wgpu::BindGroup {
+    let numbered = resources.into_iter().enumerate();
+    bind_group_at(device, label, layout, numbered.map(|(b, r)| (b as u32, r)))
+}
+
+/// A bind group of any resources, each at the binding given with it.
+pub fn bind_group_at<'a>(
+    device: &wgpu::Device,
+    label: &str,
+    layout: &wgpu::BindGroupLayout,
+    resources: impl IntoIterator<Item = (u32, wgpu::BindingResource<'a>)>,
+) -> wgpu::BindGroup {
     let entries: Vec<_> = resources
         .into_iter()
-        .enumerate()
-        .map(|(b, resource)| wgpu::BindGroupEntry {
-            binding: b as u32,
-            resource,
-        })
+        .map(|(binding, resource)| wgpu::BindGroupEntry { binding, resource })
         .collect();
     device.create_bind_group(&wgpu::BindGroupDescriptor {
         label: Some(label),
@@ -493,8 +500,18 @@ impl GpuContext {
 
     /// Copies `buffer` (which must have `COPY_SRC`) to the CPU as `T`s.
     pub fn read_buffer<T: bytemuck::Pod>(&self, buffer: &wgpu::Buffer) -> Result<Vec<T>> {
-        let bytes = self.read_back(buffer.size(), |encoder, staging| {
-            encoder.copy_buffer_to_buffer(buffer, 0, staging, 0, buffer.size());
+        self.read_buffer_range(buffer, 0, buffer.size())
+    }
+
+    /// Reads `size` bytes of `buffer` from byte `offset` on back (both multiples of 4).
+    pub fn read_buffer_range<T: bytemuck::Pod>(
+        &self,
+        buffer: &wgpu::Buffer,
+        offset: u64,
+        size: u64,
+    ) -> Result<Vec<T>> {
+        let bytes = self.read_back(size, |encoder, staging| {
+            encoder.copy_buffer_to_buffer(buffer, offset, staging, 0, size);
         })?;
         Ok(bytemuck::pod_collect_to_vec(&bytes))
     }

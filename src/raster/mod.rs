@@ -314,7 +314,7 @@ impl RasterFaces {
                 let pipeline = shader::scene_pipeline(
                     device,
                     "raster",
-                    &scene.arrays,
+                    (&scene.arrays, &[]),
                     "deferred_lighting",
                     &constants,
                     &[&layout, &scene.layout, &shadows.lookup_layout],

@@ -47,20 +47,20 @@ use crate::lens::gpu::DirectionSource;
 use crate::raster::RasterMethod;
 use crate::scene::{Camera, Scene};
 use crate::shader;
-use crate::shared::TRACE_STORAGE_BUFFERS;
+use crate::shared::{ADAPTIVE_STORAGE_BUFFERS, TRACE_STORAGE_BUFFERS};
 use crate::trace::{
     Adaptive, AdaptivePass, AdaptiveSpans, GpuScene, RenderOptions, RenderOutput, TracePass,
     Traversal,
 };
 
 /// The limits a device needs for the renderer: wgpu's downlevel defaults, with the storage
-/// buffers the trace kernel binds. Ask for these (or the adapter's own) when creating the
-/// device; adaptive sampling binds [`crate::shared::ADAPTIVE_STORAGE_BUFFERS`] storage
-/// buffers more; ray queries also need `Features::EXPERIMENTAL_RAY_QUERY` and the adapter's
-/// acceleration-structure limits.
+/// buffers the trace kernel binds and one more, for the direction table or adaptive
+/// sampling's work buffer (both together bind one more again): 8, WebGPU's default. Ask for
+/// these (or the adapter's own) when creating the device; ray queries also need
+/// `Features::EXPERIMENTAL_RAY_QUERY` and the adapter's acceleration-structure limits.
 pub fn required_limits() -> wgpu::Limits {
     wgpu::Limits {
-        max_storage_buffers_per_shader_stage: TRACE_STORAGE_BUFFERS,
+        max_storage_buffers_per_shader_stage: TRACE_STORAGE_BUFFERS + ADAPTIVE_STORAGE_BUFFERS,
         ..wgpu::Limits::downlevel_defaults()
     }
 }

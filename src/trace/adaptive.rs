@@ -3,10 +3,10 @@
 //! uniform supersampling of [`super::sampling`] where colours still differ; every pass on the
 //! GPU, with no read-back between them. `wgsl/adaptive.wgsl` says how each pass decides.
 
-use super::pass::{TracePass, shared_entries};
+use super::pass::{TracePass, check_storage_buffers, shared_entries};
 use super::{Adaptive, GpuScene, RenderOutput};
 use crate::error::{Error, Result};
-use crate::gpu::{GpuContext, bind_group, storage_entry, uniform_entry};
+use crate::gpu::{GpuContext, bind_group_at, storage_entry, uniform_entry};
 use crate::lens::LensCamera;
 use crate::lens::gpu::DirectionSource;
 use crate::scene::Camera;
@@ -78,8 +78,9 @@ pub struct AdaptiveSpans<'a> {
 }
 
 /// Adaptive sampling of one lens, image size and scene: the trace kernel's outputs and frame
-/// (a [`TracePass`] at the largest sample count, whose buffers it writes), the per-pixel
-/// state (rays taken, what the centre saw), the work list and its indirect dispatch.
+/// (a [`TracePass`] at the largest sample count, whose buffers it writes), the work buffer
+/// (the work list, then the per-pixel state: rays taken, what the centre saw) and the list's
+/// indirect dispatch.
 pub struct AdaptivePass {
     trace: TracePass,
     options: Adaptive,
@@ -93,7 +94,6 @@ pub struct AdaptivePass {
     args: [wgpu::ComputePipeline; 2],
     group: wgpu::BindGroup,
     args_group: wgpu::BindGroup,
-    state: wgpu::Buffer,
     work: wgpu::Buffer,
     dispatch: wgpu::Buffer,
     /// The length of each stage's list in the last frame, in [`ALL_STAGES`] order (0 for a
@@ -136,15 +136,9 @@ impl AdaptivePass {
                 camera.size
             )));
         }
-        let needed =
-            TRACE_STORAGE_BUFFERS + ADAPTIVE_STORAGE_BUFFERS + scene.arrays.extra_bindings();
-        let has = ctx.device.limits().max_storage_buffers_per_shader_stage;
-        if needed > has {
-            return Err(Error::Limit(format!(
-                "adaptive sampling binds {needed} storage buffers per kernel, above this \
-                 device's limit of {has}; use uniform sampling (--spp N)"
-            )));
-        }
+        let needed = TRACE_STORAGE_BUFFERS + source.storage_buffers() + ADAPTIVE_STORAGE_BUFFERS;
+        check_storage_buffers(ctx, scene, needed, "adaptive sampling")
+            .map_err(|e| Error::Limit(format!("{e}; use uniform sampling (--spp N)")))?;
         let (width, height) = (camera.size.width, camera.size.height);
         let pixels = camera.size.pixels() as u64;
         // A progressive step supersamples at most as many pixels as take one ray each, at
@@ -175,14 +169,10 @@ impl AdaptivePass {
                     mapped_at_creation: false,
                 })
             };
-            let state = buffer(
-                "fisheye.adaptive.state",
-                8 * pixels,
-                wgpu::BufferUsages::COPY_SRC,
-            );
+            // The header, a list with room for every pixel, two words of state a pixel.
             let work = buffer(
                 "fisheye.adaptive.work",
-                4 * (u64::from(ADAPTIVE_HEADER) + pixels),
+                4 * (u64::from(ADAPTIVE_HEADER) + 3 * pixels),
                 wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::COPY_SRC,
             );
             let listed = device.create_buffer(&wgpu::BufferDescriptor {
@@ -203,22 +193,17 @@ impl AdaptivePass {
                 wgpu::BufferUsages::UNIFORM,
             );
             // Group 0 as wgsl/pixel.wgsl and wgsl/adaptive.wgsl declare it.
-            let mut entries = shared_entries().to_vec();
-            entries.extend([
-                storage_entry(7, false),
-                storage_entry(8, false),
-                uniform_entry(9),
-            ]);
+            let mut entries = shared_entries(source);
+            entries.extend([storage_entry(7, false), uniform_entry(8)]);
             let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
                 label: Some("fisheye.adaptive"),
                 entries: &entries,
             });
             let resources = trace.shared_bindings().into_iter().chain([
-                state.as_entire_binding(),
-                work.as_entire_binding(),
-                uniform.as_entire_binding(),
+                (7, work.as_entire_binding()),
+                (8, uniform.as_entire_binding()),
             ]);
-            let group = bind_group(device, "fisheye.adaptive", &layout, resources);
+            let group = bind_group_at(device, "fisheye.adaptive", &layout, resources);
             let mut layouts = vec![&layout, &scene.layout];
             let file = match &scene.ray_query {
                 Some(rq) => {
@@ -230,7 +215,8 @@ impl AdaptivePass {
             let kernel = |entry: &str, mode: u32| {
                 let mut constants = trace.constants().to_vec();
                 constants.push(("LIST_MODE", f64::from(mode)));
-                shader::scene_pipeline(device, file, &scene.arrays, entry, &constants, &layouts)
+                let composed = (&scene.arrays, source.swaps());
+                shader::scene_pipeline(device, file, composed, entry, &constants, &layouts)
             };
             let builders =
                 ["lattice", "classify", "select_pixels", "more", "untraced"].map(|e| kernel(e, 0));
@@ -272,7 +258,6 @@ impl AdaptivePass {
                 args,
                 group,
                 args_group,
-                state,
                 work,
                 dispatch,
                 listed,
@@ -490,7 +475,9 @@ impl AdaptivePass {
     /// one more for each sample that the lens covers of a pixel's 2 × 2 estimating samples and
     /// of its full supersampling.
     pub fn read_rays(&self, ctx: &GpuContext) -> Result<Vec<u32>> {
-        let state: Vec<[u32; 2]> = ctx.read_buffer(&self.state)?;
+        let pixels = self.trace.size().pixels() as u64;
+        let first = 4 * (u64::from(ADAPTIVE_HEADER) + pixels);
+        let state: Vec<[u32; 2]> = ctx.read_buffer_range(&self.work, first, 8 * pixels)?;
         Ok(state.into_iter().map(|[rays, _]| rays).collect())
     }
 }

@@ -102,7 +102,7 @@ impl RayCast {
                 pipeline: shader::scene_pipeline(
                     &ctx.device,
                     "cast",
-                    &scene.arrays,
+                    (&scene.arrays, &[]),
                     "main",
                     &constants,
                     &[&layout, &scene.layout],

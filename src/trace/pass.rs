@@ -6,12 +6,12 @@ use super::gpu_scene::{frame_for, view_frame};
 use super::options::surface_constants;
 use super::{GpuScene, Motion, RenderOutput, sampling};
 use crate::error::{Error, Result};
-use crate::gpu::{GpuContext, bind_group, dispatch_over_image, storage_entry, uniform_entry};
+use crate::gpu::{GpuContext, bind_group_at, dispatch_over_image, storage_entry, uniform_entry};
 use crate::lens::LensCamera;
 use crate::lens::gpu::{DirectionSource, LensRays, lens_constants, params_buffer};
 use crate::scene::Camera;
 use crate::shader;
-use crate::shared::Frame;
+use crate::shared::{Frame, TRACE_STORAGE_BUFFERS};
 use glam::{DMat3, DVec3};
 
 /// Bytes between the frame uniforms of a [`TracePass`]'s views: the frame rounded up to
@@ -43,10 +43,10 @@ pub struct TracePass {
     geometry: wgpu::Buffer,
     ids: wgpu::Buffer,
     frame: wgpu::Buffer,
-    /// The lens parameters and the direction table (a placeholder without one), for kernels
-    /// that share the trace kernel's group 0 (`AdaptivePass`).
+    /// The lens parameters and the direction table (where directions are read from one), for
+    /// kernels that share the trace kernel's group 0 (`AdaptivePass`).
     lens: wgpu::Buffer,
-    table: wgpu::Buffer,
+    table: Option<wgpu::Buffer>,
     /// The camera's glass (zeros without: `GLASS` is off then).
     glass: wgpu::Buffer,
     constants: Vec<(&'static str, f64)>,
@@ -101,14 +101,16 @@ impl TracePass {
         let bands = output_bands(ctx, camera.size, views)?;
         // Rows in the largest band: what the kernel's outputs hold.
         let band_pixels = u64::from(camera.size.width) * u64::from(bands[0].1);
+        let needed = TRACE_STORAGE_BUFFERS + source.storage_buffers();
+        check_storage_buffers(ctx, scene, needed, "the trace kernel")?;
         let table = LensRays::for_source(ctx, camera, source)?;
         ctx.checked("creating the trace pass", || {
             let device = &ctx.device;
             let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
                 label: Some("fisheye.trace.frame"),
-                entries: &shared_entries(),
+                entries: &shared_entries(source),
             });
-            let constants = trace_constants(camera, scene, source, samples_per_side);
+            let constants = trace_constants(camera, scene, samples_per_side);
             let mut layouts = vec![&layout, &scene.layout];
             let file = match &scene.ray_query {
                 Some(rq) => {
@@ -117,8 +119,9 @@ impl TracePass {
                 }
                 None => "trace",
             };
+            let composed = (&scene.arrays, source.swaps());
             let pipeline =
-                shader::scene_pipeline(device, file, &scene.arrays, "main", &constants, &layouts);
+                shader::scene_pipeline(device, file, composed, "main", &constants, &layouts);
             let output = |label: &str, bytes: u64, usage: wgpu::BufferUsages| {
                 device.create_buffer(&wgpu::BufferDescriptor {
                     label: Some(label),
@@ -151,10 +154,7 @@ impl TracePass {
                 &slots,
                 wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
             );
-            let table = match &table {
-                Some(t) => t.directions.clone(),
-                None => output("fisheye.trace.no_table", 16, none),
-            };
+            let table = table.map(|t| t.directions);
             let lens = params_buffer(device, camera);
             let glass = glass_buffer(device, camera);
             let bind_groups = (0..frames.len() as u64)
@@ -164,19 +164,20 @@ impl TracePass {
                         offset: view * FRAME_SLOT,
                         size: wgpu::BufferSize::new(size_of::<Frame>() as u64),
                     };
-                    bind_group(
+                    let resources = [
+                        lens.as_entire_binding(),
+                        wgpu::BindingResource::Buffer(slot),
+                        colour.as_entire_binding(),
+                        geometry.as_entire_binding(),
+                        ids.as_entire_binding(),
+                        glass.as_entire_binding(),
+                    ];
+                    let table = table.as_ref().map(|t| t.as_entire_binding());
+                    bind_group_at(
                         device,
                         "fisheye.trace.frame",
                         &layout,
-                        [
-                            lens.as_entire_binding(),
-                            table.as_entire_binding(),
-                            wgpu::BindingResource::Buffer(slot),
-                            colour.as_entire_binding(),
-                            geometry.as_entire_binding(),
-                            ids.as_entire_binding(),
-                            glass.as_entire_binding(),
-                        ],
+                        numbered_shared(resources, table),
                     )
                 })
                 .collect();
@@ -278,13 +279,12 @@ impl TracePass {
         &self.constants
     }
 
-    /// Group 0's shared bindings in `wgsl/pixel.wgsl`'s order (lens, table, the first view's
-    /// frame, colour, geometry, ids, glass), for kernels that trace as this pass does. Only
-    /// for an image traced in one band.
-    pub(crate) fn shared_bindings(&self) -> [wgpu::BindingResource<'_>; 7] {
-        [
+    /// Group 0's shared bindings as `wgsl/pixel.wgsl` declares them (lens, table where there
+    /// is one, the first view's frame, colour, geometry, ids, glass), each with its binding,
+    /// for kernels that trace as this pass does. Only for an image traced in one band.
+    pub(crate) fn shared_bindings(&self) -> Vec<(u32, wgpu::BindingResource<'_>)> {
+        let resources = [
             self.lens.as_entire_binding(),
-            self.table.as_entire_binding(),
             wgpu::BindingResource::Buffer(wgpu::BufferBinding {
                 buffer: &self.frame,
                 offset: 0,
@@ -294,7 +294,9 @@ impl TracePass {
             self.geometry.as_entire_binding(),
             self.ids.as_entire_binding(),
             self.glass.as_entire_binding(),
-        ]
+        ];
+        let table = self.table.as_ref().map(|t| t.as_entire_binding());
+        numbered_shared(resources, table)
     }
 
     /// The colour output of the last frame (as [`RenderOutput::colour`]), for passes that
@@ -414,19 +416,51 @@ impl TracePass {
     }
 }
 
-/// Group 0's entries that every kernel tracing a pixel binds, as `wgsl/primary.wgsl` and
-/// `wgsl/pixel.wgsl` declare them: the lens and the direction table, the frame, the colour,
-/// geometry and id outputs, the glass ([`TracePass::shared_bindings`] in this order).
-pub(crate) fn shared_entries() -> [wgpu::BindGroupLayoutEntry; 7] {
-    [
+/// Group 0's entries that every kernel tracing a pixel binds, as `wgsl/primary.wgsl` (or
+/// `wgsl/primary_table.wgsl`) and `wgsl/pixel.wgsl` declare them: the lens, the direction
+/// table where `source` reads one, the frame, the colour, geometry and id outputs, the glass.
+pub(crate) fn shared_entries(source: DirectionSource) -> Vec<wgpu::BindGroupLayoutEntry> {
+    let table = (source == DirectionSource::Table).then(|| storage_entry(1, true));
+    let entries = [
         uniform_entry(0),
-        storage_entry(1, true),
         uniform_entry(2),
         storage_entry(3, false),
         storage_entry(4, false),
         storage_entry(5, false),
         uniform_entry(6),
-    ]
+    ];
+    let mut entries = entries.to_vec();
+    entries.extend(table);
+    entries
+}
+
+/// The resources of [`shared_entries`] with their bindings: `resources` (lens, frame, colour,
+/// geometry, ids, glass) and the table, if any, at 1.
+fn numbered_shared<'a>(
+    resources: [wgpu::BindingResource<'a>; 6],
+    table: Option<wgpu::BindingResource<'a>>,
+) -> Vec<(u32, wgpu::BindingResource<'a>)> {
+    let bindings = [0, 2, 3, 4, 5, 6].into_iter().zip(resources);
+    bindings.chain(table.map(|t| (1, t))).collect()
+}
+
+/// Refuses a kernel that binds `needed` storage buffers beside the scene's extra chunks on a
+/// device with fewer a shader stage, naming `kernel`.
+pub(crate) fn check_storage_buffers(
+    ctx: &GpuContext,
+    scene: &GpuScene,
+    needed: u32,
+    kernel: &str,
+) -> Result<()> {
+    let needed = needed + scene.arrays.extra_bindings();
+    let has = ctx.device.limits().max_storage_buffers_per_shader_stage;
+    if needed > has {
+        return Err(Error::Limit(format!(
+            "{kernel} binds {needed} storage buffers, above this device's limit of {has} per \
+             shader stage"
+        )));
+    }
+    Ok(())
 }
 
 /// The uniform of `camera`'s glass, zeros where it has none (`GLASS` is off then).
@@ -444,13 +478,11 @@ fn glass_buffer(device: &wgpu::Device, camera: &LensCamera) -> wgpu::Buffer {
 fn trace_constants(
     camera: &LensCamera,
     scene: &GpuScene,
-    source: DirectionSource,
     samples_per_side: u32,
 ) -> Vec<(&'static str, f64)> {
     let mut constants = lens_constants(camera).to_vec();
     constants.extend(surface_constants(scene.features));
     constants.extend([
-        ("DIRECTION_SOURCE", f64::from(source as u32)),
         ("SAMPLES_PER_SIDE", f64::from(samples_per_side)),
         (
             "HAS_TRANSLUCENT",

@@ -41,10 +41,11 @@ pub struct Fisheye {
 
 #[wasm_bindgen]
 impl Fisheye {
-    /// Requests the browser's WebGPU adapter and a device with every limit it offers
-    /// (adaptive sampling binds more storage buffers a stage than WebGPU's default); rejects
-    /// with what is missing where it is below what the trace kernel needs.
-    pub async fn start() -> Result<Fisheye, JsError> {
+    /// Requests the browser's WebGPU adapter and a device with every limit it offers, or with
+    /// `defaults_only` WebGPU's default limits (what a small device, a phone, may offer: the
+    /// tracer, adaptive sampling included, works within them); rejects with what is missing
+    /// where the adapter is below what the tracer needs.
+    pub async fn start(defaults_only: Option<bool>) -> Result<Fisheye, JsError> {
         let mut descriptor = wgpu::InstanceDescriptor::new_without_display_handle();
         descriptor.backends = wgpu::Backends::BROWSER_WEBGPU;
         let instance = wgpu::Instance::new(descriptor);
@@ -86,7 +87,10 @@ impl Fisheye {
             .request_device(&wgpu::DeviceDescriptor {
                 label: Some("fisheye.web"),
                 required_features: wgpu::Features::empty(),
-                required_limits: has,
+                required_limits: match defaults_only {
+                    Some(true) => wgpu::Limits::default(),
+                    _ => has,
+                },
                 experimental_features: wgpu::ExperimentalFeatures::disabled(),
                 memory_hints: wgpu::MemoryHints::Performance,
                 trace: wgpu::Trace::Off,
@@ -119,8 +123,8 @@ impl Fisheye {
         })
     }
 
-    /// The storage buffers a shader stage may bind on this device: adaptive sampling (and so
-    /// progressive refinement) needs 10, the trace kernel 8.
+    /// The storage buffers a shader stage may bind on this device: the tracer needs 8
+    /// (adaptive sampling, and so progressive refinement, included).
     #[wasm_bindgen(getter)]
     pub fn storage_buffers(&self) -> u32 {
         self.device.limits().max_storage_buffers_per_shader_stage

@@ -95,13 +95,13 @@ const adapter = await page.evaluate(() => window.fisheye.ready.then((d) => d.ada
 console.log(`WebGPU adapter: ${adapter || "(unnamed)"}`);
 
 // The page's render of `opts` (its scene: builtin:NAME, a URL, or {bytes: PATH, name} sent
-// as an ArrayBuffer), its pixels base64-encoded across the page boundary.
-async function pageRender(opts) {
+// as an ArrayBuffer) on page `on`, its pixels base64-encoded across the page boundary.
+async function pageRender(opts, on = page) {
   const sent = { ...opts };
   if (opts.bytes) {
     sent.bytes = fs.readFileSync(path.join(repo, opts.bytes)).toString("base64");
   }
-  return page.evaluate(async (o) => {
+  return on.evaluate(async (o) => {
     if (o.bytes) {
       o.scene = Uint8Array.from(atob(o.bytes), (c) => c.charCodeAt(0)).buffer;
       delete o.bytes;
@@ -347,6 +347,22 @@ compare(
   await pageRender({ scene: "builtin:default", lens: "samyang-7.5mm", size: "128x96", spp: "auto" }),
   "builtin:default through samyang-7.5mm at 128x96, spp auto (adaptive)",
 );
+
+// A device with WebGPU's default limits alone (?limits=default), 8 storage buffers a stage as
+// on many phones: the tracer and adaptive sampling work within them, as natively.
+{
+  const small = await context.newPage();
+  await small.goto(`${site}?limits=default`);
+  const buffers = await small.evaluate(() => window.fisheye.ready.then((d) => d.storage_buffers));
+  check(buffers === 8, `?limits=default gives a device of WebGPU's default 8 storage buffers (${buffers})`);
+  const opts = { lens: "samyang-7.5mm", size: "128x96", spp: "auto" };
+  compare(
+    nativeRender("builtin:default", opts, "auto"),
+    await pageRender({ scene: "builtin:default", ...opts }, small),
+    "builtin:default through samyang-7.5mm at 128x96, spp auto (adaptive), on 8 storage buffers",
+  );
+  await small.close();
+}
 
 // The MTL beside the OBJ was fetched: the Cornell box's red wall is red, as natively (the
 // comparison above); and no warning said a file was missing.
