@@ -1,7 +1,7 @@
 // The page's script: starts the wasm module on the browser's WebGPU, exposes
 // `window.fisheye` ({ready, render(opts), open(opts), lensTwin, lenses}: the contract tests
 // and other pages drive), and wires the controls:
-// scene (built-in, picked or dropped files), lens, size, rays per pixel, orbiting camera,
+// scene (built-in, picked or dropped files), lens, size, rays per pixel, orbiting and flying camera,
 // the GPU time of each frame, saving the picture as PNG.
 import init, { Fisheye, lenses } from "./fisheye_web.js";
 
@@ -209,6 +209,7 @@ async function tick() {
     if (current === view) {
       last = frame;
       pose = last.camera;
+      $("view").dataset.camera = pose;
       step++;
       show(last);
       const warned = last.warnings.length ? ` (warnings: ${last.warnings.join("; ")})` : "";
@@ -228,23 +229,57 @@ async function tick() {
   requestAnimationFrame(tick);
 }
 
-// Turns the camera about its look-at point by a drag of (dx, dy) pixels; refinement restarts.
-function orbit(dx, dy) {
-  if (!pose) return;
-  const [eye, at] = pose.split(":").map((t) => t.split(",").map(Number));
-  const v = eye.map((e, i) => e - at[i]);
+// A pose's eye and look-at point, and back.
+const parsePose = (p) => p.split(":").map((t) => t.split(",").map(Number));
+const poseOf = (eye, at) => `${eye.join(",")}:${at.join(",")}`;
+
+// `point` turned about `centre` by `yaw` about the vertical (y) and `pitch` up, its distance
+// kept, never over the pole.
+function turned(centre, point, yaw, pitch) {
+  const v = point.map((p, i) => p - centre[i]);
   const r = Math.hypot(...v);
-  const yaw = Math.atan2(v[0], v[2]) - dx * 0.01;
-  const pitch = Math.max(-1.5, Math.min(1.5, Math.asin(v[1] / r) + dy * 0.01));
-  const e = [
-    at[0] + r * Math.cos(pitch) * Math.sin(yaw),
-    at[1] + r * Math.sin(pitch),
-    at[2] + r * Math.cos(pitch) * Math.cos(yaw),
+  const y = Math.atan2(v[0], v[2]) + yaw;
+  const p = Math.max(-1.5, Math.min(1.5, Math.asin(v[1] / r) + pitch));
+  return [
+    centre[0] + r * Math.cos(p) * Math.sin(y),
+    centre[1] + r * Math.sin(p),
+    centre[2] + r * Math.cos(p) * Math.cos(y),
   ];
-  pose = `${e.join(",")}:${at.join(",")}`;
+}
+
+// Moves to `next` (a pose) and starts refining there.
+function go(next) {
+  pose = next;
   step = 0;
   tick();
 }
+
+// A drag of (dx, dy) pixels: turns the eye about the look-at point (orbit), or with `look`
+// the look-at point about the eye (looking around, as flying).
+function drag(dx, dy, look) {
+  if (!pose) return;
+  const [eye, at] = parsePose(pose);
+  if (look) go(poseOf(eye, turned(eye, at, -dx * 0.005, -dy * 0.005)));
+  else go(poseOf(turned(at, eye, -dx * 0.01, dy * 0.01), at));
+}
+
+// Flies the eye and look-at point together `forward` steps along the view, `right` steps
+// across it and `up` steps up, a step a twentieth of their distance.
+function fly(forward, right, up) {
+  if (!pose) return;
+  const [eye, at] = parsePose(pose);
+  const d = at.map((a, i) => a - eye[i]);
+  const step = Math.hypot(...d) / 20;
+  const f = d.map((x) => x / Math.hypot(...d));
+  // Right: the view direction × y, level; none where the view is vertical.
+  const level = Math.hypot(f[0], f[2]);
+  const r = level > 0 ? [-f[2] / level, 0, f[0] / level] : [0, 0, 0];
+  const move = [0, 1, 2].map((i) => step * (forward * f[i] + right * r[i] + (i === 1 ? up : 0)));
+  go(poseOf(eye.map((e, i) => e + move[i]), at.map((a, i) => a + move[i])));
+}
+
+// Keys that fly: W/S forward and back, A/D left and right, E/Q up and down.
+const FLY_KEYS = { w: [1, 0, 0], s: [-1, 0, 0], a: [0, -1, 0], d: [0, 1, 0], e: [0, 0, 1], q: [0, 0, -1] };
 
 async function setUp() {
   let device;
@@ -300,14 +335,22 @@ async function setUp() {
     e.preventDefault();
     take(e.dataTransfer.files);
   };
-  let drag = null;
-  $("view").onpointerdown = (e) => (drag = [e.clientX, e.clientY]);
+  // Drag to orbit; with Shift (or the right button) to look around; keys fly. Moves made while
+  // a frame is on its way are dropped (the frame brings its own pose).
+  let from = null;
+  $("view").onpointerdown = (e) => (from = [e.clientX, e.clientY]);
+  $("view").oncontextmenu = (e) => e.preventDefault();
   window.onpointermove = (e) => {
-    if (!drag || busy) return;
-    orbit(e.clientX - drag[0], e.clientY - drag[1]);
-    drag = [e.clientX, e.clientY];
+    if (!from || busy) return;
+    drag(e.clientX - from[0], e.clientY - from[1], e.shiftKey || (e.buttons & 2) !== 0);
+    from = [e.clientX, e.clientY];
   };
-  window.onpointerup = () => (drag = null);
+  window.onpointerup = () => (from = null);
+  window.onkeydown = (e) => {
+    const keys = FLY_KEYS[e.key.toLowerCase()];
+    if (!keys || busy || e.target.closest("input, select, textarea") || e.ctrlKey || e.metaKey) return;
+    fly(...keys);
+  };
   reopen();
 }
 

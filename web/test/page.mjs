@@ -132,6 +132,7 @@ function nativeRender(scene, opts, name) {
   } else {
     args.push("--lens", opts.lens, "--size", opts.size);
   }
+  if (opts.camera) args.push("--camera", opts.camera);
   args.push("--spp", String(opts.spp), "-o", out);
   const uniform = /^[0-9]+$/.test(String(opts.spp));
   if (uniform) args.push("--outputs", "id");
@@ -300,6 +301,66 @@ for (const spec of twinSpecs) {
     return window.packed({ ...r, rgba: new Uint8Array(r.rgba.buffer), gpu_ms: 0 }, 0);
   });
   compare(native, canvas, `${obj} and its MTL picked in the page, its canvas`);
+
+  // Flying, in the default room (no headlight, which `--camera` would place at the new eye):
+  // W moves the eye and look-at point a twentieth of their distance along the view, D as far
+  // to the right (level), E as far up; a Shift-drag turns the view about the eye, keeping it
+  // and the distance. Each move renders a frame at the new pose (the canvas, read back at the
+  // end, is `fisheye render --camera` there).
+  const pose = () => picker.evaluate(() => document.getElementById("view").dataset.camera);
+  const after = async (move) => {
+    const before = await pose();
+    await move();
+    await picker
+      .waitForFunction((p) => document.getElementById("view").dataset.camera !== p, before, {
+        timeout: 120000,
+      })
+      .catch(async (e) => {
+        throw new Error(`the camera stayed at ${before}; the page said: ${await picker.textContent("#status")} (${e.message})`);
+      });
+    return [before, await pose()].map((p) => p.split(":").map((t) => t.split(",").map(Number)));
+  };
+  const sub = (a, b) => a.map((x, i) => x - b[i]);
+  const near = (a, b) => Math.hypot(...sub(a, b)) < 1e-9 * (1 + Math.hypot(...b));
+  const flew = async (key, direction) => {
+    const [[eye0, at0], [eye1, at1]] = await after(() => picker.keyboard.press(key));
+    const d = sub(at0, eye0);
+    const step = Math.hypot(...d) / 20;
+    const wanted = direction(d.map((x) => x / Math.hypot(...d))).map((x) => x * step);
+    return near(sub(eye1, eye0), wanted) && near(sub(at1, at0), wanted);
+  };
+  // Keys typed into the controls are theirs: leave them first (leaving a changed one
+  // re-renders, before the scene's change below).
+  await picker.evaluate(() => document.activeElement.blur());
+  await after(() => picker.selectOption("#scene", "builtin:default"));
+  const forward = await flew("w", (f) => f);
+  const right = await flew("d", (f) => {
+    const level = Math.hypot(f[0], f[2]);
+    return [-f[2] / level, 0, f[0] / level];
+  });
+  const up = await flew("e", () => [0, 1, 0]);
+  const box = await picker.locator("#view").boundingBox();
+  const [[eye0, at0], [eye1, at1]] = await after(async () => {
+    await picker.keyboard.down("Shift");
+    await picker.mouse.move(box.x + 50, box.y + 50);
+    await picker.mouse.down();
+    await picker.mouse.move(box.x + 80, box.y + 60);
+    await picker.mouse.up();
+    await picker.keyboard.up("Shift");
+  });
+  const distance = (a, b) => Math.hypot(...sub(a, b));
+  const looked =
+    near(eye1, eye0) && !near(at1, at0) && Math.abs(distance(at1, eye1) - distance(at0, eye0)) < 1e-9;
+  check(forward && right && up && looked, `W, D and E fly the camera by a twentieth of its distance (${forward}, ${right}, ${up}); Shift-drag turns it about the eye (${looked})`);
+  await picker.waitForFunction(() => /^200×150: .*submission/.test(document.getElementById("status").textContent));
+  const flown = await pose();
+  const seen = await picker.evaluate(() => {
+    const c = document.getElementById("view");
+    const r = { width: c.width, height: c.height, rgba: c.getContext("2d").getImageData(0, 0, c.width, c.height).data, warnings: [] };
+    return window.packed({ ...r, rgba: new Uint8Array(r.rgba.buffer), gpu_ms: 0 }, 0);
+  });
+  const there = nativeRender("builtin:default", { lens, size: "200x150", spp: 1, camera: flown }, "flown");
+  compare(there, seen, `the canvas after flying, against fisheye render --camera ${flown}`);
   await picker.close();
 }
 
