@@ -430,3 +430,46 @@ fn every_kernel_runs_within_the_storage_buffers_it_names() {
         assert_eq!(small.ids, large.ids);
     }
 }
+
+/// Marks around work whose passes take no timestamp writes of their own
+/// (`Queries::mark`, as the web page times a frame the renderer records) span at least the
+/// time the work's pass gives by its own timestamps, and at most the time from submission to
+/// completion.
+#[test]
+fn marks_around_a_frame_span_its_passes() {
+    use fisheye_rt::gpu::Queries;
+    use fisheye_rt::lens::gpu::DirectionSource;
+    let adapter = adapter();
+    let descriptor = wgpu::DeviceDescriptor {
+        required_features: wgpu::Features::TIMESTAMP_QUERY,
+        required_limits: fisheye_rt::renderer::required_limits(),
+        ..Default::default()
+    };
+    let (device, queue) = pollster::block_on(adapter.request_device(&descriptor)).unwrap();
+    let ctx = GpuContext::from_device(&device, &queue);
+    let (scene, camera) = view("default", "samyang-7.5mm", 96, 72);
+    let gpu_scene = GpuScene::new(&ctx, &scene, &RenderOptions::default()).unwrap();
+    let pass =
+        TracePass::supersampled(&ctx, &camera, &gpu_scene, DirectionSource::Computed, 4).unwrap();
+    let queries = Queries::new(&ctx, 2).expect("lavapipe has timestamp queries");
+    for _ in 0..3 {
+        let mut encoder = device.create_command_encoder(&Default::default());
+        queries.mark(&mut encoder, 0, true);
+        pass.encode(&mut encoder, &gpu_scene, Some(queries.writes(1)));
+        queries.mark(&mut encoder, 0, false);
+        queries.resolve(&mut encoder);
+        let started = std::time::Instant::now();
+        queue.submit([encoder.finish()]);
+        let ns = queries.read_ns(&ctx).unwrap();
+        let wall = started.elapsed().as_nanos() as f64;
+        let (marked, own) = (ns[0], ns[1]);
+        assert!(
+            own > 0.0 && marked >= own,
+            "marks {marked} ns, the pass {own} ns"
+        );
+        assert!(
+            marked <= wall,
+            "marks {marked} ns, {wall} ns from submission"
+        );
+    }
+}

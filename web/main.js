@@ -132,8 +132,8 @@ async function open(opts = {}) {
   }
 }
 
-// Renders as `fisheye render` does; resolves to {width, height, rgba, gpu_ms, camera,
-// warnings}.
+// Renders as `fisheye render` does; resolves to {width, height, rgba, ids, gpu_ms, timed_by,
+// wall_ms, camera, warnings}.
 async function render(opts = {}) {
   const view = await open(opts);
   return await view.frame("", false);
@@ -215,8 +215,8 @@ async function tick() {
       const warned = last.warnings.length ? ` (warnings: ${last.warnings.join("; ")})` : "";
       const progress = current.steps > 1 ? `, frame ${step} of at most ${current.steps}` : "";
       say(
-        `${last.width}×${last.height}${progress}: ${last.gpu_ms.toFixed(1)} ms from ` +
-          `submission to pixels${warned}`,
+        `${last.width}×${last.height}${progress}: ${last.gpu_ms.toFixed(1)} ms on the GPU ` +
+          `(${last.timed_by}), ${last.wall_ms.toFixed(1)} ms from submission to pixels${warned}`,
       );
     }
   } catch (error) {

@@ -50,18 +50,42 @@ impl Queries {
         }
     }
 
+    /// Records an empty compute pass that writes span `span`'s beginning (`first`) or its
+    /// end, to time work recorded between two marks whose passes take no timestamp writes of
+    /// their own (a frame recorded by [`crate::renderer::Renderer`]). Timestamps are written
+    /// as the GPU reaches them in order, the end once the work before it is done (Vulkan's
+    /// `vkCmdWriteTimestamp`); WebGPU leaves their relation to other passes to the
+    /// implementation, and browsers quantise them.
+    pub fn mark(&self, encoder: &mut wgpu::CommandEncoder, span: u32, first: bool) {
+        encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+            label: Some("fisheye.timestamps.mark"),
+            timestamp_writes: self.span(span).compute(first, !first),
+        });
+    }
+
     /// Resolves every timestamp; encode after the timed passes.
     pub fn resolve(&self, encoder: &mut wgpu::CommandEncoder) {
         encoder.resolve_query_set(&self.set, 0..2 * self.passes, &self.resolved, 0);
     }
 
+    /// The resolved timestamps (`QUERY_RESOLVE | COPY_SRC`): copy them to a buffer of one's
+    /// own to read them without blocking, and give them to [`Queries::durations_ns`].
+    pub fn resolved(&self) -> &wgpu::Buffer {
+        &self.resolved
+    }
+
     /// The duration of each timed pass in nanoseconds, once the resolve has been submitted.
     pub fn read_ns(&self, ctx: &GpuContext) -> Result<Vec<f64>> {
         let ticks: Vec<u64> = ctx.read_buffer(&self.resolved)?;
-        Ok(ticks
+        Ok(self.durations_ns(&ticks))
+    }
+
+    /// The duration of each timed span in nanoseconds from the resolved timestamps `ticks`.
+    pub fn durations_ns(&self, ticks: &[u64]) -> Vec<f64> {
+        ticks
             .chunks_exact(2)
             .map(|pair| pair[1].wrapping_sub(pair[0]) as f64 * self.period_ns)
-            .collect())
+            .collect()
     }
 
     /// Times `frames` frames of one pass after `warmup` untimed ones: `encode(frame, encoder,

@@ -17,7 +17,7 @@ use std::rc::Rc;
 use std::sync::{Arc, Mutex};
 use std::task::{Context, Poll, Waker};
 
-use fisheye_rt::gpu::GpuContext;
+use fisheye_rt::gpu::{GpuContext, Queries};
 use fisheye_rt::input::InputKind;
 use fisheye_rt::lens::glass::camera_for;
 use fisheye_rt::lens::gpu::LensRays;
@@ -86,7 +86,8 @@ impl Fisheye {
         let (device, queue) = adapter
             .request_device(&wgpu::DeviceDescriptor {
                 label: Some("fisheye.web"),
-                required_features: wgpu::Features::empty(),
+                // Timestamps, where the adapter has them, time each frame on the GPU.
+                required_features: adapter.features() & wgpu::Features::TIMESTAMP_QUERY,
                 required_limits: match defaults_only {
                     Some(true) => wgpu::Limits::default(),
                     _ => has,
@@ -210,6 +211,9 @@ struct ViewInner {
     row: u32,
     /// Where its ids are (traced frames only).
     ids_read_back: Option<wgpu::Buffer>,
+    /// Timestamps around each frame and where they are read, on a device with timestamp
+    /// queries.
+    timing: Option<(Queries, wgpu::Buffer)>,
     /// The frames a progressive refinement takes at most (1 where it is not progressive).
     steps: u32,
 }
@@ -221,11 +225,14 @@ impl View {
     /// (`Renderer::encode_progressive`: with adaptive sampling the first frame at a pose is
     /// the coarse one and each frame after it at the same pose sharpens it, until the whole
     /// frame, bit for bit, after at most [`View::steps`]; a new pose starts again). Resolves
-    /// to `{width, height, rgba, ids, gpu_ms, camera, warnings}`: the PNG's 8-bit sRGB pixels,
-    /// the scene triangle at each pixel's centre (`--outputs id`'s, as a `Uint32Array`; with
-    /// adaptive sampling only the traced pixels' are there, the rest `NO_HIT`), the
-    /// milliseconds from submission to the pixels' arrival on the CPU, the pose (as `camera`
-    /// takes it) and what loading the scene warned of. One frame at a time: frames share the
+    /// to `{width, height, rgba, ids, gpu_ms, timed_by, wall_ms, camera, warnings}`: the
+    /// PNG's 8-bit sRGB pixels, the scene triangle at each pixel's centre (`--outputs id`'s,
+    /// as a `Uint32Array`; with adaptive sampling only the traced pixels' are there, the rest
+    /// `NO_HIT`), the frame's milliseconds on the GPU (`timed_by` `"timestamps"`: from the
+    /// start of its first pass to the end of its last, by the GPU's timestamps, which browsers
+    /// quantise; or `"wall clock"` where the device has no timestamp queries, `wall_ms`), the
+    /// milliseconds from submission to the pixels' arrival on the CPU (`wall_ms`), the pose
+    /// (as `camera` takes it) and what loading the scene warned of. One frame at a time: frames share the
     /// view's read-back buffers.
     pub fn frame(&self, camera: String, progressive: bool) -> js_sys::Promise {
         let inner = self.inner.clone();
@@ -237,7 +244,13 @@ impl View {
             set("height", image.size.height.into())?;
             set("rgba", Uint8Array::from(&image.rgba[..]).into())?;
             set("ids", js_sys::Uint32Array::from(&image.ids[..]).into())?;
-            set("gpu_ms", image.gpu_ms.into())?;
+            let (gpu_ms, timed_by) = match image.gpu_ms {
+                Some(ms) => (ms, "timestamps"),
+                None => (image.wall_ms, "wall clock"),
+            };
+            set("gpu_ms", gpu_ms.into())?;
+            set("timed_by", timed_by.into())?;
+            set("wall_ms", image.wall_ms.into())?;
             set("camera", image.camera.into())?;
             let warnings: Array = inner.warnings.iter().map(JsValue::from).collect();
             set("warnings", warnings.into())?;
@@ -275,7 +288,10 @@ struct Image {
     rgba: Vec<u8>,
     /// The scene triangle at each pixel's centre (`NO_HIT` where none), row-major.
     ids: Vec<u32>,
-    gpu_ms: f64,
+    /// The frame's time on the GPU by timestamps, where the device has them.
+    gpu_ms: Option<f64>,
+    /// From submission to the pixels' arrival on the CPU.
+    wall_ms: f64,
     /// The pose it was seen from, as `camera` takes it.
     camera: String,
 }
@@ -328,6 +344,11 @@ impl Request {
         let ids = renderer
             .outputs()
             .map(|[_, _, ids]| read_back("fisheye.web.ids", ids.size()));
+        let ctx = GpuContext::from_device(&device, &queue);
+        let timing = Queries::new(&ctx, 1).map(|q| {
+            let ticks = read_back("fisheye.web.timestamps", q.resolved().size());
+            (q, ticks)
+        });
         Ok(ViewInner {
             device,
             queue,
@@ -340,6 +361,7 @@ impl Request {
             read_back: image,
             row,
             ids_read_back: ids,
+            timing,
             steps: if adaptive.is_some() { 2 + spp } else { 1 },
         })
     }
@@ -417,6 +439,9 @@ impl ViewInner {
         };
         let (size, row) = (self.size, self.row);
         let mut encoder = self.device.create_command_encoder(&Default::default());
+        if let Some((queries, _)) = &self.timing {
+            queries.mark(&mut encoder, 0, true);
+        }
         let encoded = match progressive {
             true => self
                 .renderer
@@ -424,6 +449,12 @@ impl ViewInner {
             false => self.renderer.encode(&mut encoder, &pose, &self.target),
         };
         encoded.map_err(error)?;
+        if let Some((queries, ticks)) = &self.timing {
+            queries.mark(&mut encoder, 0, false);
+            queries.resolve(&mut encoder);
+            let resolved = queries.resolved();
+            encoder.copy_buffer_to_buffer(resolved, 0, ticks, 0, resolved.size());
+        }
         encoder.copy_texture_to_buffer(
             self.target.as_image_copy(),
             wgpu::TexelCopyBufferInfo {
@@ -442,7 +473,14 @@ impl ViewInner {
         }
         let started = js_sys::Date::now();
         let data = submit_and_read(&self.queue, encoder, &self.read_back, &self.errors).await?;
-        let gpu_ms = js_sys::Date::now() - started;
+        let wall_ms = js_sys::Date::now() - started;
+        let gpu_ms = match &self.timing {
+            Some((queries, ticks)) => {
+                let ticks: Vec<u64> = bytemuck::pod_collect_to_vec(&map_read(ticks).await?);
+                Some(queries.durations_ns(&ticks)[0] * 1e-6)
+            }
+            None => None,
+        };
         let ids = match &self.ids_read_back {
             Some(staging) => bytemuck::pod_collect_to_vec::<u8, u32>(&map_read(staging).await?),
             None => Vec::new(),
@@ -468,6 +506,7 @@ impl ViewInner {
             rgba: colour_image_with(size, &colour, &display).into_raw(),
             ids,
             gpu_ms,
+            wall_ms,
             camera: format!(
                 "{},{},{}:{},{},{}",
                 pose.position.x,

@@ -73,6 +73,8 @@ await context.addInitScript(() => {
     width: r.width,
     height: r.height,
     gpu_ms: r.gpu_ms,
+    timed_by: r.timed_by,
+    wall_ms: r.wall_ms,
     ms,
     warnings: r.warnings,
     rgba: base64(r.rgba),
@@ -185,7 +187,8 @@ function compare(native, web, what) {
     `${what}: ${(100 * share).toFixed(3)}% of pixels beyond 2 levels, mean ` +
       `${mean.toFixed(4)}, ${masks} mask pixels differ${ids}, ` +
       `${((100 * lit) / pixels).toFixed(0)}% lit; ${web.ms.toFixed(0)} ms in the page ` +
-      `(${web.gpu_ms.toFixed(0)} ms submission to pixels)`,
+      `(${web.wall_ms.toFixed(0)} ms submission to pixels` +
+      `${web.timed_by ? `, ${web.gpu_ms.toFixed(1)} ms on the GPU by ${web.timed_by}` : ""})`,
   );
 }
 
@@ -216,17 +219,28 @@ const cases = [
     spp: 1,
   },
 ];
+const timings = [];
 for (const [k, c] of cases.entries()) {
   const file = c.bytes ?? (c.scene.startsWith("/") ? c.scene.slice(1) : null);
   const scene = file ? path.join(repo, file) : c.scene;
   const what = `${c.bytes ?? c.scene} through ${c.lens.split(":")[0]} at ${c.size}, spp ${c.spp}`;
   try {
     const native = nativeRender(scene, c, `case${k}`);
-    compare(native, await pageRender(c), what);
+    const web = await pageRender(c);
+    compare(native, web, what);
+    timings.push(web);
   } catch (error) {
     check(false, `${what}: ${error.message ?? error}`);
   }
 }
+// SwiftShader has timestamp queries: each frame's GPU time is theirs, more than nothing and
+// no more than the time from submission to its pixels (Chromium quantises timestamps to
+// 0.1 ms, hence the margin).
+check(
+  timings.length === cases.length &&
+    timings.every((t) => t.timed_by === "timestamps" && t.gpu_ms > 0 && t.gpu_ms <= t.wall_ms + 0.1),
+  `frames timed by GPU timestamps: ${timings.map((t) => `${t.gpu_ms.toFixed(1)} of ${t.wall_ms.toFixed(0)} ms`).join(", ")}`,
+);
 
 // The lens twins in the page: the WGSL lens code on SwiftShader against the f64 reference
 // compiled to wasm, at every pixel, within `fisheye_rt::lens::twin`'s bounds (those
@@ -298,7 +312,7 @@ for (const spec of twinSpecs) {
   const canvas = await picker.evaluate(() => {
     const c = document.getElementById("view");
     const r = { width: c.width, height: c.height, rgba: c.getContext("2d").getImageData(0, 0, c.width, c.height).data, warnings: [] };
-    return window.packed({ ...r, rgba: new Uint8Array(r.rgba.buffer), gpu_ms: 0 }, 0);
+    return window.packed({ ...r, rgba: new Uint8Array(r.rgba.buffer), wall_ms: 0 }, 0);
   });
   compare(native, canvas, `${obj} and its MTL picked in the page, its canvas`);
 
@@ -357,7 +371,7 @@ for (const spec of twinSpecs) {
   const seen = await picker.evaluate(() => {
     const c = document.getElementById("view");
     const r = { width: c.width, height: c.height, rgba: c.getContext("2d").getImageData(0, 0, c.width, c.height).data, warnings: [] };
-    return window.packed({ ...r, rgba: new Uint8Array(r.rgba.buffer), gpu_ms: 0 }, 0);
+    return window.packed({ ...r, rgba: new Uint8Array(r.rgba.buffer), wall_ms: 0 }, 0);
   });
   const there = nativeRender("builtin:default", { lens, size: "200x150", spp: 1, camera: flown }, "flown");
   compare(there, seen, `the canvas after flying, against fisheye render --camera ${flown}`);
@@ -488,19 +502,24 @@ check(after.width === 64 && after.height === 48, "the page renders after bad inp
   await plain.close();
 }
 
-// With TIMINGS=N, each of the book's timed frames is rendered N times and the median of all
-// but the first printed (submission to pixels).
+// With TIMINGS=N, each of the book's timed frames is rendered N times and the medians of all
+// but the first printed: submission to pixels, and GPU time.
 if (process.env.TIMINGS) {
   const timed = [
     { scene: "builtin:default", lens: "samyang-7.5mm", size: "256x192", spp: 4 },
     { scene: "builtin:default", lens: "canon-8-15mm@8mm", size: "1024x768", spp: 1 },
   ];
+  const median = (v) => v.slice(1).sort((a, b) => a - b)[Math.floor((v.length - 1) / 2)];
   for (const opts of timed) {
-    const ms = [];
-    for (let i = 0; i < Number(process.env.TIMINGS); i++) ms.push((await pageRender(opts)).gpu_ms);
-    const later = ms.slice(1).sort((a, b) => a - b);
-    const median = later[Math.floor(later.length / 2)];
-    console.log(`timing ${opts.lens} ${opts.size} spp ${opts.spp}: first ${ms[0].toFixed(0)} ms, median of the rest ${median.toFixed(0)} ms`);
+    const frames = [];
+    for (let i = 0; i < Number(process.env.TIMINGS); i++) frames.push(await pageRender(opts));
+    const wall = frames.map((f) => f.wall_ms);
+    const gpu = frames.map((f) => f.gpu_ms);
+    console.log(
+      `timing ${opts.lens} ${opts.size} spp ${opts.spp}: first ${wall[0].toFixed(0)} ms, medians of ` +
+        `the rest ${median(wall).toFixed(0)} ms submission to pixels, ${median(gpu).toFixed(1)} ms on ` +
+        `the GPU (${frames[0].timed_by})`,
+    );
   }
 }
 
