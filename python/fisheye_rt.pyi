@@ -91,6 +91,7 @@ class Renderer:
         exposure: float = 0.0,
         tone: Literal["aces", "clamp"] = "aces",
         time: float = 0.0,
+        filter: Literal["box", "tent"] = "box",
     ) -> dict[str, np.ndarray]:
         """Renders through `lens` from `pose` (4×4 T_scene_camera; the scene's camera if None)
         with `spp` rays per pixel (a square, 1 to 256, or "auto[:THRESHOLD[:MAX]]": adaptive
@@ -100,7 +101,9 @@ class Renderer:
         float32, "normal" H×W×3 float32, "id" H×W uint32 (4294967295: none), "direction"
         H×W×3 float32 (scene frame), "mask" H×W uint8, as `fisheye render --outputs` writes
         them, bit for bit. Moving objects are placed at scene time `time` (seconds), as
-        `fisheye render --time` places them. The GIL is released while the GPU works."""
+        `fisheye render --time` places them. `filter` "tent" blends each pixel of a frame of
+        one ray a pixel at most with its neighbours, as `fisheye render --filter tent`. The GIL
+        is released while the GPU works."""
 
 def look_at(
     eye: Tuple[float, float, float],

@@ -3,18 +3,19 @@
 # (the built-in many-small and few-detailed, and the shared Sibenik, Cornell box, bunny and
 # Buddha), through a 180° equidistant fisheye (canon-8-15mm@8mm) and the Samyang equisolid
 # preset (bench adds the pinhole baseline); direct RT over rays per pixel (SPP: uniform
-# counts, and adaptive sampling at thresholds and most rays, auto:THRESHOLD[:MAX]) against
+# counts, and adaptive sampling at thresholds and most rays, auto:THRESHOLD[:MAX]), each
+# with the box filter and, where pixels take one ray, the tent (FILTERS), against
 # the cube maps over face sizes (CUBES); then the thesis's face sizes (512, 1024, 1920) at
 # 1024x768.
 #
 #   bash results/run.sh results/NAME
-#   # SIZE, CUBES, SPP, REFERENCE_SPP, BENCH_CUBES, BENCH_SPP, FRAMES, COMPARE_FRAMES, SCENES,
-#   # COMPARE, SOAK, GLASS, THESIS, VALIDATE override (0 leaves the part out); FISHEYE=PATH runs a
-#   # binary built elsewhere instead of building one
+#   # SIZE, CUBES, SPP, FILTERS, REFERENCE_SPP, BENCH_CUBES, BENCH_SPP, FRAMES, COMPARE_FRAMES,
+#   # SCENES, COMPARE, BENCH, SOAK, GLASS, THESIS, VALIDATE override (0 leaves the part out);
+#   # FISHEYE=PATH runs a binary built elsewhere instead of building one
 #
 # The defaults suit a CPU (lavapipe): 256x192 images, and cube faces of 128, 256 and 480
-# texels (0.5, 1 and 2 texels per pixel at the 180° image's centre, as the 512, 1024
-# and 1920 are at 1024x768). On a GPU use SIZE=1024x768 CUBES=512,1024,1920
+# texels (1.2, 2.4 and 4.5 texels across a pixel at the 180° image's centre, whose circle is
+# 169 pixels wide: as the 512, 1024 and 1920 are at 1024x768). On a GPU use SIZE=1024x768 CUBES=512,1024,1920
 # BENCH_CUBES=512,1024,1920 FRAMES=60 COMPARE_FRAMES=15 (a GPU's clocks need more than three
 # frames for a steady median). Error maps and reference images are kept for the first
 # scene only (FIRST=0: for none), to keep the folder small.
@@ -24,11 +25,12 @@ out=${1:?usage: bash results/run.sh OUT_DIR}
 size=${SIZE:-256x192}
 cubes=${CUBES:-128,256,480}
 spp=${SPP:-1,4,16,auto:0.1:1,auto:0.1:4,auto:0.1,auto:0.02}
+filters=${FILTERS:-box,tent}
 reference_spp=${REFERENCE_SPP:-256}
 bench_cubes=${BENCH_CUBES:-128,256}
 bench_spp=${BENCH_SPP:-1,16,auto:0.1:1,auto:0.1}
 frames=${FRAMES:-8}
-compare_frames=${COMPARE_FRAMES:-3}
+compare_frames=${COMPARE_FRAMES:-7}
 bin=${FISHEYE:-target/release/fisheye}
 [ -n "${FISHEYE:-}" ] || cargo build --release --quiet
 lenses=(--lens canon-8-15mm@8mm --lens samyang-7.5mm)
@@ -39,15 +41,18 @@ for scene in $scenes; do
     name=$(basename "${scene#builtin:}" .toml)
     if [ "${COMPARE:-1}" = 1 ]; then
         "$bin" compare "$scene" "${lenses[@]}" --no-pinhole --size "$size" --cube-size "$cubes" \
-            --spp "$spp" --reference-spp "$reference_spp" --frames "$compare_frames" \
-            -o "$out/$name/compare"
+            --spp "$spp" --filter "$filters" --reference-spp "$reference_spp" \
+            --frames "$compare_frames" -o "$out/$name/compare"
         if [ "$first" = 0 ]; then
             rm -f "$out/$name/compare/"*.error.png "$out/$name/compare/"*.reference.png
         fi
         first=0
     fi
-    "$bin" bench "$scene" "${lenses[@]}" --size "$size" --cube-size "$bench_cubes" \
-        --spp "$bench_spp" --frames "$frames" --warmup 2 -o "$out/$name/bench"
+    if [ "${BENCH:-1}" = 1 ]; then
+        "$bin" bench "$scene" "${lenses[@]}" --size "$size" --cube-size "$bench_cubes" \
+            --spp "$bench_spp" --filter "$filters" --frames "$frames" --warmup 2 \
+            -o "$out/$name/bench"
+    fi
 done
 # Lens validation: every preset and calibrated example. Two overlays are kept, and no
 # per-corner lists, to keep the folder small (VALIDATE=0 leaves it out).

@@ -32,7 +32,10 @@ const FONT_CANDIDATES: [&str; 6] = [
 pub fn font() -> std::result::Result<&'static Path, String> {
     static FONT: OnceLock<std::result::Result<PathBuf, String>> = OnceLock::new();
     FONT.get_or_init(|| {
-        let wanted = std::env::var_os("FISHEYE_FONT").map(PathBuf::from);
+        // An empty FISHEYE_FONT (`FISHEYE_FONT= cmd`) is no choice of font.
+        let wanted = std::env::var_os("FISHEYE_FONT")
+            .filter(|v| !v.is_empty())
+            .map(PathBuf::from);
         let path = match &wanted {
             Some(p) => p.clone(),
             None => FONT_CANDIDATES

@@ -17,7 +17,7 @@ use crate::split::SceneArrays;
 const SCENE_ARRAYS: &str = "scene_arrays";
 
 /// Every WGSL file of the project, by name (its file stem under `wgsl/`).
-pub const FILES: [(&str, &str); 34] = [
+pub const FILES: [(&str, &str); 35] = [
     ("math", include_str!("../wgsl/math.wgsl")),
     ("quaternion", include_str!("../wgsl/quaternion.wgsl")),
     ("calibrated", include_str!("../wgsl/calibrated.wgsl")),
@@ -34,6 +34,7 @@ pub const FILES: [(&str, &str); 34] = [
     ("adaptive", include_str!("../wgsl/adaptive.wgsl")),
     ("adaptive_rq", include_str!("../wgsl/adaptive_rq.wgsl")),
     ("adaptive_args", include_str!("../wgsl/adaptive_args.wgsl")),
+    ("tent", include_str!("../wgsl/tent.wgsl")),
     ("cast", include_str!("../wgsl/cast.wgsl")),
     ("lens", include_str!("../wgsl/lens.wgsl")),
     ("glass", include_str!("../wgsl/glass.wgsl")),

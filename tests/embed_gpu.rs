@@ -7,7 +7,7 @@ use fisheye_rt::gpu::GpuContext;
 use fisheye_rt::lens::{ImageSize, LensCamera, parse_spec};
 use fisheye_rt::renderer::Renderer;
 use fisheye_rt::scene::{Camera, Scene, builtin};
-use fisheye_rt::trace::{Adaptive, GpuScene, RenderOptions, TracePass, render};
+use fisheye_rt::trace::{Adaptive, GpuScene, PixelFilter, RenderOptions, TracePass, render};
 use glam::DVec3;
 
 /// The default adapter, found the plain wgpu way.
@@ -326,7 +326,8 @@ fn unwritable_targets_are_errors_naming_what_is_wanted() {
 
 /// Progressive frames (`Renderer::encode_progressive`): the first at a pose is the adaptive
 /// frame below one ray a pixel, frames at the same pose sharpen it into the whole adaptive
-/// frame, and a move starts again; frames with uniform sampling are whole from the first.
+/// frame, and a move starts again; frames with uniform sampling are whole from the first, and
+/// so are adaptive frames of one ray at most, through the tent filter too.
 #[test]
 fn progressive_frames_sharpen_while_still_and_restart_on_a_move() {
     let (device, queue) = own_device();
@@ -347,8 +348,17 @@ fn progressive_frames_sharpen_while_still_and_restart_on_a_move() {
         position: home.position + DVec3::new(0.3, 0.0, 0.2),
         ..home
     };
+    let tent = |options: RenderOptions| RenderOptions {
+        filter: PixelFilter::Tent,
+        ..options
+    };
     for (options, first, last) in [
         (sampled(16, true), sampled(1, true), sampled(16, true)),
+        (
+            tent(sampled(1, true)),
+            tent(sampled(1, true)),
+            tent(sampled(1, true)),
+        ),
         (sampled(4, false), sampled(4, false), sampled(4, false)),
     ] {
         let renderer = Renderer::new(&device, &queue, &scene, &camera, &options, format).unwrap();

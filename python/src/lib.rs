@@ -16,8 +16,8 @@ use fisheye_rt::lens::points::{self, PixelOrigin};
 use fisheye_rt::lens::{ImageSize, LensCamera, calib};
 use fisheye_rt::scene::Camera;
 use fisheye_rt::trace::{
-    Channel, Display, FramePass, GpuScene, RenderOptions, RenderOutput, Sampling, Tone, Values,
-    colour_image_with, world_directions,
+    Channel, Display, FramePass, GpuScene, PixelFilter, RenderOptions, RenderOutput, Sampling,
+    Tone, Values, colour_image_with, world_directions,
 };
 use fisheye_rt::{Error, LensError};
 use glam::{DAffine3, DVec2, DVec3};
@@ -399,8 +399,10 @@ impl Renderer {
     /// scene frame) and "mask" (H×W uint8). The same arrays `fisheye render --outputs`
     /// writes, bit for bit. Moving objects (glTF animations, scene-file keys) are placed at
     /// scene time `time` (seconds), as `fisheye render --time` places them, without building
-    /// the meshes' BVHs again.
-    #[pyo3(signature = (lens, pose = None, spp = Spp::Count(16), outputs = vec!["colour".to_string(), "srgb".to_string()], exposure = 0.0, tone = "aces", time = 0.0))]
+    /// the meshes' BVHs again. `filter` is "box" (each pixel its own rays' mean) or "tent"
+    /// (at one ray a pixel at most, each pixel blended with its neighbours, as
+    /// `fisheye render --filter tent`).
+    #[pyo3(signature = (lens, pose = None, spp = Spp::Count(16), outputs = vec!["colour".to_string(), "srgb".to_string()], exposure = 0.0, tone = "aces", time = 0.0, filter = "box"))]
     #[allow(clippy::too_many_arguments)]
     fn render<'py>(
         &self,
@@ -412,7 +414,11 @@ impl Renderer {
         exposure: f32,
         tone: &str,
         time: f64,
+        filter: &str,
     ) -> PyResult<Bound<'py, PyDict>> {
+        let filter: PixelFilter = filter
+            .parse()
+            .map_err(|e| PyValueError::new_err(format!("filter: {e}")))?;
         if !time.is_finite() {
             return Err(PyValueError::new_err(format!(
                 "time={time}: give a finite number of seconds"
@@ -463,7 +469,10 @@ impl Renderer {
         };
         let ctx = context()?;
         let camera = lens.camera;
-        let options = self.options;
+        let options = RenderOptions {
+            filter,
+            ..self.options
+        };
         let rays = (sampling, ground_truth);
         let output = py.detach(|| self.trace(ctx, &camera, (&pose, time), rays, &options))?;
         let dict = PyDict::new(py);
@@ -534,7 +543,7 @@ impl Renderer {
         let (spp, adaptive) = sampling.options(ground_truth);
         let key = (
             format!("{camera:?}"),
-            sampling.to_string(),
+            format!("{sampling}+{}", options.filter.name()),
             ground_truth && adaptive.is_some(),
         );
         if !passes.contains_key(&key) {

@@ -192,6 +192,24 @@ def test_adaptive_sampling_equals_the_commands_and_keeps_exact_ground_truth(tmp_
     assert exact["colour"].tobytes() == uniform["colour"].tobytes()
 
 
+def test_the_tent_filter_is_the_commands(tmp_path):
+    """filter="tent" renders what `fisheye render --filter tent` writes, bit for bit, and
+    changes a one-ray image's colour but not its ground truth."""
+    out = tmp_path / "tent.png"
+    fisheye(
+        "render", "builtin:default", "--lens", "samyang-7.5mm", "--size", "96x72", "--spp",
+        "auto:0.1:1", "--filter", "tent", "--outputs", "id", "-o", str(out),
+    )
+    renderer = fr.Renderer(fr.Scene.load("builtin:default"))
+    lens = fr.Lens.from_spec("samyang-7.5mm", size=(96, 72))
+    tent = renderer.render(lens, spp="auto:0.1:1", filter="tent", outputs=["srgb", "id"])
+    assert np.array_equal(tent["srgb"], np.asarray(Image.open(out).convert("RGBA")))
+    assert tent["id"].tobytes() == np.load(tmp_path / "tent.id.npy").tobytes()
+    boxed = renderer.render(lens, spp="auto:0.1:1", outputs=["srgb", "id"])
+    assert np.array_equal(boxed["id"], tent["id"])
+    assert not np.array_equal(boxed["srgb"], tent["srgb"])
+
+
 def test_a_prescription_is_a_lens_as_the_command_line_has_it():
     """Lens.from_spec takes a lens prescription (mapping by its chief rays, fitted as
     Kannala-Brandt at the size): directions land where `fisheye lens project` puts them, to
@@ -313,6 +331,7 @@ def test_bad_input_raises_with_the_librarys_message(tmp_path):
         (lambda: renderer.render(lens, pose=np.eye(3)), ValueError, "4×4"),
         (lambda: renderer.render(lens, pose=shear), ValueError, "rotation"),
         (lambda: renderer.render(lens, tone="filmic"), ValueError, "tone"),
+        (lambda: renderer.render(lens, filter="gauss"), ValueError, "tent"),
         (lambda: renderer.render(lens, exposure=float("nan")), ValueError, "exposure"),
     ]
     for call, kind, text in cases:

@@ -49,8 +49,8 @@ use crate::scene::{Camera, Scene};
 use crate::shader;
 use crate::shared::{ADAPTIVE_STORAGE_BUFFERS, TRACE_STORAGE_BUFFERS};
 use crate::trace::{
-    Adaptive, AdaptivePass, AdaptiveSpans, GpuScene, RenderOptions, RenderOutput, TracePass,
-    Traversal,
+    Adaptive, AdaptivePass, AdaptiveSpans, GpuScene, PixelFilter, RenderOptions, RenderOutput,
+    TracePass, Traversal,
 };
 
 /// The limits a device needs for the renderer: wgpu's downlevel defaults, with the storage
@@ -153,34 +153,39 @@ pub(crate) enum Path {
 }
 
 /// How a frame's passes are timed: a traced frame's one pass, an adaptive frame's stages, a
-/// cube map's passes.
+/// traced frame's filter, a cube map's passes.
 #[derive(Default)]
 pub(crate) struct Spans<'a> {
     pub(crate) trace: Option<wgpu::ComputePassTimestampWrites<'a>>,
+    pub(crate) filter: Option<wgpu::ComputePassTimestampWrites<'a>>,
     pub(crate) adaptive: AdaptiveSpans<'a>,
     pub(crate) cube: CubeSpans<'a>,
 }
 
 impl Path {
     /// Direct tracing with `directions` and `spp` rays per pixel (adaptively where `adaptive`
-    /// says), or a cube map made as `cube` says.
+    /// says), its colours made as `filter` says, or a cube map made as `cube` says.
     pub(crate) fn new(
         ctx: &GpuContext,
         camera: &LensCamera,
         scene: &GpuScene,
-        (directions, spp, adaptive): (DirectionSource, u32, Option<Adaptive>),
+        (directions, spp, adaptive, filter): (DirectionSource, u32, Option<Adaptive>, PixelFilter),
         cube: Option<&CubeSettings>,
     ) -> Result<Self> {
         Ok(match (cube, adaptive) {
             (Some(settings), _) => {
                 Path::Cube(Box::new(CubeMap::new(ctx, camera, scene, settings)?))
             }
-            (None, Some(adaptive)) => Path::Adaptive(Box::new(AdaptivePass::new(
-                ctx, camera, scene, directions, spp, adaptive,
-            )?)),
-            (None, None) => Path::Direct(Box::new(TracePass::supersampled(
-                ctx, camera, scene, directions, spp,
-            )?)),
+            (None, Some(adaptive)) => {
+                let mut pass = AdaptivePass::new(ctx, camera, scene, directions, spp, adaptive)?;
+                pass.set_filter(ctx, filter)?;
+                Path::Adaptive(Box::new(pass))
+            }
+            (None, None) => {
+                let mut pass = TracePass::supersampled(ctx, camera, scene, directions, spp)?;
+                pass.set_filter(ctx, filter)?;
+                Path::Direct(Box::new(pass))
+            }
         })
     }
 
@@ -203,6 +208,9 @@ impl Path {
                 pass.encode(encoder, scene, spans.adaptive);
             }
             Path::Cube(cube) => cube.encode(ctx, encoder, scene, pose, spans.cube),
+        }
+        if let Some(pass) = self.trace_pass() {
+            pass.encode_filter(encoder, spans.filter);
         }
     }
 
@@ -321,7 +329,12 @@ impl Renderer {
             scene
         };
         let gpu_scene = GpuScene::new(&ctx, scene, options)?;
-        let rays = (options.directions, options.spp, options.adaptive);
+        let rays = (
+            options.directions,
+            options.spp,
+            options.adaptive,
+            options.filter,
+        );
         let path = Path::new(&ctx, camera, &gpu_scene, rays, cube)?;
         let (present, present_layout) = ctx.checked("creating the present pass", || {
             let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
@@ -441,6 +454,7 @@ impl Renderer {
                         pass.encode_pose(&ctx.device, encoder, scene, pose);
                     }
                     pass.encode_step(encoder, scene, step);
+                    pass.trace_pass().encode_filter(encoder, None);
                 }
                 (_, 0) => self
                     .path

@@ -16,8 +16,8 @@ use crate::lens::gpu::DirectionSource;
 use crate::raster::RasterMethod;
 use crate::scene::{Camera, Scene};
 use crate::trace::{
-    ALL_STAGES, Adaptive, AdaptiveSpans, GpuScene, RenderOptions, RenderOutput, Sampling, Stage,
-    Traversal, stages_for,
+    ALL_STAGES, Adaptive, AdaptiveSpans, GpuScene, PixelFilter, RenderOptions, RenderOutput,
+    Sampling, Stage, Traversal, stages_for,
 };
 
 impl Method {
@@ -44,6 +44,8 @@ pub struct Setup {
     /// Rays per pixel of a direct method, uniform or adaptive (see [`Sampling`]); one for
     /// cube maps, whose resampler takes one bilinear sample a pixel.
     pub sampling: Sampling,
+    /// How a direct method's pixels are made from its rays; the box for cube maps.
+    pub filter: PixelFilter,
 }
 
 impl Setup {
@@ -58,7 +60,18 @@ impl Setup {
             method,
             cube_size: 0,
             sampling,
+            filter: PixelFilter::Box,
         }
+    }
+
+    /// This direct setup with its pixels made as `filter` says: the box where the filter
+    /// would change no pixel ([`PixelFilter::applies_to`]), so that no setup is measured twice.
+    pub fn filtered(self, filter: PixelFilter) -> Setup {
+        let filter = match filter.applies_to(self.sampling) {
+            true => filter,
+            false => PixelFilter::Box,
+        };
+        Setup { filter, ..self }
     }
 
     /// A cube method at face size `cube_size`.
@@ -67,15 +80,18 @@ impl Setup {
             method,
             cube_size,
             sampling: Sampling::Uniform(1),
+            filter: PixelFilter::Box,
         }
     }
 
-    /// `rt@16spp`, `rt@auto:0.02`, `rq@1spp`, or the cube method and face size:
-    /// `cube-forward@512`.
+    /// `rt@16spp`, `rt@auto:0.02`, `rq@1spp`, `rt@1spp+tent` (the tent filter), or the cube
+    /// method and face size: `cube-forward@512`.
     pub fn label(&self) -> String {
-        match self.method {
-            Method::Cube(_) => format!("{}@{}", self.method.name(), self.cube_size),
-            _ => format!("{}@{}", self.method.name(), self.sampling.label()),
+        let method = self.method.name();
+        match (self.method, self.filter) {
+            (Method::Cube(_), _) => format!("{method}@{}", self.cube_size),
+            (_, PixelFilter::Box) => format!("{method}@{}", self.sampling.label()),
+            (_, filter) => format!("{method}@{}+{}", self.sampling.label(), filter.name()),
         }
     }
 
@@ -103,24 +119,38 @@ impl Setup {
 
     /// The passes a frame of this setup is timed in, in order (an adaptive frame's stages, as
     /// [`crate::trace::stages_for`] lists them).
+    /// A filtered direct setup's filter is a pass of its own, last.
     pub fn passes(&self, ground_truth: bool) -> Vec<Pass> {
-        let Some(threshold) = self.threshold() else {
-            return self.method.passes().to_vec();
+        let mut passes = match self.threshold() {
+            None => self.method.passes().to_vec(),
+            Some(threshold) => {
+                let spp = self.sampling.max_spp();
+                let side = crate::trace::sampling::samples_per_side(spp).unwrap_or(1);
+                let options = Adaptive {
+                    threshold,
+                    ground_truth,
+                };
+                stages_for(side, options)
+                    .into_iter()
+                    .flat_map(|stage| [Pass::listing(stage), Pass::of(stage)])
+                    .collect()
+            }
         };
-        let side = crate::trace::sampling::samples_per_side(self.sampling.max_spp()).unwrap_or(1);
-        let options = Adaptive {
-            threshold,
-            ground_truth,
-        };
-        stages_for(side, options)
-            .into_iter()
-            .flat_map(|stage| [Pass::listing(stage), Pass::of(stage)])
-            .collect()
+        if self.method.cube().is_none() && self.filter != PixelFilter::Box {
+            passes.push(Pass::Filter);
+        }
+        passes
     }
 
-    /// Every setup of `methods`: direct methods once per sampling of `samplings`, cube
-    /// methods once per face size.
-    pub fn all(methods: &[Method], cube_sizes: &[u32], samplings: &[Sampling]) -> Vec<Setup> {
+    /// Every setup of `methods`: direct methods once per sampling of `samplings` and filter
+    /// of `filters` that changes its pixels ([`PixelFilter::applies_to`]: the tent only
+    /// where pixels take one ray), cube methods once per face size.
+    pub fn all(
+        methods: &[Method],
+        cube_sizes: &[u32],
+        samplings: &[Sampling],
+        filters: &[PixelFilter],
+    ) -> Vec<Setup> {
         methods
             .iter()
             .flat_map(|&method| match method {
@@ -130,7 +160,13 @@ impl Setup {
                     .collect::<Vec<_>>(),
                 _ => samplings
                     .iter()
-                    .map(|&sampling| Setup::sampled(method, sampling))
+                    .flat_map(|&sampling| {
+                        let setup = Setup::sampled(method, sampling);
+                        filters
+                            .iter()
+                            .filter(move |f| f.applies_to(sampling))
+                            .map(move |&f| setup.filtered(f))
+                    })
                     .collect(),
             })
             .collect()
@@ -177,6 +213,8 @@ pub enum Pass {
     /// Listing the interpolated pixels (before [`Pass::Truth`]).
     #[serde(rename = "truth-list")]
     TruthList,
+    /// The tent filter of a direct frame's one-ray pixels ([`PixelFilter::Tent`]).
+    Filter,
 }
 
 impl Pass {
@@ -220,6 +258,7 @@ impl Pass {
             Pass::EstimateList => "estimate list",
             Pass::SupersampleList => "supersample list",
             Pass::TruthList => "truth list",
+            Pass::Filter => "filter",
         }
     }
 }
@@ -360,7 +399,7 @@ impl Offscreen {
         ground_truth: bool,
     ) -> Result<Self> {
         let (spp, adaptive) = setup.sampling.options(ground_truth);
-        let rays = (directions, spp, adaptive);
+        let rays = (directions, spp, adaptive, setup.filter);
         let scene = scenes.for_method(setup.method);
         let cube = match setup.method {
             Method::Cube(method) => Some(CubeSettings {
@@ -420,6 +459,7 @@ impl Offscreen {
             let writes = |p: Pass| index(p).and_then(|i| q.map(|q| q.writes(i)));
             let spans = Spans {
                 trace: writes(Pass::Trace),
+                filter: writes(Pass::Filter),
                 adaptive: AdaptiveSpans {
                     lists: ALL_STAGES.map(|stage| writes(Pass::listing(stage))),
                     stages: ALL_STAGES.map(|stage| writes(Pass::of(stage))),
@@ -442,7 +482,7 @@ impl Offscreen {
             Some(q) => Some(q.read_ns(ctx)?.into_iter().map(|ns| ns * 1e-6).collect()),
             None => None,
         };
-        let passes_rays = match &self.path {
+        let mut passes_rays = match &self.path {
             Path::Direct(_) => Some(vec![self.uniform_rays]),
             // Listing traces nothing; each stage's rays are its tracing pass's.
             Path::Adaptive(pass) => Some(
@@ -453,6 +493,13 @@ impl Offscreen {
             ),
             Path::Cube(_) => None,
         };
+        // The filter traces nothing.
+        if let Some(rays) = passes_rays
+            .as_mut()
+            .filter(|_| self.passes.contains(&Pass::Filter))
+        {
+            rays.push(0);
+        }
         Ok(FrameTime {
             wall_ms,
             passes_ms,
@@ -474,6 +521,7 @@ impl Offscreen {
                     let mut encoder = ctx.device.create_command_encoder(&Default::default());
                     pass.encode_pose(&ctx.device, &mut encoder, scene, pose);
                     pass.encode_region(&mut encoder, scene, 0, one, None);
+                    pass.encode_filter(&mut encoder, None);
                     ctx.queue.submit([encoder.finish()]);
                 })?;
                 ctx.wait()?;
@@ -516,14 +564,22 @@ mod tests {
             assert_eq!(Method::from_name(m.name()), Some(m));
         }
         let samplings = [1, 16].map(Sampling::Uniform);
-        let mut setups = Setup::all(&[Method::Rt, Method::ALL[3]], &[512, 1024], &samplings);
+        let filters = PixelFilter::ALL;
+        let mut setups = Setup::all(
+            &[Method::Rt, Method::ALL[3]],
+            &[512, 1024],
+            &samplings,
+            &filters,
+        );
         setups.push(Setup::sampled(
             Method::Rt,
             Sampling::parse("auto:0.05").unwrap(),
         ));
         let labels: Vec<String> = setups.iter().map(Setup::label).collect();
+        // The tent changes nothing at 16 rays a pixel, nor a cube map: no setup for them.
         let wanted = [
             "rt@1spp",
+            "rt@1spp+tent",
             "rt@16spp",
             "cube-forward@512",
             "cube-forward@1024",

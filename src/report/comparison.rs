@@ -34,6 +34,8 @@ pub struct CompareEntry {
     pub spp: Option<u32>,
     /// Adaptive sampling's threshold, `None` for uniform sampling and cube maps.
     pub threshold: Option<f32>,
+    /// The pixel filter of a direct method (`box` or `tent`), `None` for cube maps.
+    pub filter: Option<&'static str>,
     /// The rays the last frame's colour took per pixel the lens covers, on average: adaptive
     /// sampling's measured count; `spp` for uniform sampling; `None` for cube maps.
     pub rays_per_pixel: Option<f64>,
@@ -237,6 +239,7 @@ pub fn compare(
                 cube_size: setup.cube_size(),
                 spp: setup.spp(),
                 threshold: setup.threshold(),
+                filter: setup.cube_size().is_none().then(|| setup.filter.name()),
                 rays_per_pixel,
                 gpu_ms: gpu.map(|g| median(&g)),
                 wall_ms: median(&wall),
@@ -301,9 +304,9 @@ fn is_rt(e: &CompareEntry) -> bool {
     e.cube_size.is_none()
 }
 
-/// The direct setups that sample every pixel alike.
+/// The direct setups that sample every pixel alike, each pixel its own rays' mean.
 fn is_uniform(e: &CompareEntry) -> bool {
-    is_rt(e) && e.threshold.is_none()
+    is_rt(e) && e.threshold.is_none() && e.filter == Some("box")
 }
 
 fn is_cube(e: &CompareEntry) -> bool {
@@ -489,7 +492,7 @@ impl CompareReport {
                 points: family(is_cube),
             },
             plot::Series {
-                label: "direct RT, uniform rays per pixel".into(),
+                label: "direct RT, uniform rays, box filter".into(),
                 points: family(is_uniform),
             },
         ];
@@ -532,6 +535,7 @@ mod tests {
             cube_size,
             spp,
             threshold: None,
+            filter: cube_size.is_none().then_some("box"),
             rays_per_pixel: spp.map(f64::from),
             gpu_ms,
             wall_ms,

@@ -266,6 +266,14 @@ impl AdaptivePass {
         })
     }
 
+    /// Makes each frame's colour output as `filter` says from now on: the tent filter with
+    /// one ray a pixel at most, each pixel then one ray or interpolated (see
+    /// [`TracePass::set_filter`]). Callers record it after a frame's stages
+    /// ([`TracePass::encode_filter`]).
+    pub fn set_filter(&mut self, ctx: &GpuContext, filter: super::PixelFilter) -> Result<()> {
+        self.trace.set_filter(ctx, filter)
+    }
+
     /// The settings.
     pub fn options(&self) -> Adaptive {
         self.options
@@ -465,6 +473,7 @@ impl AdaptivePass {
         ctx.checked(what, || {
             let mut encoder = ctx.device.create_command_encoder(&Default::default());
             self.encode(&mut encoder, scene, AdaptiveSpans::default());
+            self.trace.encode_filter(&mut encoder, None);
             ctx.queue.submit([encoder.finish()]);
         })?;
         self.trace.read(ctx)

@@ -19,7 +19,8 @@ pub enum FramePass {
 }
 
 impl FramePass {
-    /// The passes `options` asks for (its directions, `spp` and `adaptive`) through `camera`.
+    /// The passes `options` asks for (its directions, `spp`, `adaptive` and `filter`) through
+    /// `camera`.
     pub fn new(
         ctx: &GpuContext,
         camera: &LensCamera,
@@ -28,12 +29,16 @@ impl FramePass {
     ) -> Result<Self> {
         let (source, spp) = (options.directions, options.spp);
         Ok(match options.adaptive {
-            Some(adaptive) => FramePass::Adaptive(Box::new(AdaptivePass::new(
-                ctx, camera, scene, source, spp, adaptive,
-            )?)),
-            None => FramePass::Uniform(Box::new(TracePass::supersampled(
-                ctx, camera, scene, source, spp,
-            )?)),
+            Some(adaptive) => {
+                let mut pass = AdaptivePass::new(ctx, camera, scene, source, spp, adaptive)?;
+                pass.set_filter(ctx, options.filter)?;
+                FramePass::Adaptive(Box::new(pass))
+            }
+            None => {
+                let mut pass = TracePass::supersampled(ctx, camera, scene, source, spp)?;
+                pass.set_filter(ctx, options.filter)?;
+                FramePass::Uniform(Box::new(pass))
+            }
         })
     }
 
@@ -77,6 +82,7 @@ impl FramePass {
             FramePass::Uniform(pass) => pass.encode(encoder, scene, None),
             FramePass::Adaptive(pass) => pass.encode(encoder, scene, AdaptiveSpans::default()),
         }
+        self.trace_pass().encode_filter(encoder, None);
     }
 
     /// Traces one frame from `pose`, reporting a GPU error as `what` failing, and reads it

@@ -17,6 +17,7 @@ mod output;
 mod pass;
 mod ray_query;
 pub mod sampling;
+mod tent;
 
 use glam::DVec3;
 
@@ -29,10 +30,13 @@ pub use display::{
 pub use frame::FramePass;
 pub use gpu_scene::{GpuScene, SceneBytes, gpu_lights, shading_vertices};
 pub use motion::{Motion, moving_directions};
-pub use options::{Adaptive, RenderOptions, Sampling, Traversal, surface_constants, surface_id};
+pub use options::{
+    Adaptive, PixelFilter, RenderOptions, Sampling, Traversal, surface_constants, surface_id,
+};
 pub use output::{Channel, RenderOutput, Values, write_exr, write_npy};
 pub use pass::TracePass;
 pub use ray_query::RayQueryScene;
+pub use tent::Tent;
 
 pub use crate::shared::{
     Frame, GpuLight, GpuMaterial, LIGHT_KINDS, MAX_DEPTH_LIMIT, MAX_SHADOW_LAYERS, NO_HIT,

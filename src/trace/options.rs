@@ -33,6 +33,67 @@ pub struct RenderOptions {
     /// Adaptive sampling ([`super::AdaptivePass`]): rays where neighbouring samples disagree,
     /// fewer than one a pixel where the image is smooth; `None` samples every pixel alike.
     pub adaptive: Option<Adaptive>,
+    /// How a pixel's colour is made from the rays traced ([`PixelFilter`]): by default its own
+    /// rays' mean.
+    pub filter: PixelFilter,
+}
+
+/// How a pixel's colour is made from the rays traced.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum PixelFilter {
+    /// Each pixel the mean of its own rays (a box filter over its square): the reference's
+    /// filter, and what supersampled pixels always take.
+    #[default]
+    Box,
+    /// In a frame of one ray a pixel at most (uniform `--spp 1`, adaptive `auto:T:1`, whose
+    /// other pixels are interpolated), each pixel takes the mean over its square of the
+    /// bilinear (tent) interpolation through its own and its eight neighbours' centres, in
+    /// linear radiance: weights 3/4 for the pixel and 1/8 for each neighbour along each
+    /// axis, the quadratic B-spline at whole-pixel offsets (the box ⊛ tent), renormalised over
+    /// the neighbours the lens covers. One centre sample aliases at edges and texture detail;
+    /// this estimate of the pixel's box average trades a little blur for it (`trace::Tent`,
+    /// `wgsl/tent.wgsl`). With more rays a pixel it changes nothing: supersampling already
+    /// estimates the box average, and adaptive sampling's one-ray pixels beside supersampled
+    /// ones are those whose colour it found linear across them.
+    Tent,
+}
+
+impl PixelFilter {
+    /// Both filters, as `--filter` lists them.
+    pub const ALL: [PixelFilter; 2] = [PixelFilter::Box, PixelFilter::Tent];
+
+    /// The name `--filter` takes and setups' labels carry (`rt@1spp+tent`).
+    pub fn name(&self) -> &'static str {
+        match self {
+            PixelFilter::Box => "box",
+            PixelFilter::Tent => "tent",
+        }
+    }
+
+    /// Whether the filter changes anything under `sampling`: the tent only at one ray a
+    /// pixel at most (uniform 1, adaptive `auto:T:1`).
+    pub fn applies_to(&self, sampling: Sampling) -> bool {
+        match self {
+            PixelFilter::Box => true,
+            PixelFilter::Tent => sampling.max_spp() == 1,
+        }
+    }
+}
+
+impl std::str::FromStr for PixelFilter {
+    type Err = crate::error::Error;
+
+    fn from_str(text: &str) -> crate::error::Result<Self> {
+        Self::ALL
+            .into_iter()
+            .find(|f| f.name() == text)
+            .ok_or_else(|| {
+                crate::error::Error::Option(format!(
+                    "pixel filter {text:?}: the filters are box (each pixel its own rays' mean) \
+                     and tent (one-ray pixels blended with their neighbours)"
+                ))
+            })
+    }
 }
 
 /// Adaptive sampling's settings (see `trace::AdaptivePass`); the most rays a pixel takes are
@@ -75,6 +136,7 @@ impl Default for RenderOptions {
             traversal: Traversal::Software,
             spp: 1,
             adaptive: None,
+            filter: PixelFilter::Box,
         }
     }
 }
@@ -266,6 +328,18 @@ mod tests {
             assert_eq!(options.sampling(), read, "{text}");
         }
         assert_eq!(Sampling::Uniform(4).label(), "4spp");
+        for filter in PixelFilter::ALL {
+            assert_eq!(filter.name().parse::<PixelFilter>().unwrap(), filter);
+        }
+        let message = "gauss".parse::<PixelFilter>().unwrap_err().to_string();
+        assert!(
+            message.contains("box") && message.contains("tent"),
+            "{message}"
+        );
+        // The tent changes frames of one ray a pixel at most: uniform 1, and auto:T:1.
+        let applies = |text: &str| PixelFilter::Tent.applies_to(Sampling::parse(text).unwrap());
+        assert!(applies("1") && applies("auto:0.1:1") && applies("auto:0:1"));
+        assert!(!applies("4") && !applies("16") && !applies("auto") && !applies("auto:0.1:4"));
         assert_eq!(Sampling::parse("auto").unwrap().label(), "auto:0.02");
         for bad in [
             "",

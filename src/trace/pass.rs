@@ -4,7 +4,7 @@
 
 use super::gpu_scene::{frame_for, view_frame};
 use super::options::surface_constants;
-use super::{GpuScene, Motion, RenderOutput, sampling};
+use super::{GpuScene, Motion, PixelFilter, RenderOutput, Tent, sampling};
 use crate::error::{Error, Result};
 use crate::gpu::{GpuContext, bind_group_at, dispatch_over_image, storage_entry, uniform_entry};
 use crate::lens::LensCamera;
@@ -57,6 +57,8 @@ pub struct TracePass {
     bands: Vec<(u32, u32)>,
     /// With several bands, the whole image's outputs, each band copied in after its dispatch.
     whole: Option<[wgpu::Buffer; 3]>,
+    /// The tent filter, where set ([`TracePass::set_filter`]): the colour output is then its.
+    tent: Option<Tent>,
 }
 
 impl TracePass {
@@ -196,6 +198,7 @@ impl TracePass {
                 camera: *camera,
                 bands,
                 whole,
+                tent: None,
             }
         })
     }
@@ -305,12 +308,56 @@ impl TracePass {
         self.buffers()[0]
     }
 
-    /// The colour, geometry and id outputs of the last frame (as [`RenderOutput`] reads them).
+    /// The colour, geometry and id outputs of the last frame (as [`RenderOutput`] reads them):
+    /// the colour filtered where a filter is set ([`TracePass::encode_filter`] writes it).
     /// For an image traced in bands these are larger than one storage binding: bind a range.
     pub fn buffers(&self) -> [&wgpu::Buffer; 3] {
-        match &self.whole {
+        let [colour, geometry, ids] = match &self.whole {
             Some([colour, geometry, ids]) => [colour, geometry, ids],
             None => [&self.colour, &self.geometry, &self.ids],
+        };
+        let colour = self.tent.as_ref().map_or(colour, Tent::colour_buffer);
+        [colour, geometry, ids]
+    }
+
+    /// Makes each frame's colour output as `filter` says from now on (recorded by
+    /// [`TracePass::encode_filter`] after the frame's rays, or after adaptive sampling's
+    /// stages, which trace into this pass's outputs). The tent changes frames of one ray a
+    /// pixel (at most, for adaptive sampling) alone: with more, each pixel keeps its samples'
+    /// mean. It reads the whole image in one binding: refused for an image traced in bands.
+    pub fn set_filter(&mut self, ctx: &GpuContext, filter: PixelFilter) -> Result<()> {
+        self.tent = match filter {
+            PixelFilter::Box => None,
+            PixelFilter::Tent if self.samples_per_side > 1 => None,
+            PixelFilter::Tent if self.bands.len() > 1 => {
+                return Err(Error::Limit(format!(
+                    "the tent filter of a {} image: its outputs exceed one storage binding of \
+                     this device; use a smaller image or --filter box",
+                    self.camera.size
+                )));
+            }
+            PixelFilter::Tent => Some(Tent::new(ctx, self.camera.size, &self.colour)?),
+        };
+        Ok(())
+    }
+
+    /// The filter each frame's colour goes through (the box where pixels take more rays).
+    pub fn filter(&self) -> PixelFilter {
+        match self.tent {
+            Some(_) => PixelFilter::Tent,
+            None => PixelFilter::Box,
+        }
+    }
+
+    /// Records the filter of the frame's colours, after its rays (nothing with the box
+    /// filter: the kernels' means are the colours), optionally timed.
+    pub fn encode_filter(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        timestamp_writes: Option<wgpu::ComputePassTimestampWrites<'_>>,
+    ) {
+        if let Some(tent) = &self.tent {
+            tent.encode(encoder, timestamp_writes);
         }
     }
 
@@ -399,6 +446,7 @@ impl TracePass {
         ctx.checked(what, || {
             let mut encoder = ctx.device.create_command_encoder(&Default::default());
             self.encode(&mut encoder, scene, None);
+            self.encode_filter(&mut encoder, None);
             ctx.queue.submit([encoder.finish()]);
         })?;
         self.read(ctx)

@@ -270,6 +270,11 @@ fn render_through_a_cube_map() {
                 "use --method rt",
             ),
             (&["--cube-size", "0"][..], "cube face size 0"),
+            (
+                &["--filter", "tent"][..],
+                "--filter applies to direct tracing",
+            ),
+            (&["--filter", "gauss"][..], "box"),
         ] {
             let output = fisheye(&[&args[..], extra].concat(), "");
             let stderr = String::from_utf8_lossy(&output.stderr);

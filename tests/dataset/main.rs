@@ -403,25 +403,27 @@ fn rigs_put_each_camera_where_their_extrinsics_say() {
     }
 }
 
-/// `--spp auto:...` renders a dataset adaptively: its ids are uniform sampling's, byte for
-/// byte (the hits of interpolated pixels are traced, never interpolated), its images are not,
-/// and the plan says which sampling made them.
+/// `--spp auto:...` renders a dataset adaptively (here with `--filter tent`): its ids are
+/// uniform sampling's, byte for byte (the hits of interpolated pixels are traced, never
+/// interpolated, and the filter touches colour alone), its images are not, and the plan says
+/// which sampling and filter made them.
 #[test]
 fn adaptive_datasets_keep_exact_ground_truth() {
     let dir = temp_dir("adaptive");
     let trajectory = repo("scenes/dataset/room-loop.tum");
-    let render = |spp: &str, out: &Path| {
+    let render = |spp: &str, filter: &str, out: &Path| {
         succeed(
             fisheye()
                 .args(["dataset", "render", "--trajectory", &trajectory])
                 .args(["--lens", "samyang-7.5mm", "--size", "64x48", "--spp", spp])
+                .args(["--filter", filter])
                 .args(["--outputs", "id", "--shard", "0/25", "-o"])
                 .arg(out),
         )
     };
     let (auto, uniform) = (dir.join("auto"), dir.join("uniform"));
-    render("auto:0.05:4", &auto);
-    render("4", &uniform);
+    render("auto:0.05:1", "tent", &auto);
+    render("4", "box", &uniform);
     let (auto_files, uniform_files) = (files(&auto), files(&uniform));
     let names = |f: &[(PathBuf, Vec<u8>)]| f.iter().map(|(p, _)| p.clone()).collect::<Vec<_>>();
     assert_eq!(names(&auto_files), names(&uniform_files));
@@ -440,8 +442,9 @@ fn adaptive_datasets_keep_exact_ground_truth() {
     assert!(images_differ, "adaptive sampling made other images");
     let plan: serde_json::Value =
         serde_json::from_slice(&std::fs::read(auto.join("plan.json")).unwrap()).unwrap();
-    assert_eq!(plan["render"]["sampling"], "auto:0.05:4");
-    assert_eq!(plan["render"]["spp"], 4);
+    assert_eq!(plan["render"]["sampling"], "auto:0.05:1");
+    assert_eq!(plan["render"]["spp"], 1);
+    assert_eq!(plan["render"]["filter"], "tent");
     std::fs::remove_dir_all(&dir).unwrap();
 }
 

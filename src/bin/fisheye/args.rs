@@ -16,7 +16,7 @@ use fisheye_rt::lens::{DirectionFormula, ImageSize, LensCamera};
 use fisheye_rt::raster::RasterMethod;
 use fisheye_rt::renderer;
 use fisheye_rt::scene::Scene;
-use fisheye_rt::trace::{Channel, Sampling, Tone};
+use fisheye_rt::trace::{Channel, PixelFilter, Sampling, Tone};
 
 /// How the scene is built and shaded, for `render`, `bench` and `compare`.
 #[derive(clap::Args)]
@@ -75,6 +75,11 @@ pub(crate) struct StudyArgs {
         default_value = "1,4,16,auto:0.1:1,auto:0.1:4,auto:0.1,auto:0.02"
     )]
     pub(crate) spp: Vec<Sampling>,
+    /// Pixel filters to measure direct tracing with (comma-separated, as `render --filter`):
+    /// each sampling once per filter that changes its pixels (the tent at one ray a pixel at
+    /// most: 1 and auto:T:1), labelled `rt@1spp+tent`.
+    #[arg(long, value_delimiter = ',', default_value = "box,tent")]
+    pub(crate) filter: Vec<PixelFilter>,
     #[command(flatten)]
     pub(crate) shading: ShadingArgs,
     /// Folder for the results; by default a new folder `fisheye-COMMAND-N` here.

@@ -16,7 +16,7 @@ use fisheye_rt::lens::calib;
 use fisheye_rt::lens::glass::camera_for;
 use fisheye_rt::lens::{ImageSize, LensCamera, Readout, Shutter};
 use fisheye_rt::pose::parse_transform;
-use fisheye_rt::trace::{Channel, ColourFile, Display, RenderOptions, Sampling};
+use fisheye_rt::trace::{Channel, ColourFile, Display, PixelFilter, RenderOptions, Sampling};
 use glam::DAffine3;
 
 use crate::args::{ArrayFormat, Output, Quality, ToneArg, load_scene_with};
@@ -119,6 +119,11 @@ pub(crate) struct RenderArgs {
     /// centre ray's.
     #[arg(long, default_value = "16")]
     spp: Sampling,
+    /// How a pixel's colour is made from its rays, as `render --filter` takes it: `box` or
+    /// `tent` (at one ray a pixel at most, each pixel blended with its neighbours; ground
+    /// truth unchanged).
+    #[arg(long, default_value = "box")]
+    filter: PixelFilter,
     /// Deepest reflection/refraction bounce (0 to 8).
     #[arg(long, default_value_t = 5,
           value_parser = clap::value_parser!(u32).range(0..=i64::from(fisheye_rt::shared::MAX_DEPTH_LIMIT)))]
@@ -291,6 +296,19 @@ fn render(args: &RenderArgs) -> Result<()> {
     // (or flow and labels, made from them) are written.
     let traced = channels.iter().any(Channel::traced) || !between.is_empty() || !labels.is_empty();
     let (spp, adaptive) = args.spp.options(traced);
+    // The plan records the filter that made the images.
+    let filter = match args.filter.applies_to(args.spp) {
+        true => args.filter,
+        false => {
+            eprintln!(
+                "note: --filter {} changes frames of one ray a pixel; at --spp {} each pixel \
+                 keeps its rays' mean",
+                args.filter.name(),
+                args.spp
+            );
+            PixelFilter::Box
+        }
+    };
     let dataset = Dataset {
         // The plan records the scene by this name: a glTF file's other scene is another.
         scene_name: match args.gltf_scene {
@@ -311,6 +329,7 @@ fn render(args: &RenderArgs) -> Result<()> {
             bvh: args.bvh.into(),
             spp,
             adaptive,
+            filter,
             ..RenderOptions::default()
         },
         colour: (

@@ -9,11 +9,11 @@ use fisheye_rt::cube::{CubeMap, FACES, bordered};
 use fisheye_rt::gpu::GpuContext;
 use fisheye_rt::lens::ImageSize;
 use fisheye_rt::lens::gpu::DirectionSource;
-use fisheye_rt::renderer::{Offscreen, SceneSet, Setup};
+use fisheye_rt::renderer::{Offscreen, Pass, SceneSet, Setup};
 use fisheye_rt::scene::{FRAME_FILL, Scene};
 use fisheye_rt::trace::{
-    Channel, ColourFile, Display, GpuScene, KEY, RenderOptions, Sampling, Tone, auto_exposure,
-    check_writable, save_png, spp_picture, world_directions, write_colour,
+    Channel, ColourFile, Display, GpuScene, KEY, PixelFilter, RenderOptions, Sampling, Tone,
+    auto_exposure, check_writable, save_png, spp_picture, world_directions, write_colour,
 };
 
 use crate::args::{
@@ -75,6 +75,14 @@ pub(crate) struct RenderArgs {
     /// the book's "Adaptive sampling").
     #[arg(long, default_value = "16")]
     pub(crate) spp: Sampling,
+    /// How a pixel's colour is made from its rays (direct methods): `box`, the mean of its
+    /// own rays; or `tent`, in a frame of one ray a pixel at most (--spp 1, or auto:T:1), the
+    /// mean over the pixel's square of the bilinear interpolation through it and its eight
+    /// neighbours (weights 3/4 and 1/8 along each axis, in linear radiance): a little blur
+    /// for far less aliasing (see the book's "Adaptive sampling"). With more rays a pixel,
+    /// the box.
+    #[arg(long, default_value = "box")]
+    pub(crate) filter: PixelFilter,
     #[command(flatten)]
     pub(crate) shading: ShadingArgs,
     /// Primary ray directions: evaluated per pixel, or read from a table made once.
@@ -155,8 +163,21 @@ pub(crate) fn render(args: &RenderArgs) -> Result<()> {
     // A cube map's resampler takes one bilinear sample a pixel; --spp is direct tracing's.
     let setup = match method.cube() {
         Some(_) => Setup::cube(method, args.cube_size),
-        None => Setup::sampled(method, args.spp),
+        None => Setup::sampled(method, args.spp).filtered(args.filter),
     };
+    if args.filter != PixelFilter::Box {
+        if method.cube().is_some() {
+            bail!("--filter applies to direct tracing (--method rt or rq)");
+        }
+        if !args.filter.applies_to(args.spp) {
+            eprintln!(
+                "note: --filter {} changes frames of one ray a pixel; at --spp {} each pixel \
+                 keeps its rays' mean",
+                args.filter.name(),
+                args.spp
+            );
+        }
+    }
     // Adaptive sampling traces the hits of the pixels it interpolates only when arrays of
     // them are written.
     let ground_truth = channels.iter().any(Channel::traced);
@@ -172,6 +193,7 @@ pub(crate) fn render(args: &RenderArgs) -> Result<()> {
         traversal: setup.method.traversal(),
         spp,
         adaptive,
+        filter: args.filter,
     };
     if !args.outputs.is_empty() && setup.method.cube().is_some() {
         bail!("--outputs come from direct tracing; use --method rt or rq for ground-truth arrays");
@@ -298,10 +320,17 @@ pub(crate) fn render(args: &RenderArgs) -> Result<()> {
             );
             (traced as usize, what)
         }
-        (None, None) => (
-            rays * spp as usize,
-            format!("trace: {rays} pixels ({hits} hit at their centre) × {spp} rays"),
-        ),
+        (None, None) => {
+            let filter = renderer.passes().iter().position(|&p| p == Pass::Filter);
+            let filter_ms = filter.and_then(|k| time.passes_ms.as_ref().map(|ms| ms[k]));
+            (
+                rays * spp as usize,
+                format!(
+                    "trace: {rays} pixels ({hits} hit at their centre) × {spp} rays{}",
+                    filter_ms.map_or(String::new(), |ms| format!(" (tent filter {ms:.2} ms)"))
+                ),
+            )
+        }
     };
     match time.gpu_ms() {
         Some(ms) => println!(

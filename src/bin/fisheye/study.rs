@@ -121,7 +121,7 @@ pub(crate) fn prepare(args: &StudyArgs, command: &str) -> Result<Prepared> {
             None => true,
         });
     }
-    let setups = Setup::all(&methods, &args.cube_size, &args.spp);
+    let setups = Setup::all(&methods, &args.cube_size, &args.spp, &args.filter);
     let options = RenderOptions {
         max_depth: args.shading.max_depth,
         bvh: args.shading.bvh.into(),

@@ -102,6 +102,7 @@ impl Dataset {
                 "method": "rt",
                 "spp": self.options.spp,
                 "sampling": self.options.sampling().to_string(),
+                "filter": self.options.filter.name(),
                 "max_depth": self.options.max_depth,
                 "bvh": self.options.bvh.name(),
                 "colour": match file {
