@@ -9,7 +9,8 @@
 //! Keys: W A S D (or the arrows) move, Q and E go down and up, dragging with the left button
 //! looks around; L switches lens, M switches method (rt, rq, cube-rt, cube-forward,
 //! cube-deferred, cube-single: those the adapter has), P switches the sampling of the traced
-//! methods (adaptive `auto` first, then 1, 4 and 16 rays per pixel, then `auto:0.1:1`), R goes
+//! methods (adaptive `auto` first, then 1, 4 and 16 rays per pixel, then `auto:0.1:1`, then
+//! `1+tent` and `auto:0.1:1+tent`: one ray a pixel at most through the tent filter), R goes
 //! back to the scene's camera, Esc quits. The title shows the lens, the method and the frame
 //! time.
 //!
@@ -53,9 +54,18 @@ const LENSES: [&str; 5] = [
 ];
 
 /// The samplings P steps through: adaptive sampling (below one ray a pixel where the image is
-/// smooth, up to 16 where it is not), uniform rays per pixel, then adaptive sampling that
-/// stops at one ray a pixel.
-const SPP: [&str; 5] = ["auto", "1", "4", "16", "auto:0.1:1"];
+/// smooth, up to 16 where it is not), uniform rays per pixel, adaptive sampling that stops at
+/// one ray a pixel, then those at one ray through the tent filter (`+tent`, as `compare`
+/// labels them).
+const SPP: [&str; 7] = [
+    "auto",
+    "1",
+    "4",
+    "16",
+    "auto:0.1:1",
+    "1+tent",
+    "auto:0.1:1+tent",
+];
 
 struct Args {
     scene: String,
@@ -230,7 +240,8 @@ impl State {
             wgpu::TextureFormat::Rgba8Unorm
         };
         let method = Method::ALL[self.method];
-        let sampling = Sampling::parse(SPP[self.spp]).map_err(|e| e.to_string())?;
+        let (sampling, filter) =
+            Sampling::parse_filtered(SPP[self.spp]).map_err(|e| e.to_string())?;
         let (spp, adaptive) = sampling.options(false);
         // The glass is traced by uniform sampling, at the choice's most rays a pixel.
         let adaptive = adaptive.filter(|_| camera.glass.is_none());
@@ -238,6 +249,7 @@ impl State {
             traversal: method.traversal(),
             spp,
             adaptive,
+            filter,
             ..RenderOptions::default()
         };
         let (device, queue) = (&self.ctx.device, &self.ctx.queue);

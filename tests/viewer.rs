@@ -10,7 +10,7 @@ use fisheye_rt::cube::{CubeMap, CubeMethod, CubeSettings};
 use fisheye_rt::gpu::GpuContext;
 use fisheye_rt::lens::{ImageSize, LensCamera, parse_spec};
 use fisheye_rt::scene::builtin;
-use fisheye_rt::trace::{Adaptive, GpuScene, RenderOptions, colour_image, render};
+use fisheye_rt::trace::{Adaptive, GpuScene, PixelFilter, RenderOptions, colour_image, render};
 
 /// The viewer example's binary, beside this test's (`target/<profile>/examples/viewer`).
 fn viewer() -> PathBuf {
@@ -103,6 +103,13 @@ fn the_viewer_shows_the_scene_under_xvfb() {
     let traced = render(&ctx, &scene, &camera, &four).unwrap().to_image();
     let window = screenshot(&[&args[..], &["--spp", "4"]].concat(), 4);
     assert_shows("rt at 4 rays a pixel", &window, &traced);
+    let tent = RenderOptions {
+        filter: PixelFilter::Tent,
+        ..options
+    };
+    let traced = render(&ctx, &scene, &camera, &tent).unwrap().to_image();
+    let window = screenshot(&[&args[..], &["--spp", "1+tent"]].concat(), 4);
+    assert_shows("rt at one ray through the tent filter", &window, &traced);
     // Adaptive sampling, the viewer's default, through the embedding `Renderer` it draws
     // with: its first frame is the one below a ray a pixel, and a still camera's frames
     // sharpen into the whole adaptive frame (2 steps, then a sixteenth of the pixels at 16

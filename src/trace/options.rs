@@ -230,6 +230,17 @@ impl Sampling {
         Ok(Sampling::Adaptive { threshold, max_spp })
     }
 
+    /// Reads a sampling and its pixel filter as `compare` labels a setup's, and the viewer and
+    /// the web page take them: `--spp`'s text, then optionally `+FILTER` (`1+tent`,
+    /// `auto:0.1:1+tent`); the box filter without.
+    pub fn parse_filtered(text: &str) -> crate::error::Result<(Self, PixelFilter)> {
+        let (sampling, filter) = match text.split_once('+') {
+            Some((sampling, filter)) => (sampling, filter.parse()?),
+            None => (text, PixelFilter::Box),
+        };
+        Ok((Sampling::parse(sampling)?, filter))
+    }
+
     /// The most samples a pixel takes.
     pub fn max_spp(&self) -> u32 {
         match *self {
@@ -336,6 +347,17 @@ mod tests {
             message.contains("box") && message.contains("tent"),
             "{message}"
         );
+        let tent = Sampling::parse_filtered("auto:0.1:1+tent").unwrap();
+        assert_eq!(
+            tent,
+            (Sampling::parse("auto:0.1:1").unwrap(), PixelFilter::Tent)
+        );
+        assert_eq!(
+            Sampling::parse_filtered("4").unwrap(),
+            (Sampling::Uniform(4), PixelFilter::Box)
+        );
+        assert!(Sampling::parse_filtered("1+gauss").is_err());
+        assert!(Sampling::parse_filtered("3+tent").is_err());
         // The tent changes frames of one ray a pixel at most: uniform 1, and auto:T:1.
         let applies = |text: &str| PixelFilter::Tent.applies_to(Sampling::parse(text).unwrap());
         assert!(applies("1") && applies("auto:0.1:1") && applies("auto:0:1"));

@@ -143,7 +143,7 @@ impl Fisheye {
     /// `files` maps names to their bytes, the scene's and those it names) through `lens` at
     /// `size` (`WxH`), or through camera `calib_camera` (from 0) of the calibration file whose
     /// bytes are `calib` (a `Uint8Array`) and name `calib_name`, with `spp` (`render --spp`'s
-    /// forms) from `camera` (`render --camera`'s forms; the scene's own if empty). The scene is loaded, its BVH built and uploaded, the kernels made; a
+    /// forms, then optionally `+tent` for `render --filter tent`) from `camera` (`render --camera`'s forms; the scene's own if empty). The scene is loaded, its BVH built and uploaded, the kernels made; a
     /// [`View`] renders frames of it. Rejects with an `Error` whose message says what is
     /// wrong. Until `complete`, a scene that names files not in `files` (an OBJ's MTL,
     /// textures, glTF buffers) is refused with an `Error` whose `missing` lists them, even
@@ -308,7 +308,8 @@ impl Request {
         queue: wgpu::Queue,
         errors: Arc<Mutex<Vec<String>>>,
     ) -> Result<ViewInner, JsValue> {
-        let sampling: Sampling = self.spp.parse().map_err(|e| error(format!("spp: {e}")))?;
+        let (sampling, filter) =
+            Sampling::parse_filtered(&self.spp).map_err(|e| error(format!("spp: {e}")))?;
         let camera = self.camera()?;
         let size = camera.size;
         let (mut scene, warnings) = self.scene()?;
@@ -322,6 +323,7 @@ impl Request {
         let options = RenderOptions {
             spp,
             adaptive,
+            filter,
             ..RenderOptions::default()
         };
         let format = wgpu::TextureFormat::Rgba32Float;

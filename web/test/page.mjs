@@ -135,8 +135,10 @@ function nativeRender(scene, opts, name) {
     args.push("--lens", opts.lens, "--size", opts.size);
   }
   if (opts.camera) args.push("--camera", opts.camera);
-  args.push("--spp", String(opts.spp), "-o", out);
-  const uniform = /^[0-9]+$/.test(String(opts.spp));
+  // `1+tent`: the sampling, then the pixel filter (as `compare` labels setups).
+  const [spp, filter] = String(opts.spp).split("+");
+  args.push("--spp", spp, "--filter", filter ?? "box", "-o", out);
+  const uniform = /^[0-9]+$/.test(spp);
   if (uniform) args.push("--outputs", "id");
   const run = spawnSync(bin, args, { encoding: "utf8" });
   if (run.status !== 0) throw new Error(`${bin} ${args.join(" ")}: ${run.stderr}`);
@@ -198,6 +200,7 @@ function compare(native, web, what) {
 const cases = [
   { scene: "builtin:default", lens: "canon-8-15mm@8mm", size: "256x192", spp: 1 },
   { scene: "builtin:default", lens: "samyang-7.5mm", size: "256x192", spp: 4 },
+  { scene: "builtin:default", lens: "canon-8-15mm@8mm", size: "256x192", spp: "1+tent" },
   {
     scene: "/scenes/cornell_box/CornellBox-Original.obj",
     lens: "stereographic:f=0.5,fov=180",
