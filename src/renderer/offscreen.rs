@@ -143,8 +143,9 @@ impl Setup {
     }
 
     /// Every setup of `methods`: direct methods once per sampling of `samplings` and filter
-    /// of `filters` that changes its pixels ([`PixelFilter::applies_to`]: the tent only
-    /// where pixels take one ray), cube methods once per face size.
+    /// of `filters`, a filter that changes nothing under a sampling counting as the box
+    /// ([`PixelFilter::applies_to`]: the tent only at one ray a pixel at most), cube methods
+    /// once per face size.
     pub fn all(
         methods: &[Method],
         cube_sizes: &[u32],
@@ -161,11 +162,12 @@ impl Setup {
                 _ => samplings
                     .iter()
                     .flat_map(|&sampling| {
+                        // A filter that changes nothing here is the box: measured once.
                         let setup = Setup::sampled(method, sampling);
-                        filters
-                            .iter()
-                            .filter(move |f| f.applies_to(sampling))
-                            .map(move |&f| setup.filtered(f))
+                        let mut filtered: Vec<Setup> =
+                            filters.iter().map(|&f| setup.filtered(f)).collect();
+                        filtered.dedup_by_key(|s| s.filter);
+                        filtered
                     })
                     .collect(),
             })
@@ -576,7 +578,7 @@ mod tests {
             Sampling::parse("auto:0.05").unwrap(),
         ));
         let labels: Vec<String> = setups.iter().map(Setup::label).collect();
-        // The tent changes nothing at 16 rays a pixel, nor a cube map: no setup for them.
+        // The tent changes nothing at 16 rays a pixel, nor a cube map: no second setup.
         let wanted = [
             "rt@1spp",
             "rt@1spp+tent",
@@ -586,5 +588,9 @@ mod tests {
             "rt@auto:0.05",
         ];
         assert_eq!(labels, wanted);
+        // The tent alone still measures 16 rays, with the box (the same pixels).
+        let tent_only = Setup::all(&[Method::Rt], &[], &samplings, &[PixelFilter::Tent]);
+        let labels: Vec<String> = tent_only.iter().map(Setup::label).collect();
+        assert_eq!(labels, ["rt@1spp+tent", "rt@16spp"]);
     }
 }
