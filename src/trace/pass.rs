@@ -4,7 +4,7 @@
 
 use super::gpu_scene::{frame_for, view_frame};
 use super::options::surface_constants;
-use super::{GpuScene, Motion, PixelFilter, RenderOutput, Tent, sampling};
+use super::{GpuScene, Motion, PixelFilter, RenderOutput, Sampling, Tent, sampling};
 use crate::error::{Error, Result};
 use crate::gpu::{GpuContext, bind_group_at, dispatch_over_image, storage_entry, uniform_entry};
 use crate::lens::LensCamera;
@@ -328,7 +328,7 @@ impl TracePass {
     pub fn set_filter(&mut self, ctx: &GpuContext, filter: PixelFilter) -> Result<()> {
         self.tent = match filter {
             PixelFilter::Box => None,
-            PixelFilter::Tent if self.samples_per_side > 1 => None,
+            _ if !filter.applies_to(Sampling::Uniform(self.samples_per_side.pow(2))) => None,
             PixelFilter::Tent if self.bands.len() > 1 => {
                 return Err(Error::Limit(format!(
                     "the tent filter of a {} image: its outputs exceed one storage binding of \

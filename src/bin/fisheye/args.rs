@@ -162,6 +162,20 @@ pub(crate) enum ArrayFormat {
     Exr,
 }
 
+/// The pixel filter that makes `--spp`'s images as `--filter` asks: the box, with a note
+/// saying so, where the filter changes nothing at that sampling ([`PixelFilter::applies_to`]).
+pub(crate) fn filter_for(filter: PixelFilter, spp: Sampling) -> PixelFilter {
+    if filter.applies_to(spp) {
+        return filter;
+    }
+    eprintln!(
+        "note: --filter {} changes frames of one ray a pixel; at --spp {spp} each pixel keeps \
+         its rays' mean",
+        filter.name()
+    );
+    PixelFilter::Box
+}
+
 /// Parses `--camera` ([`Scene::parse_camera`]).
 pub(crate) fn parse_camera(text: &str, scene: &Scene) -> Result<fisheye_rt::scene::Camera> {
     scene.parse_camera(text).map_err(anyhow::Error::msg)

@@ -19,7 +19,7 @@ use fisheye_rt::pose::parse_transform;
 use fisheye_rt::trace::{Channel, ColourFile, Display, PixelFilter, RenderOptions, Sampling};
 use glam::DAffine3;
 
-use crate::args::{ArrayFormat, Output, Quality, ToneArg, load_scene_with};
+use crate::args::{ArrayFormat, Output, Quality, ToneArg, filter_for, load_scene_with};
 use crate::progress::Progress;
 
 #[derive(Subcommand)]
@@ -297,18 +297,7 @@ fn render(args: &RenderArgs) -> Result<()> {
     let traced = channels.iter().any(Channel::traced) || !between.is_empty() || !labels.is_empty();
     let (spp, adaptive) = args.spp.options(traced);
     // The plan records the filter that made the images.
-    let filter = match args.filter.applies_to(args.spp) {
-        true => args.filter,
-        false => {
-            eprintln!(
-                "note: --filter {} changes frames of one ray a pixel; at --spp {} each pixel \
-                 keeps its rays' mean",
-                args.filter.name(),
-                args.spp
-            );
-            PixelFilter::Box
-        }
-    };
+    let filter = filter_for(args.filter, args.spp);
     let dataset = Dataset {
         // The plan records the scene by this name: a glTF file's other scene is another.
         scene_name: match args.gltf_scene {

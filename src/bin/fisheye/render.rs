@@ -17,7 +17,7 @@ use fisheye_rt::trace::{
 };
 
 use crate::args::{
-    ArrayFormat, CalibArgs, Directions, Exposure, Method, Output, ShadingArgs, ToneArg,
+    ArrayFormat, CalibArgs, Directions, Exposure, Method, Output, ShadingArgs, ToneArg, filter_for,
     load_scene_with, parse_camera,
 };
 
@@ -161,23 +161,14 @@ pub(crate) fn render(args: &RenderArgs) -> Result<()> {
     }
     let method = args.method.method();
     // A cube map's resampler takes one bilinear sample a pixel; --spp is direct tracing's.
+    if args.filter != PixelFilter::Box && method.cube().is_some() {
+        bail!("--filter applies to direct tracing (--method rt or rq)");
+    }
+    let filter = filter_for(args.filter, args.spp);
     let setup = match method.cube() {
         Some(_) => Setup::cube(method, args.cube_size),
-        None => Setup::sampled(method, args.spp).filtered(args.filter),
+        None => Setup::sampled(method, args.spp).filtered(filter),
     };
-    if args.filter != PixelFilter::Box {
-        if method.cube().is_some() {
-            bail!("--filter applies to direct tracing (--method rt or rq)");
-        }
-        if !args.filter.applies_to(args.spp) {
-            eprintln!(
-                "note: --filter {} changes frames of one ray a pixel; at --spp {} each pixel \
-                 keeps its rays' mean",
-                args.filter.name(),
-                args.spp
-            );
-        }
-    }
     // Adaptive sampling traces the hits of the pixels it interpolates only when arrays of
     // them are written.
     let ground_truth = channels.iter().any(Channel::traced);
@@ -193,7 +184,7 @@ pub(crate) fn render(args: &RenderArgs) -> Result<()> {
         traversal: setup.method.traversal(),
         spp,
         adaptive,
-        filter: args.filter,
+        filter,
     };
     if !args.outputs.is_empty() && setup.method.cube().is_some() {
         bail!("--outputs come from direct tracing; use --method rt or rq for ground-truth arrays");
