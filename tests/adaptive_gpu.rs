@@ -60,15 +60,23 @@ fn upload(scene: &Scene) -> GpuScene {
 }
 
 /// At threshold 0 every block is refined and every pixel supersampled with the very samples
-/// uniform sampling takes, summed in the same order: the same bits.
+/// uniform sampling takes, summed in the same order: the same bits. Supersampling traces a
+/// pixel's samples side by side, one invocation each up to a workgroup's 64: 16 samples fill
+/// a workgroup with 4 pixels, 9 leave one invocation of 64 idle, 256 take 4 rounds of 64.
 #[test]
 fn threshold_zero_is_uniform_sampling_exactly() {
     let room = scene("builtin:default");
     let gpu = upload(&room);
     let cam = camera("canon-8-15mm@8mm", 61, 46);
-    let reference = uniform(&gpu, &cam, 16);
-    let (out, rays, stages) = adaptive_stages(&gpu, &cam, 16, 0.0, true);
-    assert_eq!(out.colour, reference.colour, "colour");
+    for spp in [16, 9, 256] {
+        threshold_zero_at(&gpu, &cam, spp);
+    }
+}
+
+fn threshold_zero_at(gpu: &GpuScene, cam: &LensCamera, spp: u32) {
+    let reference = uniform(gpu, cam, spp);
+    let (out, rays, stages) = adaptive_stages(gpu, cam, spp, 0.0, true);
+    assert_eq!(out.colour, reference.colour, "colour at {spp} samples");
     // Every lattice point; every other pixel but those of blocks wholly outside the lens
     // (filled as masked), so at least every one the lens covers; every pixel's 16 samples
     // (counted as rays where the lens masks them, though they cost a lens evaluation
@@ -83,7 +91,7 @@ fn threshold_zero_is_uniform_sampling_exactly() {
         .filter(|&(x, y)| on_lattice(x, y))
         .count() as u64;
     let pixels = u64::from(w * h);
-    let centres = uniform(&gpu, &cam, 1);
+    let centres = uniform(gpu, cam, 1);
     let covered_off_lattice = (0..h)
         .flat_map(|y| (0..w).map(move |x| (x, y)))
         .filter(|&(x, y)| !on_lattice(x, y) && centres.valid((y * w + x) as usize))
@@ -97,13 +105,13 @@ fn threshold_zero_is_uniform_sampling_exactly() {
         (covered_off_lattice..=pixels - lattice).contains(&refine.1),
         "{refine:?}: {covered_off_lattice} covered"
     );
-    assert_eq!(supersample, (Stage::Supersample, 16 * pixels));
+    assert_eq!(supersample, (Stage::Supersample, u64::from(spp) * pixels));
     assert_eq!(truth, (Stage::Truth, 0));
     assert_eq!(out.geometry, reference.geometry, "geometry");
     assert_eq!(out.ids, reference.ids, "ids");
-    // Each pixel: its centre where the lens covers it, then its 16 samples that it covers.
+    // Each pixel: its centre where the lens covers it, then those of its samples it covers.
     for (i, (&n, c)) in rays.iter().zip(&reference.colour).enumerate() {
-        let samples = (c[3] * 16.0).round() as u32;
+        let samples = (c[3] * spp as f32).round() as u32;
         assert_eq!(n, u32::from(centres.valid(i)) + samples, "pixel {i}");
     }
 }
@@ -282,6 +290,36 @@ fn error_falls_as_the_threshold_falls() {
         }
         last = Some((threshold, mse, spent));
     }
+}
+
+/// Above threshold 0, a pixel the estimating stage samples 2 × 2 and leaves is uniform
+/// sampling's 4-ray pixel, and one it goes on to supersample is the 16-ray pixel, bit for bit
+/// (the same samples, added in the same order, though traced side by side): both kinds occur.
+#[test]
+fn estimated_and_supersampled_pixels_are_uniform_samplings() {
+    let room = scene("builtin:default");
+    let gpu = upload(&room);
+    let cam = camera("canon-8-15mm@8mm", 80, 60);
+    let (four, sixteen) = (uniform(&gpu, &cam, 4), uniform(&gpu, &cam, 16));
+    let (out, rays) = adaptive(&gpu, &cam, 16, 0.05, false);
+    let (mut estimated, mut supersampled) = (0, 0);
+    for (i, &n) in rays.iter().enumerate() {
+        // Pixels the lens covers whole: their centre's ray, then 4, then 16 samples.
+        if out.colour[i][3] != 1.0 {
+            continue;
+        }
+        if n == 1 + 4 {
+            assert_eq!(out.colour[i], four.colour[i], "pixel {i}, estimated");
+            estimated += 1;
+        } else if n == 1 + 4 + 16 {
+            assert_eq!(out.colour[i], sixteen.colour[i], "pixel {i}, supersampled");
+            supersampled += 1;
+        }
+    }
+    assert!(
+        estimated > 0 && supersampled > 0,
+        "{estimated} estimated, {supersampled} supersampled"
+    );
 }
 
 /// What adaptive sampling cannot do is refused with what to do instead: a negative or

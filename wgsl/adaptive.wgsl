@@ -15,16 +15,16 @@
 //    and those on the lens's edge: a one-ray pixel is its box filter's value where colour
 //    changes linearly across it, and the bend estimates how far off it is (Mitchell 1987 drove
 //    supersampling by such local contrast). Where SAMPLES_PER_SIDE > 2 and the threshold is
-//    above 0, `trace_list` first takes 2 × 2 stratified samples of each (`MODE_ESTIMATE`) and
+//    above 0, `trace_samples` first takes 2 × 2 stratified samples of each (`MODE_ESTIMATE`) and
 //    marks those whose half-sample mean differs from the mean by the threshold or more
 //    (Dammertz et al. 2010's error estimate); `more` lists those. The last list's pixels take
 //    the SAMPLES_PER_SIDE² jittered stratified samples that uniform supersampling takes, in
-//    its order;
+//    its order (`trace_samples` again);
 // 4. with ground truth asked for, `untraced` lists the interpolated pixels and `trace_list`
 //    traces their centres' first hits, so ids, normals and ranges are never interpolated.
 //
 // Lists are compacted by one atomic per workgroup; `adaptive_args.wgsl` turns a list's length
-// into the indirect dispatch of `trace_list`; nothing is read back between passes. A pixel's
+// into the indirect dispatch of `trace_list` or `trace_samples`; nothing is read back between passes. A pixel's
 // result depends on its own samples and its neighbours' alone, so the order in which lists
 // fill does not change the image: reruns are bit-identical.
 #import pixel
@@ -54,8 +54,9 @@ struct AdaptiveParams {
 @group(0) @binding(7) var<storage, read_write> work: array<atomic<u32>>;
 @group(0) @binding(8) var<uniform> adaptive: AdaptiveParams;
 
-// What `trace_list` does with the pixels listed: a pipeline for each (the modes' kernels
-// differ in size, and one kernel holding all four would be as slow as the largest).
+// What is traced of the pixels listed: centres and first hits by `trace_list`, samples and
+// estimates by `trace_samples`; a pipeline for each (the modes' kernels differ in size, and
+// one kernel holding all four would be as slow as the largest).
 const MODE_CENTRE: u32 = 0u;
 const MODE_SAMPLES: u32 = 1u;
 const MODE_TRUTH: u32 = 2u;
@@ -147,7 +148,8 @@ fn lattice(@builtin(global_invocation_id) id: vec3<u32>, @builtin(local_invocati
     list_if(all(id.xy < adaptive.lattice), index_of(lattice_pixel(id.xy)), local);
 }
 
-// Traces the listed pixels as LIST_MODE says.
+// Traces the centres of the listed pixels as LIST_MODE says: shaded (MODE_CENTRE) or their
+// first hits alone (MODE_TRUTH).
 @compute @workgroup_size(WORKGROUP_1D)
 fn trace_list(
     @builtin(workgroup_id) group: vec3<u32>,
@@ -161,24 +163,6 @@ fn trace_list(
     let index = atomicLoad(&work[ADAPTIVE_HEADER + i]);
     let pixel = vec2<u32>(index % lens.width, index / lens.width);
     let mode = LIST_MODE;
-    if mode == MODE_SAMPLES {
-        let c = supersampled(pixel, index);
-        colour_out[index] = c;
-        let count = f32(SAMPLES_PER_SIDE * SAMPLES_PER_SIDE);
-        add_rays(index, u32(round(c.w * count)));
-        return;
-    }
-    if mode == MODE_ESTIMATE {
-        // Dammertz et al. (2010) estimate a pixel's error by how far the mean of half its
-        // samples lies from the mean of all: here in displayed colour, where the threshold is.
-        let s = samples(pixel, index, ADAPTIVE_ESTIMATE_SIDE);
-        colour_out[index] = s.colour;
-        add_rays(index, u32(round(s.colour.w * f32(ADAPTIVE_ESTIMATE_SIDE * ADAPTIVE_ESTIMATE_SIDE))));
-        if largest(abs(shown(s.colour.rgb) - shown(s.half))) >= adaptive.threshold {
-            set_key(index, KEY_MORE);
-        }
-        return;
-    }
     let ray = primary_ray(pixel);
     if ray.w == 0.0 {
         if mode == MODE_CENTRE {
@@ -200,6 +184,66 @@ fn trace_list(
     geometry_out[index] = geometry_of(traced);
     ids_out[index] = traced.triangle;
     set_state(index, 1u, surface_key(traced));
+}
+
+// Invocations that trace one listed pixel's samples side by side in `trace_samples`: as many
+// as it takes samples, at most a workgroup's (WORKGROUP_1D / SAMPLE_LANES pixels a workgroup).
+override SAMPLE_LANES: u32 = 1u;
+// Each invocation's last sample, for its pixel's first lane to add up.
+var<workgroup> lane_radiance: array<vec4<f32>, WORKGROUP_1D>;
+
+// Traces the listed pixels' samples, LIST_MODE's MODE_SAMPLES (SAMPLES_PER_SIDE² each) or
+// MODE_ESTIMATE (ADAPTIVE_ESTIMATE_SIDE²), SAMPLE_LANES invocations a pixel: lane j traces
+// samples j, j + SAMPLE_LANES, ..., and the pixel's first lane adds them to its sums in sample
+// order, as `samples` does in one invocation, so the colour is the same bit for bit. (With one
+// invocation a pixel, a few listed pixels left a large GPU waiting on a few long invocations:
+// on an H200, supersampling a few thousand pixels took 3 to 5 ms.)
+@compute @workgroup_size(WORKGROUP_1D)
+fn trace_samples(
+    @builtin(workgroup_id) group: vec3<u32>,
+    @builtin(num_workgroups) groups: vec3<u32>,
+    @builtin(local_invocation_index) local: u32,
+) {
+    let estimate = LIST_MODE == MODE_ESTIMATE;
+    let side = select(SAMPLES_PER_SIDE, ADAPTIVE_ESTIMATE_SIDE, estimate);
+    let count = side * side;
+    let per_group = WORKGROUP_1D / SAMPLE_LANES;
+    let lane = local % SAMPLE_LANES;
+    let slot = local / SAMPLE_LANES;
+    let i = atomicLoad(&work[ADAPTIVE_FIRST]) + (group.y * groups.x + group.x) * per_group + slot;
+    let listed = slot < per_group && i < atomicLoad(&work[ADAPTIVE_END]);
+    var index = 0u;
+    if listed {
+        index = atomicLoad(&work[ADAPTIVE_HEADER + i]);
+    }
+    let pixel = vec2<u32>(index % lens.width, index / lens.width);
+    var sums = SampleSums();
+    // Every invocation runs every round and its barriers, listed or not.
+    for (var first = 0u; first < count; first += SAMPLE_LANES) {
+        var c = vec4<f32>(0.0);
+        if listed && first + lane < count {
+            c = sample_radiance(pixel, index, first + lane, side);
+        }
+        lane_radiance[local] = c;
+        workgroupBarrier();
+        if listed && lane == 0u {
+            for (var j = 0u; j < min(SAMPLE_LANES, count - first); j++) {
+                add_sample(&sums, first + j, side, lane_radiance[local + j]);
+            }
+        }
+        workgroupBarrier();
+    }
+    if !listed || lane != 0u {
+        return;
+    }
+    let s = sampled(sums, count);
+    colour_out[index] = s.colour;
+    add_rays(index, u32(round(s.colour.w * f32(count))));
+    // Dammertz et al. (2010) estimate a pixel's error by how far the mean of half its samples
+    // lies from the mean of all: here in displayed colour, where the threshold is.
+    if estimate && largest(abs(shown(s.colour.rgb) - shown(s.half))) >= adaptive.threshold {
+        set_key(index, KEY_MORE);
+    }
 }
 
 // What a block's corner saw: its key, and its hit's normal and position (relative to the

@@ -1,5 +1,5 @@
 // Turns adaptive sampling's work list into the indirect dispatch of `adaptive.wgsl`'s
-// `trace_list`: one invocation. It sets the part of the list `trace_list` traces (entries
+// `trace_list` or `trace_samples`, PER_GROUP list entries a workgroup: one invocation. It sets the part of the list `trace_list` traces (entries
 // ADAPTIVE_FIRST to ADAPTIVE_END of the header): the whole list, or with SLICE > 0 the next
 // SLICE entries after the last part's end, so that progressive refinement traces a long list
 // over several frames. The arguments live in a buffer of their own, since a dispatch may not
@@ -12,6 +12,8 @@
 
 // List entries per dispatch; 0: all of them.
 override SLICE: u32 = 0u;
+// List entries per workgroup of the kernel dispatched.
+override PER_GROUP: u32 = WORKGROUP_1D;
 
 @compute @workgroup_size(1)
 fn main() {
@@ -24,7 +26,7 @@ fn main() {
     }
     work[ADAPTIVE_FIRST] = first;
     work[ADAPTIVE_END] = end;
-    let groups = (end - first + WORKGROUP_1D - 1u) / WORKGROUP_1D;
+    let groups = (end - first + PER_GROUP - 1u) / PER_GROUP;
     // Rows of at most 65535 workgroups (the least limit on a dimension).
     let rows = max((groups + 65534u) / 65535u, 1u);
     dispatch[0] = (groups + rows - 1u) / rows;

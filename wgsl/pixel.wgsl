@@ -29,33 +29,58 @@ struct Sampled {
     half: vec3<f32>,
 }
 
-// The `side`² jittered stratified samples of pixel `pixel` (index `index`).
-fn samples(pixel: vec2<u32>, index: u32, side: u32) -> Sampled {
-    let count = side * side;
-    var sum = vec3<f32>(0.0);
-    var half_sum = vec3<f32>(0.0);
-    var covered = 0u;
-    var half_covered = 0u;
-    for (var k = 0u; k < count; k++) {
-        let p = vec2<f32>(pixel) + sample_offset(index, k, side);
-        let d = lens_unproject(lens, p);
-        if d.w != 0.0 {
-            let at = camera_at(sample_time(pixel, index, k, count));
-            let c = shade(placed_ray(at, vec3<f32>(0.0), d.xyz)).colour;
-            sum += c;
-            covered += 1u;
-            if (k % side + k / side) % 2u == 0u {
-                half_sum += c;
-                half_covered += 1u;
-            }
-        }
+// Running sums over a pixel's samples, added in sample order (`add_sample`), wherever the
+// samples were traced: one invocation (`samples`) or several side by side
+// (`adaptive.wgsl`'s `trace_samples`) give the same bits.
+struct SampleSums {
+    sum: vec3<f32>,
+    half_sum: vec3<f32>,
+    covered: u32,
+    half_covered: u32,
+}
+
+// Sample `k` of the `side`² jittered stratified samples of pixel `pixel` (index `index`): its
+// radiance with w = 1, or all zero where the lens masks it.
+fn sample_radiance(pixel: vec2<u32>, index: u32, k: u32, side: u32) -> vec4<f32> {
+    let p = vec2<f32>(pixel) + sample_offset(index, k, side);
+    let d = lens_unproject(lens, p);
+    if d.w == 0.0 {
+        return vec4<f32>(0.0);
     }
-    if covered == 0u {
+    let at = camera_at(sample_time(pixel, index, k, side * side));
+    return vec4<f32>(shade(placed_ray(at, vec3<f32>(0.0), d.xyz)).colour, 1.0);
+}
+
+// Adds sample `k` of `side`², `sample_radiance`'s `c`, to `sums`.
+fn add_sample(sums: ptr<function, SampleSums>, k: u32, side: u32, c: vec4<f32>) {
+    if c.w == 0.0 {
+        return;
+    }
+    (*sums).sum += c.rgb;
+    (*sums).covered += 1u;
+    if (k % side + k / side) % 2u == 0u {
+        (*sums).half_sum += c.rgb;
+        (*sums).half_covered += 1u;
+    }
+}
+
+// What `count` samples summed in `sums` make.
+fn sampled(sums: SampleSums, count: u32) -> Sampled {
+    if sums.covered == 0u {
         return Sampled(vec4<f32>(0.0), vec3<f32>(0.0));
     }
-    let mean = sum / f32(covered);
-    let half = select(mean, half_sum / f32(max(half_covered, 1u)), half_covered > 0u);
-    return Sampled(vec4<f32>(mean, f32(covered) / f32(count)), half);
+    let mean = sums.sum / f32(sums.covered);
+    let half = select(mean, sums.half_sum / f32(max(sums.half_covered, 1u)), sums.half_covered > 0u);
+    return Sampled(vec4<f32>(mean, f32(sums.covered) / f32(count)), half);
+}
+
+// The `side`² jittered stratified samples of pixel `pixel` (index `index`), in one invocation.
+fn samples(pixel: vec2<u32>, index: u32, side: u32) -> Sampled {
+    var sums = SampleSums();
+    for (var k = 0u; k < side * side; k++) {
+        add_sample(&sums, k, side, sample_radiance(pixel, index, k, side));
+    }
+    return sampled(sums, side * side);
 }
 
 // The pixel's SAMPLES_PER_SIDE² samples: their mean radiance, and the share with a ray (w).

@@ -5,6 +5,7 @@
 
 use std::fmt::Write as _;
 use std::path::Path;
+use std::time::{Duration, Instant};
 
 use serde::Serialize;
 
@@ -132,7 +133,7 @@ pub struct CompareReport {
     pub pose: String,
     /// Rays per pixel of the reference.
     pub reference_spp: u32,
-    /// Timed frames per setup (medians are reported), after one untimed.
+    /// Timed frames per setup (medians are reported), after [`WARM_UP`] of untimed ones.
     pub frames: usize,
     /// How errors are measured.
     pub method_note: &'static str,
@@ -150,6 +151,25 @@ const COMPARE_NOTE: &str = "The reference is direct ray tracing with many strati
     per channel, PSNR = 10 log10(1 / MSE), and mean ꟻLIP (NVIDIA's perceptual difference, \
     0 to 1, at 67 pixels per degree). Mask agreement is the fraction of all pixels whose lens \
     mask matches the reference's. Errors within 5% count as equal on the Pareto front.";
+
+/// Untimed frames before each setup's timed ones: at least one (lavapipe compiles a pipeline
+/// at its first dispatch), and more until they fill this many milliseconds of wall time. A GPU
+/// lowers its clocks while idle, as it is while the next setup's pipelines compile, and takes
+/// a while under load to raise them again: on an H200 after one untimed frame, 4 rays a pixel
+/// timed slower than 16 and neighbouring setups' medians moved tenfold.
+pub const WARM_UP: Duration = Duration::from_millis(250);
+
+/// Runs `frame` once, then again until `least` has passed since the first began; returns how
+/// many times it ran.
+fn warm_up(least: Duration, mut frame: impl FnMut() -> Result<()>) -> Result<usize> {
+    let start = Instant::now();
+    let mut frames = 0;
+    while frames == 0 || start.elapsed() < least {
+        frame()?;
+        frames += 1;
+    }
+    Ok(frames)
+}
 
 /// Times `frames` frames of every setup at `pose` on every lens, measures each image's error
 /// against direct ray tracing at `reference_spp` rays per pixel, and writes the reference's
@@ -207,17 +227,23 @@ pub fn compare(
         for &setup in setups {
             let what = format!("{} {}", lens.name, setup.label());
             let renderer = study.renderer(lens, setup)?;
+            progress(Progress {
+                done,
+                total,
+                what: &what,
+            });
+            warm_up(WARM_UP, || {
+                renderer.frame(study.ctx, study.scenes, pose).map(drop)
+            })?;
+            done += 1;
             let mut times = Vec::with_capacity(frames);
-            for k in 0..=frames {
+            for _ in 0..frames {
                 progress(Progress {
                     done,
                     total,
                     what: &what,
                 });
-                let t = renderer.frame(study.ctx, study.scenes, pose)?;
-                if k > 0 {
-                    times.push(t);
-                }
+                times.push(renderer.frame(study.ctx, study.scenes, pose)?);
                 done += 1;
             }
             let colour = renderer.colour(study.ctx)?;
@@ -364,7 +390,7 @@ impl CompareReport {
     /// The Markdown table: a row per lens and setup, then the verdicts.
     pub fn markdown(&self) -> String {
         let mut md = format!(
-            "# fisheye compare: {} ({} triangles), {}, {}\n\n{}\n{} Reference: {} rays per pixel. Times are medians of {} frames.\n\n",
+            "# fisheye compare: {} ({} triangles), {}, {}\n\n{}\n{} Reference: {} rays per pixel. Times are medians of {} frames, after {} ms of untimed ones.\n\n",
             self.run.scene,
             self.run.triangles,
             self.run.size,
@@ -372,7 +398,8 @@ impl CompareReport {
             machine_lines(&self.run.machine),
             self.method_note,
             self.reference_spp,
-            self.frames
+            self.frames,
+            WARM_UP.as_millis()
         );
         md.push_str(
             "| lens | setup | ms / frame | MSE | PSNR (dB) | ꟻLIP | mask agreement | Pareto (MSE) | Pareto (ꟻLIP) |\n|---|---|---:|---:|---:|---:|---:|:-:|:-:|\n",
@@ -513,6 +540,27 @@ impl CompareReport {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The warm-up runs at least one frame, and frames until its time has passed: frames of
+    /// at least 5 ms fill 20 ms in no fewer than 4. A frame's error ends it.
+    #[test]
+    fn the_warm_up_runs_frames_until_its_time_has_passed() {
+        assert_eq!(warm_up(Duration::ZERO, || Ok(())).unwrap(), 1);
+        let start = Instant::now();
+        let frames = warm_up(Duration::from_millis(20), || {
+            std::thread::sleep(Duration::from_millis(5));
+            Ok(())
+        })
+        .unwrap();
+        assert!(frames >= 4, "{frames} frames");
+        assert!(start.elapsed() >= Duration::from_millis(20));
+        let mut calls = 0;
+        let failed = warm_up(Duration::from_secs(60), || {
+            calls += 1;
+            Err(crate::error::Error::Option("no adapter".into()))
+        });
+        assert!(failed.is_err() && calls == 1);
+    }
 
     /// A setup (`rt@Nspp` or `cube-rt@SIZE`) with a time (GPU, else wall), an MSE and a ꟻLIP.
     fn entry(setup: &str, gpu_ms: Option<f64>, wall_ms: f64, mse: f64) -> CompareEntry {

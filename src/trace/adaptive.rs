@@ -13,7 +13,7 @@ use crate::scene::Camera;
 use crate::shader;
 use crate::shared::{
     ADAPTIVE_BLOCK, ADAPTIVE_COUNT, ADAPTIVE_ESTIMATE_SIDE, ADAPTIVE_HEADER,
-    ADAPTIVE_STORAGE_BUFFERS, AdaptiveParams, TRACE_STORAGE_BUFFERS, WORKGROUP_2D,
+    ADAPTIVE_STORAGE_BUFFERS, AdaptiveParams, TRACE_STORAGE_BUFFERS, WORKGROUP_1D, WORKGROUP_2D,
 };
 
 /// Two corners' shading normals further apart than this (about 25°) are not one smooth
@@ -67,6 +67,19 @@ pub fn stages_for(samples_per_side: u32, options: Adaptive) -> Vec<Stage> {
     stages
 }
 
+/// How many invocations of `trace_samples` (wgsl/adaptive.wgsl) trace each pixel listed at
+/// `stage` side by side, with `samples_per_side`² samples at most: one for each of its samples
+/// (2 × 2 estimating, all of them supersampling), at most a workgroup's; 1 at the stages that
+/// trace centres (`trace_list`).
+fn sample_lanes(stage: Stage, samples_per_side: u32) -> u32 {
+    let samples = match stage {
+        Stage::Estimate => ADAPTIVE_ESTIMATE_SIDE.pow(2),
+        Stage::Supersample => samples_per_side.pow(2),
+        Stage::Coarse | Stage::Refine | Stage::Truth => 1,
+    };
+    samples.min(WORKGROUP_1D)
+}
+
 /// Timestamp writes for the stages of one frame, each in two compute passes: the listing of
 /// its pixels (the bookkeeping), then the tracing of the list; `None` leaves a pass untimed.
 #[derive(Default)]
@@ -87,11 +100,13 @@ pub struct AdaptivePass {
     /// The kernels that list each stage's pixels: lattice, classify, select_pixels, more,
     /// untraced.
     builders: [wgpu::ComputePipeline; 5],
-    /// `trace_list` for each [`Stage`] (coarse and refine share one).
+    /// The tracing kernel of each [`Stage`]: `trace_list` (coarse and refine share one) or
+    /// `trace_samples`.
     trace_lists: [wgpu::ComputePipeline; 5],
-    /// The kernels that size `trace_list`'s dispatch: over the whole list, and over the next
-    /// slice of it (progressive refinement, [`AdaptivePass::encode_step`]).
-    args: [wgpu::ComputePipeline; 2],
+    /// The kernels that size each [`Stage`]'s tracing dispatch over its whole list, then
+    /// supersampling's over the next slice of it (progressive refinement,
+    /// [`AdaptivePass::encode_step`]).
+    args: [wgpu::ComputePipeline; 6],
     group: wgpu::BindGroup,
     args_group: wgpu::BindGroup,
     work: wgpu::Buffer,
@@ -212,29 +227,35 @@ impl AdaptivePass {
                 }
                 None => "adaptive",
             };
-            let kernel = |entry: &str, mode: u32| {
+            let side = trace.samples_per_side();
+            let kernel = |entry: &str, mode: u32, lanes: u32| {
                 let mut constants = trace.constants().to_vec();
                 constants.push(("LIST_MODE", f64::from(mode)));
+                constants.push(("SAMPLE_LANES", f64::from(lanes)));
                 let composed = (&scene.arrays, source.swaps());
                 shader::scene_pipeline(device, file, composed, entry, &constants, &layouts)
             };
-            let builders =
-                ["lattice", "classify", "select_pixels", "more", "untraced"].map(|e| kernel(e, 0));
+            let builders = ["lattice", "classify", "select_pixels", "more", "untraced"]
+                .map(|e| kernel(e, 0, 1));
             // The modes of wgsl/adaptive.wgsl: centres, samples, first hits, estimates.
-            let centres = kernel("trace_list", 0);
+            let centres = kernel("trace_list", 0, 1);
             let trace_lists = [
                 centres.clone(),
                 centres,
-                kernel("trace_list", 3),
-                kernel("trace_list", 1),
-                kernel("trace_list", 2),
+                kernel("trace_samples", 3, sample_lanes(Stage::Estimate, side)),
+                kernel("trace_samples", 1, sample_lanes(Stage::Supersample, side)),
+                kernel("trace_list", 2, 1),
             ];
             let args_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
                 label: Some("fisheye.adaptive.args"),
                 entries: &[storage_entry(0, false), storage_entry(1, false)],
             });
-            let args_kernel = |slice: u32| {
-                let constants = [("SLICE", f64::from(slice))];
+            let args_kernel = |slice: u32, stage: Stage| {
+                let per_group = WORKGROUP_1D / sample_lanes(stage, side);
+                let constants = [
+                    ("SLICE", f64::from(slice)),
+                    ("PER_GROUP", f64::from(per_group)),
+                ];
                 shader::compute_pipeline(
                     device,
                     "adaptive_args",
@@ -243,7 +264,10 @@ impl AdaptivePass {
                     &[&args_layout],
                 )
             };
-            let args = [args_kernel(0), args_kernel(slice)];
+            let [coarse, refine, estimate, supersample, truth] =
+                ALL_STAGES.map(|stage| args_kernel(0, stage));
+            let sliced = args_kernel(slice, Stage::Supersample);
+            let args = [coarse, refine, estimate, supersample, truth, sliced];
             let args_group = crate::gpu::bind_buffers(
                 device,
                 "fisheye.adaptive.args",
@@ -358,7 +382,7 @@ impl AdaptivePass {
             _ => {
                 if stages.contains(&Stage::Supersample) {
                     let mut pass = encoder.begin_compute_pass(&Default::default());
-                    self.trace_listed(&mut pass, scene, Stage::Supersample, 1);
+                    self.trace_listed(&mut pass, scene, Stage::Supersample, true);
                 }
             }
         }
@@ -408,21 +432,26 @@ impl AdaptivePass {
                 label: Some("fisheye.adaptive.trace"),
                 timestamp_writes: writes,
             });
-            self.trace_listed(&mut pass, scene, stage, 0);
+            self.trace_listed(&mut pass, scene, stage, false);
         }
         let count = 4 * u64::from(ADAPTIVE_COUNT);
         encoder.copy_buffer_to_buffer(&self.work, count, &self.listed, 4 * stage as u64, 4);
     }
 
-    /// Records the sizing of `trace_list`'s dispatch by `args` kernel `args` (the whole
-    /// list, or its next slice), then `stage`'s `trace_list` over it.
+    /// Records the sizing of `stage`'s tracing dispatch over its whole list, or with `sliced`
+    /// over the next slice of it, then the tracing.
     fn trace_listed(
         &self,
         pass: &mut wgpu::ComputePass<'_>,
         scene: &GpuScene,
         stage: Stage,
-        args: usize,
+        sliced: bool,
     ) {
+        let args = if sliced {
+            ALL_STAGES.len()
+        } else {
+            stage as usize
+        };
         pass.set_pipeline(&self.args[args]);
         pass.set_bind_group(0, &self.args_group, &[]);
         pass.dispatch_workgroups(1, 1, 1);
