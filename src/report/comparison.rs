@@ -133,7 +133,7 @@ pub struct CompareReport {
     pub pose: String,
     /// Rays per pixel of the reference.
     pub reference_spp: u32,
-    /// Timed frames per setup (medians are reported), after [`WARM_UP`] of untimed ones.
+    /// Timed frames per setup (medians are reported), after a quarter of a second of untimed ones.
     pub frames: usize,
     /// How errors are measured.
     pub method_note: &'static str,
@@ -157,7 +157,7 @@ const COMPARE_NOTE: &str = "The reference is direct ray tracing with many strati
 /// lowers its clocks while idle, as it is while the next setup's pipelines compile, and takes
 /// a while under load to raise them again: on an H200 after one untimed frame, 4 rays a pixel
 /// timed slower than 16 and neighbouring setups' medians moved tenfold.
-pub const WARM_UP: Duration = Duration::from_millis(250);
+const WARM_UP: Duration = Duration::from_millis(250);
 
 /// Runs `frame` once, then again until `least` has passed since the first began; returns how
 /// many times it ran.
