@@ -15,8 +15,8 @@
 //    and those on the lens's edge: a one-ray pixel is its box filter's value where colour
 //    changes linearly across it, and the bend estimates how far off it is (Mitchell 1987 drove
 //    supersampling by such local contrast). Where SAMPLES_PER_SIDE > 2 and the threshold is
-//    above 0, `trace_samples` first takes 2 × 2 stratified samples of each (`MODE_ESTIMATE`) and
-//    marks those whose half-sample mean differs from the mean by the threshold or more
+//    above 0, `trace_samples` first takes 2 × 2 stratified samples of each (`MODE_ESTIMATE`)
+//    and marks those whose half-sample mean differs from the mean by the threshold or more
 //    (Dammertz et al. 2010's error estimate); `more` lists those. The last list's pixels take
 //    the SAMPLES_PER_SIDE² jittered stratified samples that uniform supersampling takes, in
 //    its order (`trace_samples` again);
@@ -24,9 +24,9 @@
 //    traces their centres' first hits, so ids, normals and ranges are never interpolated.
 //
 // Lists are compacted by one atomic per workgroup; `adaptive_args.wgsl` turns a list's length
-// into the indirect dispatch of `trace_list` or `trace_samples`; nothing is read back between passes. A pixel's
-// result depends on its own samples and its neighbours' alone, so the order in which lists
-// fill does not change the image: reruns are bit-identical.
+// into the indirect dispatch of `trace_list` or `trace_samples`; nothing is read back between
+// passes. A pixel's result depends on its own samples and its neighbours' alone, so the order
+// in which lists fill does not change the image: reruns are bit-identical.
 #import pixel
 #import colour
 

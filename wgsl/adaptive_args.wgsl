@@ -1,9 +1,10 @@
 // Turns adaptive sampling's work list into the indirect dispatch of `adaptive.wgsl`'s
-// `trace_list` or `trace_samples`, PER_GROUP list entries a workgroup: one invocation. It sets the part of the list `trace_list` traces (entries
-// ADAPTIVE_FIRST to ADAPTIVE_END of the header): the whole list, or with SLICE > 0 the next
-// SLICE entries after the last part's end, so that progressive refinement traces a long list
-// over several frames. The arguments live in a buffer of their own, since a dispatch may not
-// read its indirect arguments from a buffer it writes.
+// `trace_list` or `trace_samples`, PER_GROUP list entries a workgroup: one invocation. It sets
+// the part of the list traced (entries ADAPTIVE_FIRST to ADAPTIVE_END of the header): the
+// whole list, or with SLICE > 0 the next SLICE entries after the last part's end, so that
+// progressive refinement traces a long list over several frames. The arguments live in a
+// buffer of their own, since a dispatch may not read its indirect arguments from a buffer it
+// writes.
 
 // The work buffer of `adaptive.wgsl`: its header, here.
 @group(0) @binding(0) var<storage, read_write> work: array<u32>;
