@@ -67,17 +67,20 @@ pub fn stages_for(samples_per_side: u32, options: Adaptive) -> Vec<Stage> {
     stages
 }
 
-/// How many invocations of `trace_samples` (wgsl/adaptive.wgsl) trace each pixel listed at
-/// `stage` side by side, with `samples_per_side`² samples at most: one for each of its samples
-/// (2 × 2 estimating, all of them supersampling), at most a workgroup's; 1 at the stages that
-/// trace centres (`trace_list`).
-fn sample_lanes(stage: Stage, samples_per_side: u32) -> u32 {
-    let samples = match stage {
+/// The rays each pixel listed at `stage` takes, with `samples_per_side`² samples at most: 1 at
+/// the stages that trace centres (`trace_list`), 2 × 2 estimating, all of them supersampling.
+fn samples_at(stage: Stage, samples_per_side: u32) -> u32 {
+    match stage {
         Stage::Estimate => ADAPTIVE_ESTIMATE_SIDE.pow(2),
         Stage::Supersample => samples_per_side.pow(2),
         Stage::Coarse | Stage::Refine | Stage::Truth => 1,
-    };
-    samples.min(WORKGROUP_1D)
+    }
+}
+
+/// How many invocations of `trace_samples` (wgsl/adaptive.wgsl) trace each pixel listed at
+/// `stage` side by side: one for each of its samples, at most a workgroup's.
+fn sample_lanes(stage: Stage, samples_per_side: u32) -> u32 {
+    samples_at(stage, samples_per_side).min(WORKGROUP_1D)
 }
 
 /// Timestamp writes for the stages of one frame, each in two compute passes: the listing of
@@ -264,10 +267,16 @@ impl AdaptivePass {
                     &[&args_layout],
                 )
             };
-            let [coarse, refine, estimate, supersample, truth] =
-                ALL_STAGES.map(|stage| args_kernel(0, stage));
-            let sliced = args_kernel(slice, Stage::Supersample);
-            let args = [coarse, refine, estimate, supersample, truth, sliced];
+            // The stages that trace centres share one: a pixel a lane.
+            let centres = args_kernel(0, Stage::Coarse);
+            let args = [
+                centres.clone(),
+                centres.clone(),
+                args_kernel(0, Stage::Estimate),
+                args_kernel(0, Stage::Supersample),
+                centres,
+                args_kernel(slice, Stage::Supersample),
+            ];
             let args_group = crate::gpu::bind_buffers(
                 device,
                 "fisheye.adaptive.args",
@@ -479,16 +488,12 @@ impl AdaptivePass {
     /// whether or not their slices are traced yet.
     pub fn read_stage_rays(&self, ctx: &GpuContext) -> Result<Vec<(Stage, u64)>> {
         let listed: Vec<u32> = ctx.read_buffer(&self.listed)?;
-        let all = self.trace.samples_per_side().pow(2);
+        let side = self.trace.samples_per_side();
         Ok(self
             .stages()
             .into_iter()
             .map(|stage| {
-                let samples = match stage {
-                    Stage::Estimate => ADAPTIVE_ESTIMATE_SIDE.pow(2),
-                    Stage::Supersample => all,
-                    _ => 1,
-                };
+                let samples = samples_at(stage, side);
                 (
                     stage,
                     u64::from(listed[stage as usize]) * u64::from(samples),
