@@ -196,12 +196,35 @@ fn compare_measures_both_families_against_the_many_ray_reference() {
         .min_by(|a, b| a.ms().total_cmp(&b.ms()))
         .unwrap();
     assert!(fastest.pareto && fastest.pareto_flip);
+    // Samples a frame: RT's rays per pixel times its 64 × 48 pixels; the traced cube's texels,
+    // at least the 64 × 48 under the pixel centres (each one a texel centre), and no more than
+    // the front face and a border row or column of each neighbour (the resampler's footprint).
+    for (label, rays) in [
+        ("rt@1spp", 1),
+        ("rt@1spp+tent", 1),
+        ("rt@4spp", 4),
+        ("rt@16spp", 16),
+    ] {
+        assert_eq!(entry(label).samples, f64::from(rays * 64 * 48), "{label}");
+    }
+    let texels = matched.samples;
+    assert!(
+        (64.0 * 48.0..=64.0 * 64.0 + 4.0 * 64.0).contains(&texels),
+        "{texels}"
+    );
+    assert!(entry("cube-rt@16").samples <= 16.0 * 16.0 + 4.0 * 16.0);
     // A verdict per metric; the 16-ray setup's zero error is one only RT reaches. (How the
-    // levels are computed is `report`'s unit test, on set numbers.)
+    // levels are computed is `report`'s unit test, on set numbers.) In samples: at each traced
+    // cube's error, no less than one ray's, RT needs its fewest rays, 64 × 48.
     assert_eq!(report.verdicts.len(), 2);
     for v in &report.verdicts {
         assert!(!v.levels.is_empty());
         assert_eq!(v.rt_only, Some((0.0, "rt@16spp".to_string())));
+        assert!(!v.rays.is_empty());
+        for l in &v.rays {
+            assert_eq!(l.rt_rays, Some(64.0 * 48.0), "{}", l.cube);
+            assert_eq!(l.fewer, Some(entry(&l.cube).samples / (64.0 * 48.0)));
+        }
     }
     // The reference, error maps and both plots were written.
     assert_eq!(report.write(&out).unwrap(), None, "plots need a font");

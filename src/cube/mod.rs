@@ -345,6 +345,15 @@ impl CubeMap {
         self.regions
     }
 
+    /// The texels its faces render a frame: those of every face's rendered part.
+    pub fn texels_rendered(&self) -> u64 {
+        self.regions
+            .iter()
+            .flatten()
+            .map(|r| u64::from(r.x1 - r.x0) * u64::from(r.y1 - r.y0))
+            .sum()
+    }
+
     /// The rasterized faces' shadow maps (`None` for traced faces).
     pub fn shadow_maps(&self) -> Option<&crate::raster::ShadowMaps> {
         match &self.faces {

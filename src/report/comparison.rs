@@ -40,6 +40,10 @@ pub struct CompareEntry {
     /// The rays the last frame's colour took per pixel the lens covers, on average: adaptive
     /// sampling's measured count; `spp` for uniform sampling; `None` for cube maps.
     pub rays_per_pixel: Option<f64>,
+    /// The scene samples the last frame's colour took: a direct setup's primary rays (every
+    /// pixel's, as `rays_per_pixel` counts them), a cube map's face texels (traced or
+    /// rasterized, over the parts of the faces the lens reaches).
+    pub samples: f64,
     /// Median GPU ms per frame, if timestamps exist.
     pub gpu_ms: Option<f64>,
     /// Median wall ms per frame.
@@ -121,6 +125,29 @@ pub struct Verdict {
     pub least_speedup: Option<f64>,
     /// When RT reaches less error than any cube map: its least error and that setup.
     pub rt_only: Option<(f64, String)>,
+    /// The same comparison in samples against the traced cube (`cube-rt`), whose texels are
+    /// rays like RT's: one per `cube-rt` setup on its envelope in texels against error (none
+    /// without traced cubes).
+    pub rays: Vec<RayLevel>,
+    /// The least of `rays`' ratios over the levels both reach.
+    pub least_fewer: Option<f64>,
+}
+
+/// Direct RT's primary rays at one traced cube setup's error: with a ray costing the same in
+/// both (the same kernels shade them), the speed-up RT's sampling allows, whatever the GPU.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct RayLevel {
+    /// The traced cube setup on its envelope in texels against error.
+    pub cube: String,
+    /// Its error (the level).
+    pub error: f64,
+    /// The texels its faces trace a frame.
+    pub texels: f64,
+    /// The primary rays a frame direct RT's family needs for that error (its envelope in rays
+    /// against error, interpolated), `None` if RT does not reach it.
+    pub rt_rays: Option<f64>,
+    /// `texels / rt_rays`: how many times fewer rays RT traces.
+    pub fewer: Option<f64>,
 }
 
 /// What `fisheye compare` measured.
@@ -252,6 +279,10 @@ pub fn compare(
                 Some(map) => Some(map.iter().map(|&n| f64::from(n)).sum::<f64>() / covered),
                 None => setup.spp().map(f64::from),
             };
+            let samples = match renderer.cube() {
+                Some(cube) => cube.texels_rendered() as f64,
+                None => rays_per_pixel.unwrap_or(0.0) * covered,
+            };
             save_png(
                 &error_map(size, &reference, &colour),
                 &out.join(format!("{stem}.{}.error.png", file_stem(&setup.label()))),
@@ -267,6 +298,7 @@ pub fn compare(
                 threshold: setup.threshold(),
                 filter: setup.cube_size().is_none().then(|| setup.filter.name()),
                 rays_per_pixel,
+                samples,
                 gpu_ms: gpu.map(|g| median(&g)),
                 wall_ms: median(&wall),
                 error: image_error(&reference, &colour),
@@ -311,18 +343,64 @@ pub fn compare(
     })
 }
 
-/// The lower envelope of the entries `family` picks, in `metric`.
+/// What a setup costs a frame: its time, or its samples.
+type Cost = fn(&CompareEntry) -> f64;
+
+fn time(e: &CompareEntry) -> f64 {
+    e.ms()
+}
+
+fn samples(e: &CompareEntry) -> f64 {
+    e.samples
+}
+
+/// The lower envelope of the entries `family` picks, in `cost` against `metric`'s error.
 fn envelope<'a>(
     entries: impl IntoIterator<Item = &'a CompareEntry>,
     metric: Metric,
     family: fn(&CompareEntry) -> bool,
+    cost: Cost,
 ) -> Envelope {
     let points: Vec<(f64, f64)> = entries
         .into_iter()
         .filter(|e| family(e))
-        .map(|e| (e.ms(), e.error_in(metric)))
+        .map(|e| (cost(e), e.error_in(metric)))
         .collect();
     Envelope::of(&points)
+}
+
+/// The setup of `family` at a point of its envelope.
+fn name_at(
+    entries: &[CompareEntry],
+    metric: Metric,
+    family: fn(&CompareEntry) -> bool,
+    cost: Cost,
+    (c, e): (f64, f64),
+) -> String {
+    entries
+        .iter()
+        .find(|x| family(x) && cost(x) == c && x.error_in(metric) == e)
+        .map_or(String::new(), |x| x.setup.clone())
+}
+
+/// At each setup on the envelope of the cube setups `cube` picks, in `cost` against error:
+/// its name, error and cost, and the cost RT's family needs for that error (`None` where it
+/// does not reach it).
+fn at_cube_errors(
+    entries: &[CompareEntry],
+    metric: Metric,
+    cube: fn(&CompareEntry) -> bool,
+    cost: Cost,
+) -> Vec<(String, f64, f64, Option<f64>)> {
+    let rt = envelope(entries, metric, is_rt, cost);
+    envelope(entries, metric, cube, cost)
+        .points
+        .iter()
+        .map(|&(c, error)| {
+            let name = name_at(entries, metric, cube, cost, (c, error));
+            (name, error, c, rt.time_to_reach(error))
+        })
+        .collect()
 }
 
 /// Every direct setup (`rt`, `rq`; uniform and adaptive): RT's family in the verdict.
@@ -339,43 +417,72 @@ fn is_cube(e: &CompareEntry) -> bool {
     e.cube_size.is_some()
 }
 
-/// RT's family against the cube maps' at the errors of the cube setups on their envelope;
-/// `None` without both families.
+/// The traced cube, whose texels are rays.
+fn is_traced_cube(e: &CompareEntry) -> bool {
+    e.method == "cube-rt"
+}
+
+/// The least of some ratios, `None` without any.
+fn least(ratios: impl Iterator<Item = Option<f64>>) -> Option<f64> {
+    ratios.flatten().min_by(f64::total_cmp)
+}
+
+/// RT's family against the cube maps' at the errors of the cube setups on their envelope,
+/// in time, and against the traced cubes' in samples; `None` without both families.
 fn verdict(lens: &str, entries: &[CompareEntry], metric: Metric) -> Option<Verdict> {
-    let rt = envelope(entries, metric, is_rt);
-    let cubes = envelope(entries, metric, is_cube);
-    let (rt_best, cube_best) = (rt.best()?, cubes.best()?);
-    let name_of = |family: fn(&CompareEntry) -> bool, (t, e): (f64, f64)| {
-        entries
-            .iter()
-            .find(|x| family(x) && x.ms() == t && x.error_in(metric) == e)
-            .map_or(String::new(), |x| x.setup.clone())
-    };
-    let levels: Vec<Level> = cubes
-        .points
-        .iter()
-        .map(|&(cube_ms, error)| {
-            let rt_ms = rt.time_to_reach(error);
-            Level {
-                cube: name_of(is_cube, (cube_ms, error)),
-                error,
-                cube_ms,
-                rt_ms,
-                speedup: rt_ms.map(|t| cube_ms / t),
-            }
+    let rt_best = envelope(entries, metric, is_rt, time).best()?;
+    let cube_best = envelope(entries, metric, is_cube, time).best()?;
+    let levels: Vec<Level> = at_cube_errors(entries, metric, is_cube, time)
+        .into_iter()
+        .map(|(cube, error, cube_ms, rt_ms)| Level {
+            cube,
+            error,
+            cube_ms,
+            rt_ms,
+            speedup: rt_ms.map(|t| cube_ms / t),
         })
         .collect();
-    let least_speedup = levels
-        .iter()
-        .filter_map(|l| l.speedup)
-        .min_by(f64::total_cmp);
+    let rays: Vec<RayLevel> = at_cube_errors(entries, metric, is_traced_cube, samples)
+        .into_iter()
+        .map(|(cube, error, texels, rt_rays)| RayLevel {
+            cube,
+            error,
+            texels,
+            rt_rays,
+            fewer: rt_rays.map(|r| texels / r),
+        })
+        .collect();
     Some(Verdict {
         lens: lens.to_string(),
         metric,
+        least_speedup: least(levels.iter().map(|l| l.speedup)),
+        least_fewer: least(rays.iter().map(|l| l.fewer)),
         levels,
-        least_speedup,
-        rt_only: (rt_best.1 < cube_best.1).then(|| (rt_best.1, name_of(is_rt, rt_best))),
+        rays,
+        rt_only: (rt_best.1 < cube_best.1)
+            .then(|| (rt_best.1, name_at(entries, metric, is_rt, time, rt_best))),
     })
+}
+
+/// A count of rays or texels to three significant figures, in thousands (k) or millions (M)
+/// above a thousand.
+fn count(n: f64) -> String {
+    if n >= 1e6 {
+        format!("{} M", sig(n / 1e6))
+    } else if n >= 1e3 {
+        format!("{} k", sig(n / 1e3))
+    } else {
+        sig(n)
+    }
+}
+
+/// How many times fewer rays RT traces than the cube texels (`ratio` = texels / rays).
+fn rays_ratio(ratio: f64) -> String {
+    if ratio >= 1.0 {
+        format!("{ratio:.2}x fewer")
+    } else {
+        format!("{:.2}x more", 1.0 / ratio)
+    }
 }
 
 /// An error in the tables: MSE in scientific notation, ꟻLIP with four decimals.
@@ -402,16 +509,17 @@ impl CompareReport {
             WARM_UP.as_millis()
         );
         md.push_str(
-            "| lens | setup | ms / frame | MSE | PSNR (dB) | ꟻLIP | mask agreement | Pareto (MSE) | Pareto (ꟻLIP) |\n|---|---|---:|---:|---:|---:|---:|:-:|:-:|\n",
+            "| lens | setup | ms / frame | rays or texels | MSE | PSNR (dB) | ꟻLIP | mask agreement | Pareto (MSE) | Pareto (ꟻLIP) |\n|---|---|---:|---:|---:|---:|---:|---:|:-:|:-:|\n",
         );
         let dot = |on: bool| if on { "●" } else { "" };
         for e in &self.entries {
             let _ = writeln!(
                 md,
-                "| {} | {} | {} | {:.2e} | {:.1} | {:.4} | {:.4} | {} | {} |",
+                "| {} | {} | {} | {} | {:.2e} | {:.1} | {:.4} | {:.4} | {} | {} |",
                 e.lens,
                 e.setup,
                 sig(e.ms()),
+                count(e.samples),
                 e.error.mse,
                 e.error.psnr_db,
                 e.flip,
@@ -456,6 +564,41 @@ impl CompareReport {
             }
             let least = v.least_speedup.map_or("no error both reach".into(), |s| {
                 format!("least: {}", speed_ratio(s))
+            });
+            let _ = writeln!(md, "- {}, {metric} ({least}): {}", v.lens, parts.join("; "));
+        }
+        if self.verdicts.iter().any(|v| !v.rays.is_empty()) {
+            md.push_str(
+                "\nIn samples, against the traced cube (`cube-rt`), whose face texels are rays \
+                 shaded by the same kernels as RT's: at each traced cube setup on its envelope \
+                 in texels against error, the primary rays RT's family needs for that error, \
+                 interpolated in log rays against log error. Where a ray costs the same in both, \
+                 this is the speed-up RT's sampling allows, on any GPU: the 4x goal needs at \
+                 least 4x fewer rays.\n\n",
+            );
+        }
+        for v in self.verdicts.iter().filter(|v| !v.rays.is_empty()) {
+            let metric = v.metric.name();
+            let parts: Vec<String> = v
+                .rays
+                .iter()
+                .map(|l| {
+                    let at = format!(
+                        "{}'s {metric} {} ({} texels)",
+                        l.cube,
+                        error_text(v.metric, l.error),
+                        count(l.texels)
+                    );
+                    match (l.rt_rays, l.fewer) {
+                        (Some(r), Some(f)) => {
+                            format!("at {at} RT needs {} rays: {}", count(r), rays_ratio(f))
+                        }
+                        _ => format!("{at} only the cube map reaches"),
+                    }
+                })
+                .collect();
+            let least = v.least_fewer.map_or("no error both reach".into(), |f| {
+                format!("least: {}", rays_ratio(f))
             });
             let _ = writeln!(md, "- {}, {metric} ({least}): {}", v.lens, parts.join("; "));
         }
@@ -508,7 +651,7 @@ impl CompareReport {
                 },
             })
             .collect();
-        let family = |pick| envelope(entries.iter().copied(), metric, pick).points;
+        let family = |pick| envelope(entries.iter().copied(), metric, pick, time).points;
         let envelopes = [
             plot::Series {
                 label: "direct RT, uniform and adaptive".into(),
@@ -538,147 +681,4 @@ impl CompareReport {
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-
-    /// The warm-up runs at least one frame, and frames until its time has passed: frames of
-    /// at least 5 ms fill 20 ms in no fewer than 4. A frame's error ends it.
-    #[test]
-    fn the_warm_up_runs_frames_until_its_time_has_passed() {
-        assert_eq!(warm_up(Duration::ZERO, || Ok(())).unwrap(), 1);
-        let start = Instant::now();
-        let frames = warm_up(Duration::from_millis(20), || {
-            std::thread::sleep(Duration::from_millis(5));
-            Ok(())
-        })
-        .unwrap();
-        assert!(frames >= 4, "{frames} frames");
-        assert!(start.elapsed() >= Duration::from_millis(20));
-        let mut calls = 0;
-        let failed = warm_up(Duration::from_secs(60), || {
-            calls += 1;
-            Err(crate::error::Error::Option("no adapter".into()))
-        });
-        assert!(failed.is_err() && calls == 1);
-    }
-
-    /// A setup (`rt@Nspp` or `cube-rt@SIZE`) with a time (GPU, else wall), an MSE and a ꟻLIP.
-    fn entry(setup: &str, gpu_ms: Option<f64>, wall_ms: f64, mse: f64) -> CompareEntry {
-        let error = ImageError {
-            mse,
-            psnr_db: -10.0 * mse.log10(),
-            max_abs: mse.sqrt(),
-            mask_agreement: 1.0,
-            compared: 1,
-        };
-        let (method, after) = setup.split_once('@').unwrap();
-        let (cube_size, spp) = match after.strip_suffix("spp") {
-            Some(spp) => (None, Some(spp.parse().unwrap())),
-            None => (Some(after.parse().unwrap()), None),
-        };
-        CompareEntry {
-            lens: "lens".into(),
-            setup: setup.into(),
-            method: if method == "rt" { "rt" } else { "cube-rt" },
-            cube_size,
-            spp,
-            threshold: None,
-            filter: cube_size.is_none().then_some("box"),
-            rays_per_pixel: spp.map(f64::from),
-            gpu_ms,
-            wall_ms,
-            error,
-            flip: mse.sqrt(),
-            pareto: false,
-            pareto_flip: false,
-        }
-    }
-
-    /// RT at 1, 4 and 16 rays per pixel: 10, 40, 160 ms for MSE 4e-3, 1e-3, 2.5e-4 (4x the
-    /// time for a quarter of the error), against cube maps whose errors fall slower.
-    fn family() -> Vec<CompareEntry> {
-        vec![
-            entry("rt@1spp", Some(10.0), 50.0, 4e-3),
-            entry("rt@4spp", Some(40.0), 90.0, 1e-3),
-            entry("rt@16spp", Some(160.0), 200.0, 2.5e-4),
-            entry("cube-rt@64", Some(5.0), 1.0, 8e-3),
-            entry("cube-rt@128", Some(40.0), 1.0, 2e-3),
-            // Dominated by 128: off the envelope, and no level of its own.
-            entry("cube-rt@192", Some(60.0), 1.0, 3e-3),
-            entry("cube-rt@256", Some(200.0), 1.0, 5e-4),
-        ]
-    }
-
-    /// The verdict's levels are the cube setups on their envelope; at each, RT's time comes
-    /// from its own envelope: its fastest setup above RT's 1-ray error, log-log interpolation
-    /// between its setups otherwise.
-    #[test]
-    fn the_verdict_compares_the_families_at_the_cubes_errors() {
-        let v = verdict("lens", &family(), Metric::Mse).unwrap();
-        let cubes: Vec<&str> = v.levels.iter().map(|l| l.cube.as_str()).collect();
-        assert_eq!(cubes, ["cube-rt@64", "cube-rt@128", "cube-rt@256"]);
-        // 8e-3: RT's 1 ray is good enough, 10 ms; 5 ms of cube map is 0.5x.
-        assert_eq!(v.levels[0].rt_ms, Some(10.0));
-        assert_eq!(v.levels[0].speedup, Some(0.5));
-        // 2e-3 lies halfway (in log) between 4e-3 and 1e-3: 20 ms, so 40 / 20 = 2x.
-        assert!((v.levels[1].rt_ms.unwrap() - 20.0).abs() < 1e-9);
-        assert!((v.levels[1].speedup.unwrap() - 2.0).abs() < 1e-9);
-        // 5e-4 halfway between 1e-3 and 2.5e-4: 80 ms, 2.5x.
-        assert!((v.levels[2].speedup.unwrap() - 2.5).abs() < 1e-9);
-        assert_eq!(v.least_speedup, Some(0.5));
-        // RT goes lower than any cube map.
-        assert_eq!(v.rt_only, Some((2.5e-4, "rt@16spp".to_string())));
-        assert_eq!(v.metric, Metric::Mse);
-
-        // Without RT's 16 rays, the 256 cube's error is one only the cube maps reach.
-        let mut fewer = family();
-        fewer.remove(2);
-        let v = verdict("lens", &fewer, Metric::Mse).unwrap();
-        assert_eq!((v.levels[2].rt_ms, v.levels[2].speedup), (None, None));
-        assert_eq!(v.rt_only, None);
-
-        // Wall times where nothing has timestamps; no verdict without both families.
-        let walls = [
-            entry("rt@1spp", None, 8.0, 0.01),
-            entry("cube-rt@64", None, 4.0, 0.01),
-        ];
-        let v = verdict("lens", &walls, Metric::Mse).unwrap();
-        assert_eq!(v.levels[0].speedup, Some(0.5));
-        assert!(verdict("lens", &walls[1..], Metric::Mse).is_none());
-        assert!(verdict("lens", &walls[..1], Metric::Mse).is_none());
-    }
-
-    /// The report says each level, what only one family reaches, and the least speed-up.
-    #[test]
-    fn the_markdown_states_every_level() {
-        let entries = family();
-        let verdicts = vec![verdict("lens", &entries, Metric::Mse).unwrap()];
-        let report = CompareReport {
-            run: Run {
-                machine: crate::bench::Machine {
-                    adapter: "a".into(),
-                    driver: "d".into(),
-                    cpu: "c".into(),
-                    cpus: 2,
-                    date: "2026-11-23".into(),
-                },
-                scene: "s".into(),
-                triangles: 1,
-                size: "8x8".into(),
-            },
-            pose: "p".into(),
-            reference_spp: 256,
-            frames: 1,
-            method_note: COMPARE_NOTE,
-            entries,
-            verdicts,
-            skipped: Vec::new(),
-        };
-        let md = report.markdown();
-        assert!(md.contains("| lens | rt@4spp | 40.0 | 1.00e-3 |"), "{md}");
-        assert!(md.contains("- lens, MSE (least: 2.00x slower): at cube-rt@64's MSE 8.00e-3 (5.00 ms) RT needs 10.0 ms: 2.00x slower; at cube-rt@128's MSE 2.00e-3 (40.0 ms) RT needs 20.0 ms: 2.00x faster"), "{md}");
-        assert!(
-            md.contains("only RT reaches below the cube maps' best, down to 2.50e-4 (rt@16spp)")
-        );
-    }
-}
+mod tests;
