@@ -2,7 +2,7 @@
 # Re-makes the pictures of the README and the book (docs/src/images/): three renders, an
 # adaptive render beside its spp map, three renders through lens prescriptions, a moving
 # camera's frames (instant, rolling shutter, motion blur, flow), a moving object's, the
-# speed-against-error plot of results/lavapipe/, and the strip the README opens with. Run from
+# speed-against-error plot of results/lavapipe/ and its plot in rays, and the strip the README opens with. Run from
 # anywhere after `cargo build --release`; about a minute on lavapipe. Needs python3 with
 # Pillow (`.ci/install-lavapipe` installs it). Each picture is kept under 300 KB.
 set -euo pipefail
@@ -138,6 +138,10 @@ plot = Image.open("results/lavapipe/sibenik/compare/tradeoff-flip.samyang-7.5mm.
 height = 300
 plot = plot.resize((round(plot.width * height / plot.height), height), Image.LANCZOS)
 plot.save(f"{out}/tradeoff.png", optimize=True)
+# The verdict in rays: many-small through the Samyang, RT's rays against the traced cube's texels.
+rays = Image.open("results/lavapipe/rays/many-small/rays.samyang-7.5mm.png").convert("RGB")
+rays = rays.resize((rays.width * 8 // 11, rays.height * 8 // 11), Image.LANCZOS)
+rays.save(f"{out}/rays.png", optimize=True)
 tiles = [Image.open(f"{out}/{n}.png").convert("RGB") for n in ("room", "gltf", "sibenik")]
 tiles.append(plot)
 strip = Image.new("RGB", (sum(t.width for t in tiles) + 8 * (len(tiles) - 1), height), "white")

@@ -108,8 +108,8 @@ pub struct TradeOff {
     pub label: String,
     /// The method's name, which picks the colour.
     pub method: &'static str,
-    /// Milliseconds per frame.
-    pub ms: f64,
+    /// What a frame costs it: milliseconds, or rays and texels.
+    pub cost: f64,
     /// Error (MSE).
     pub error: f64,
     /// Whether it is on the Pareto front.
@@ -275,19 +275,20 @@ fn place_labels(anchors: &[(i32, i32)], widths: &[i32], height: i32) -> Vec<(i32
         .collect()
 }
 
-/// Time per frame (x, log) against error (y, log), a labelled point per setup coloured by
-/// method (filled where it is on the Pareto front), and each family's lower envelope as a
-/// line (`envelopes`: direct RT first, then the cube maps, then direct RT's uniform
-/// sampling alone).
-pub fn time_against_error(
+/// Cost per frame (x, log: `cost_label` says which) against error (y, log), a labelled point
+/// per setup coloured by method (filled where it is on the Pareto front), and each family's
+/// lower envelope as a line (`envelopes`: direct RT first, then the cube maps, then direct
+/// RT's uniform sampling alone).
+pub fn cost_against_error(
     path: &Path,
     title: &str,
+    cost_label: &str,
     error_label: &str,
     points: &[TradeOff],
     envelopes: &[Series],
 ) -> Result<()> {
     write_png(path, |root| {
-        let (x0, x1) = log_bounds(points.iter().map(|p| p.ms));
+        let (x0, x1) = log_bounds(points.iter().map(|p| p.cost));
         let (y0, y1) = log_bounds(points.iter().map(|p| p.error));
         let mut chart = ChartBuilder::on(root)
             .caption(title, (FAMILY, 22))
@@ -300,7 +301,7 @@ pub fn time_against_error(
             )?;
         chart
             .configure_mesh()
-            .x_desc("GPU ms per frame (log)")
+            .x_desc(cost_label)
             .y_desc(error_label)
             .label_style((FAMILY, 15))
             .light_line_style(WHITE)
@@ -328,7 +329,7 @@ pub fn time_against_error(
         }
         let anchors: Vec<(i32, i32)> = points
             .iter()
-            .map(|p| chart.backend_coord(&(p.ms, p.error.max(1e-12))))
+            .map(|p| chart.backend_coord(&(p.cost, p.error.max(1e-12))))
             .collect();
         // About 7 pixels a character at 13 px.
         let widths: Vec<i32> = points
@@ -345,7 +346,7 @@ pub fn time_against_error(
                 colour.stroke_width(2)
             };
             let series = chart.draw_series(std::iter::once(
-                EmptyElement::at((p.ms, p.error.max(1e-12)))
+                EmptyElement::at((p.cost, p.error.max(1e-12)))
                     + Circle::new((0, 0), 6, style)
                     + Text::new(p.label.clone(), (dx, dy), (FAMILY, 13)),
             ))?;

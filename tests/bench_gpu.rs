@@ -236,7 +236,12 @@ fn compare_measures_both_families_against_the_many_ray_reference() {
         let img = image::open(out.join(file)).unwrap();
         assert_eq!((img.width(), img.height()), (64, 48), "{file}");
     }
-    for plot in ["tradeoff.pinhole.png", "tradeoff-flip.pinhole.png"] {
+    for plot in [
+        "tradeoff.pinhole.png",
+        "tradeoff-flip.pinhole.png",
+        "rays.pinhole.png",
+        "rays-flip.pinhole.png",
+    ] {
         let img = image::open(out.join(plot)).unwrap();
         assert_eq!((img.width(), img.height()), (1100, 700), "{plot}");
     }

@@ -13,7 +13,6 @@ use super::{Progress, Run, Study, file_stem, machine_lines, sig, speed_ratio, wr
 use crate::compare::{Envelope, ImageError, error_map, flip_error, image_error, pareto_front};
 use crate::error::Result;
 use crate::gpu::median;
-use crate::plot;
 use crate::renderer::Method;
 use crate::renderer::{FrameTime, Setup};
 use crate::scene::Camera;
@@ -608,77 +607,18 @@ impl CompareReport {
         md
     }
 
-    /// Writes `compare.json`, `compare.md` and per lens `tradeoff.LENS.png` (MSE) and
-    /// `tradeoff-flip.LENS.png` into `out`; returns the plots' warning when they could not be
-    /// drawn.
+    /// Writes `compare.json`, `compare.md` and per lens and metric the plots of time against
+    /// error (`tradeoff.LENS.png`, `tradeoff-flip.LENS.png`) and, with traced cubes, of rays
+    /// against error (`rays.LENS.png`, `rays-flip.LENS.png`) into `out`; returns the plots'
+    /// warning when they could not be drawn.
     pub fn write(&self, out: &Path) -> Result<Option<String>> {
         let lenses = self.entries.iter().map(|e| e.lens.as_str());
         write_report(out, "compare", self, &self.markdown(), lenses, |lens| {
-            for (metric, file, axis) in [
-                (Metric::Mse, "tradeoff", "MSE against the reference (log)"),
-                (
-                    Metric::Flip,
-                    "tradeoff-flip",
-                    "mean ꟻLIP against the reference (log)",
-                ),
-            ] {
-                self.plot(out, lens, metric, file, axis)?;
-            }
-            Ok(())
+            self.plots(out, lens)
         })
-    }
-
-    fn plot(&self, out: &Path, lens: &str, metric: Metric, file: &str, axis: &str) -> Result<()> {
-        let entries: Vec<&CompareEntry> = self.entries.iter().filter(|e| e.lens == lens).collect();
-        let points: Vec<plot::TradeOff> = entries
-            .iter()
-            .map(|e| plot::TradeOff {
-                label: match e.cube_size {
-                    Some(size) => size.to_string(),
-                    // `16spp`, `auto:0.1`: the sampling, after the method's name.
-                    None => e
-                        .setup
-                        .split_once('@')
-                        .map_or(&*e.setup, |(_, s)| s)
-                        .to_string(),
-                },
-                method: e.method,
-                ms: e.ms(),
-                error: e.error_in(metric),
-                pareto: match metric {
-                    Metric::Mse => e.pareto,
-                    Metric::Flip => e.pareto_flip,
-                },
-            })
-            .collect();
-        let family = |pick| envelope(entries.iter().copied(), metric, pick, time).points;
-        let envelopes = [
-            plot::Series {
-                label: "direct RT, uniform and adaptive".into(),
-                points: family(is_rt),
-            },
-            plot::Series {
-                label: "cube maps over face sizes".into(),
-                points: family(is_cube),
-            },
-            plot::Series {
-                label: "direct RT, uniform rays, box filter".into(),
-                points: family(is_uniform),
-            },
-        ];
-        let title = format!(
-            "{}: {lens}, {} ({})",
-            self.run.scene, self.run.size, self.run.machine.adapter
-        );
-        plot::time_against_error(
-            &out.join(format!("{file}.{}.png", file_stem(lens))),
-            &title,
-            axis,
-            &points,
-            &envelopes,
-        )
     }
 }
 
+mod plots;
 #[cfg(test)]
 mod tests;
