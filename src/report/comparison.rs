@@ -11,6 +11,7 @@ use serde::Serialize;
 
 use super::{Progress, Run, Study, file_stem, machine_lines, sig, speed_ratio, write_report};
 use crate::compare::{Envelope, ImageError, error_map, flip_error, image_error, pareto_front};
+use crate::cube::CubeMethod;
 use crate::error::Result;
 use crate::gpu::median;
 use crate::renderer::Method;
@@ -418,7 +419,7 @@ fn is_cube(e: &CompareEntry) -> bool {
 
 /// The traced cube, whose texels are rays.
 fn is_traced_cube(e: &CompareEntry) -> bool {
-    e.method == "cube-rt"
+    e.method == Method::Cube(CubeMethod::Traced).name()
 }
 
 /// The least of some ratios, `None` without any.

@@ -12,6 +12,7 @@ use super::{
 use crate::compare::pareto_front;
 use crate::error::Result;
 use crate::plot;
+use crate::renderer::Method;
 use crate::report::file_stem;
 
 /// One kind of plot: its file, its cost axis and the setups it shows.
@@ -36,7 +37,7 @@ const RAYS: Kind = Kind {
     cost: samples,
     cost_label: "primary rays, or traced cube texels, per frame (log)",
     // `rq` traces `rt`'s rays to the same image: one of them is enough.
-    shows: |e| e.method == "rt" || is_traced_cube(e),
+    shows: |e| e.method == Method::Rt.name() || is_traced_cube(e),
     cubes: "traced cube over face sizes",
 };
 
