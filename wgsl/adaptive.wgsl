@@ -2,8 +2,9 @@
 // covered by blocks of ADAPTIVE_BLOCK × ADAPTIVE_BLOCK pixels whose corners form a lattice of
 // pixel centres (the last row and column of the image are lattice points too):
 //
-// 1. `lattice` lists the lattice pixels and `trace_list` traces one shaded ray through each
-//    centre (a first pass below one ray per pixel: 1/ADAPTIVE_BLOCK² of them);
+// 1. `trace_lattice` traces one shaded ray through each lattice pixel's centre (a first pass
+//    below one ray per pixel: 1/ADAPTIVE_BLOCK² of them), an invocation a lattice point, with
+//    no list;
 // 2. `classify` looks at each block's four corners (Whitted 1980 subdivided a pixel whose
 //    corners disagree): where they agree (the same surface, normals and tangent planes, and
 //    displayed colour along each edge that bends by less than the threshold, see `bend`) and
@@ -23,7 +24,7 @@
 // 4. with ground truth asked for, `untraced` lists the interpolated pixels and `trace_list`
 //    traces their centres' first hits, so ids, normals and ranges are never interpolated.
 //
-// Lists are compacted by one atomic per workgroup; `adaptive_args.wgsl` turns a list's length
+// The later stages' lists are compacted by one atomic per workgroup; `adaptive_args.wgsl` turns a list's length
 // into the indirect dispatch of `trace_list` or `trace_samples`; nothing is read back between
 // passes. A pixel's result depends on its own samples and its neighbours' alone, so the order
 // in which lists fill does not change the image: reruns are bit-identical.
@@ -54,9 +55,10 @@ struct AdaptiveParams {
 @group(0) @binding(7) var<storage, read_write> work: array<atomic<u32>>;
 @group(0) @binding(8) var<uniform> adaptive: AdaptiveParams;
 
-// What is traced of the pixels listed: centres and first hits by `trace_list`, samples and
-// estimates by `trace_samples`; a pipeline for each (the modes' kernels differ in size, and
-// one kernel holding all four would be as slow as the largest).
+// What is traced of the pixels listed: centres and first hits by `trace_list` (centres by
+// `trace_lattice` too), samples and estimates by `trace_samples`; a pipeline for each (the
+// modes' kernels differ in size, and one kernel holding all four would be as slow as the
+// largest).
 const MODE_CENTRE: u32 = 0u;
 const MODE_SAMPLES: u32 = 1u;
 const MODE_TRUTH: u32 = 2u;
@@ -143,26 +145,9 @@ fn is_lattice(p: vec2<u32>) -> bool {
     return (p.x % ADAPTIVE_BLOCK == 0u || p.x == last.x) && (p.y % ADAPTIVE_BLOCK == 0u || p.y == last.y);
 }
 
-@compute @workgroup_size(WORKGROUP_2D, WORKGROUP_2D)
-fn lattice(@builtin(global_invocation_id) id: vec3<u32>, @builtin(local_invocation_index) local: u32) {
-    list_if(all(id.xy < adaptive.lattice), index_of(lattice_pixel(id.xy)), local);
-}
-
-// Traces the centres of the listed pixels as LIST_MODE says: shaded (MODE_CENTRE) or their
-// first hits alone (MODE_TRUTH).
-@compute @workgroup_size(WORKGROUP_1D)
-fn trace_list(
-    @builtin(workgroup_id) group: vec3<u32>,
-    @builtin(num_workgroups) groups: vec3<u32>,
-    @builtin(local_invocation_index) local: u32,
-) {
-    let i = atomicLoad(&work[ADAPTIVE_FIRST]) + (group.y * groups.x + group.x) * WORKGROUP_1D + local;
-    if i >= atomicLoad(&work[ADAPTIVE_END]) {
-        return;
-    }
-    let index = atomicLoad(&work[ADAPTIVE_HEADER + i]);
-    let pixel = vec2<u32>(index % lens.width, index / lens.width);
-    let mode = LIST_MODE;
+// Traces the centre of pixel `index` (at `pixel`) as `mode` says: shaded (MODE_CENTRE), or
+// its first hit alone (MODE_TRUTH).
+fn trace_centre(index: u32, pixel: vec2<u32>, mode: u32) {
     let ray = primary_ray(pixel);
     if ray.w == 0.0 {
         if mode == MODE_CENTRE {
@@ -184,6 +169,32 @@ fn trace_list(
     geometry_out[index] = geometry_of(traced);
     ids_out[index] = traced.triangle;
     set_state(index, 1u, surface_key(traced));
+}
+
+// The coarse stage: a shaded ray through each lattice pixel's centre, an invocation a lattice
+// point, in the lattice's rows (no list to make or read: the lattice is known).
+@compute @workgroup_size(WORKGROUP_2D, WORKGROUP_2D)
+fn trace_lattice(@builtin(global_invocation_id) id: vec3<u32>) {
+    if any(id.xy >= adaptive.lattice) {
+        return;
+    }
+    let pixel = lattice_pixel(id.xy);
+    trace_centre(index_of(pixel), pixel, MODE_CENTRE);
+}
+
+// Traces the centres of the listed pixels as LIST_MODE says (`trace_centre`).
+@compute @workgroup_size(WORKGROUP_1D)
+fn trace_list(
+    @builtin(workgroup_id) group: vec3<u32>,
+    @builtin(num_workgroups) groups: vec3<u32>,
+    @builtin(local_invocation_index) local: u32,
+) {
+    let i = atomicLoad(&work[ADAPTIVE_FIRST]) + (group.y * groups.x + group.x) * WORKGROUP_1D + local;
+    if i >= atomicLoad(&work[ADAPTIVE_END]) {
+        return;
+    }
+    let index = atomicLoad(&work[ADAPTIVE_HEADER + i]);
+    trace_centre(index, vec2<u32>(index % lens.width, index / lens.width), LIST_MODE);
 }
 
 // Invocations that trace one listed pixel's samples side by side in `trace_samples`: as many
@@ -247,18 +258,56 @@ fn trace_samples(
 }
 
 // What a block's corner saw: its key, and its hit's normal and position (relative to the
-// scene's origin).
+// scene's origin; only where it hit a surface, the one case `same_surface` reads it).
 struct Corner {
     key: u32,
     geometry: vec4<f32>,
     position: vec3<f32>,
 }
 
-fn corner(p: vec2<u32>) -> Corner {
-    let i = index_of(p);
-    let g = geometry_out[i];
-    let ray = centre_ray(p, primary_ray(p).xyz);
-    return Corner(key_at(i), g, ray.origin + ray.dir * g.w);
+// What `classify` reads of the lattice points around its workgroup's blocks, loaded once into
+// workgroup memory by `load_tile`: the WORKGROUP_2D² blocks' corners and the ring beyond them
+// (whose colours `edge_bend` and keys `lattice_near` look at), TILE² points in rows. Each
+// point is a corner of up to four blocks and on the lines of up to twelve of their edges, so
+// that reading it from the outputs (and displaying its colour, and making its ray to place
+// its hit) once instead of at each use saves most of the classifying pass's work.
+const TILE: u32 = WORKGROUP_2D + 3u;
+var<workgroup> tile_corner: array<Corner, TILE * TILE>;
+// The point's traced colour (linear) and its displayed colour (`shown`).
+var<workgroup> tile_colour: array<vec4<f32>, TILE * TILE>;
+var<workgroup> tile_shown: array<vec3<f32>, TILE * TILE>;
+
+// The tile entry of lattice point `l`, for the workgroup whose first block is `origin`.
+fn tile_index(origin: vec2<u32>, l: vec2<i32>) -> u32 {
+    let t = vec2<u32>(l - vec2<i32>(origin) + 1);
+    return t.y * TILE + t.x;
+}
+
+// Loads the tile of the workgroup whose first block is `origin` (every invocation calls it,
+// in uniform control flow: it has a barrier). Entries outside the lattice are left as they
+// are: nothing reads them.
+fn load_tile(origin: vec2<u32>, local: u32) {
+    let last = vec2<i32>(adaptive.lattice) - 1;
+    for (var t = local; t < TILE * TILE; t += WORKGROUP_2D * WORKGROUP_2D) {
+        let l = vec2<i32>(origin) - 1 + vec2<i32>(i32(t % TILE), i32(t / TILE));
+        if any(l < vec2<i32>(0)) || any(l > last) {
+            continue;
+        }
+        let p = lattice_pixel(vec2<u32>(l));
+        let i = index_of(p);
+        let key = key_at(i);
+        let g = geometry_out[i];
+        var position = vec3<f32>(0.0);
+        if key < KEY_MORE {
+            let ray = centre_ray(p, primary_ray(p).xyz);
+            position = ray.origin + ray.dir * g.w;
+        }
+        tile_corner[t] = Corner(key, g, position);
+        let c = colour_out[i];
+        tile_colour[t] = c;
+        tile_shown[t] = shown(c.rgb);
+    }
+    workgroupBarrier();
 }
 
 // Whether two traced, unmasked corners see one smooth stretch of one surface: the same
@@ -282,13 +331,13 @@ fn same_surface(a: Corner, b: Corner) -> bool {
 // Whether a lattice point among the 4 × 4 around the block at lattice point `l` (its corners
 // and the ring beyond) is masked (`masked`) or not: where none is, the lens's edge is more
 // than a block away and, the lens's valid region being convex (a disk or ellipse, or the
-// whole image), does not cross the block.
-fn lattice_near(l: vec2<u32>, masked: bool) -> bool {
+// whole image), does not cross the block. Reads the tile of the workgroup at `origin`.
+fn lattice_near(origin: vec2<u32>, l: vec2<u32>, masked: bool) -> bool {
     let first = vec2<i32>(l) - 1;
     let last = vec2<i32>(adaptive.lattice) - 1;
     for (var y = max(first.y, 0); y <= min(first.y + 3, last.y); y++) {
         for (var x = max(first.x, 0); x <= min(first.x + 3, last.x); x++) {
-            let key = key_at(index_of(lattice_pixel(vec2<u32>(u32(x), u32(y)))));
+            let key = tile_corner[tile_index(origin, vec2<i32>(x, y))].key;
             if (key == KEY_MASKED) == masked {
                 return true;
             }
@@ -321,30 +370,29 @@ fn bend(before: vec3<f32>, a: vec3<f32>, b: vec3<f32>, after: vec3<f32>, has: ve
     return worst;
 }
 
-// `bend` along the lattice edge from lattice point `a` to its neighbour `b`.
-fn edge_bend(a: vec2<u32>, b: vec2<u32>) -> f32 {
+// `bend` along the lattice edge from lattice point `a` to its neighbour `b`, from the tile of
+// the workgroup at `origin`.
+fn edge_bend(origin: vec2<u32>, a: vec2<u32>, b: vec2<u32>) -> f32 {
     let d = vec2<i32>(b) - vec2<i32>(a);
     let before = vec2<i32>(a) - d;
     let after = vec2<i32>(b) + d;
     let last = vec2<i32>(adaptive.lattice) - 1;
-    let key_a = key_at(index_of(lattice_pixel(a)));
-    let key_b = key_at(index_of(lattice_pixel(b)));
+    let ta = tile_index(origin, vec2<i32>(a));
+    let tb = tile_index(origin, vec2<i32>(b));
     var has = vec2<bool>(false);
     var cb = vec3<f32>(0.0);
     var ca = vec3<f32>(0.0);
     if all(before >= vec2<i32>(0)) {
-        let i = index_of(lattice_pixel(vec2<u32>(before)));
-        has.x = key_at(i) == key_a;
-        cb = shown(colour_out[i].rgb);
+        let t = tile_index(origin, before);
+        has.x = tile_corner[t].key == tile_corner[ta].key;
+        cb = tile_shown[t];
     }
     if all(after <= last) {
-        let i = index_of(lattice_pixel(vec2<u32>(after)));
-        has.y = key_at(i) == key_b;
-        ca = shown(colour_out[i].rgb);
+        let t = tile_index(origin, after);
+        has.y = tile_corner[t].key == tile_corner[tb].key;
+        ca = tile_shown[t];
     }
-    let sa = shown(colour_out[index_of(lattice_pixel(a))].rgb);
-    let sb = shown(colour_out[index_of(lattice_pixel(b))].rgb);
-    return bend(cb, sa, sb, ca, has);
+    return bend(cb, tile_shown[ta], tile_shown[tb], ca, has);
 }
 
 // Whether the lens gives a ray to every pixel of the block from `first` to `end` (exclusive),
@@ -361,44 +409,48 @@ fn block_mask_is(first: vec2<u32>, end: vec2<u32>, covered: bool) -> bool {
 }
 
 @compute @workgroup_size(WORKGROUP_2D, WORKGROUP_2D)
-fn classify(@builtin(global_invocation_id) id: vec3<u32>, @builtin(local_invocation_index) local: u32) {
+fn classify(
+    @builtin(global_invocation_id) id: vec3<u32>,
+    @builtin(workgroup_id) group: vec3<u32>,
+    @builtin(local_invocation_index) local: u32,
+) {
+    let origin = group.xy * WORKGROUP_2D;
+    load_tile(origin, local);
     let inside = all(id.xy < adaptive.blocks);
     let first = id.xy * ADAPTIVE_BLOCK;
     let end = min(first + ADAPTIVE_BLOCK, size());
     let far = min(first + ADAPTIVE_BLOCK, size() - 1u);
-    let c00 = first;
-    let c10 = vec2<u32>(far.x, first.y);
-    let c01 = vec2<u32>(first.x, far.y);
-    let c11 = far;
+    // The block's corners, as lattice points: first (l), across, down, and far (l11).
+    let l = id.xy;
+    let l11 = min(l + 1u, adaptive.lattice - 1u);
+    let l10 = vec2<u32>(l11.x, l.y);
+    let l01 = vec2<u32>(l.x, l11.y);
+    let t00 = tile_index(origin, vec2<i32>(l));
+    let t10 = tile_index(origin, vec2<i32>(l10));
+    let t01 = tile_index(origin, vec2<i32>(l01));
+    let t11 = tile_index(origin, vec2<i32>(l11));
     var refine = false;
     var listed = 0u;
     if inside {
-        let keys = vec4<u32>(
-            key_at(index_of(c00)),
-            key_at(index_of(c10)),
-            key_at(index_of(c01)),
-            key_at(index_of(c11)),
-        );
-        let masked = keys == vec4<u32>(KEY_MASKED);
-        let l = id.xy;
+        let a = tile_corner[t00];
+        let b = tile_corner[t10];
+        let c = tile_corner[t01];
+        let d = tile_corner[t11];
+        let masked = vec4<u32>(a.key, b.key, c.key, d.key) == vec4<u32>(KEY_MASKED);
         if all(masked) {
-            refine = lattice_near(l, false) && !block_mask_is(first, end, false);
+            refine = lattice_near(origin, l, false) && !block_mask_is(first, end, false);
         } else if any(masked) {
             refine = true;
         } else {
-            let l11 = min(l + 1u, adaptive.lattice - 1u);
-            let l10 = vec2<u32>(l11.x, l.y);
-            let l01 = vec2<u32>(l.x, l11.y);
-            let bent = max(max(edge_bend(l, l10), edge_bend(l01, l11)), max(edge_bend(l, l01), edge_bend(l10, l11)));
+            let bent = max(
+                max(edge_bend(origin, l, l10), edge_bend(origin, l01, l11)),
+                max(edge_bend(origin, l, l01), edge_bend(origin, l10, l11)),
+            );
             refine = bent >= adaptive.threshold;
             if !refine {
-                let a = corner(c00);
-                let b = corner(c10);
-                let c = corner(c01);
-                let d = corner(c11);
                 refine = !(same_surface(a, b) && same_surface(a, c) && same_surface(b, d)
                     && same_surface(c, d) && same_surface(a, d) && same_surface(b, c))
-                    || (lattice_near(l, true) && !block_mask_is(first, end, true));
+                    || (lattice_near(origin, l, true) && !block_mask_is(first, end, true));
             }
         }
         for (var y = first.y; y < end.y; y++) {
@@ -412,7 +464,7 @@ fn classify(@builtin(global_invocation_id) id: vec3<u32>, @builtin(local_invocat
         return;
     }
     let span = vec2<f32>(max(far - first, vec2<u32>(1u)));
-    let all_masked = key_at(index_of(c00)) == KEY_MASKED;
+    let all_masked = tile_corner[t00].key == KEY_MASKED;
     for (var y = first.y; y < end.y; y++) {
         for (var x = first.x; x < end.x; x++) {
             let p = vec2<u32>(x, y);
@@ -433,8 +485,8 @@ fn classify(@builtin(global_invocation_id) id: vec3<u32>, @builtin(local_invocat
                 continue;
             }
             let f = vec2<f32>(p - first) / span;
-            let top = mix(colour_out[index_of(c00)], colour_out[index_of(c10)], f.x);
-            let bottom = mix(colour_out[index_of(c01)], colour_out[index_of(c11)], f.x);
+            let top = mix(tile_colour[t00], tile_colour[t10], f.x);
+            let bottom = mix(tile_colour[t01], tile_colour[t11], f.x);
             colour_out[i] = vec4<f32>(mix(top, bottom, f.y).rgb, 1.0);
             set_state(i, 0u, KEY_UNTRACED);
         }

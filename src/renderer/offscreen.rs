@@ -132,7 +132,7 @@ impl Setup {
                 };
                 stages_for(side, options)
                     .into_iter()
-                    .flat_map(|stage| [Pass::listing(stage), Pass::of(stage)])
+                    .flat_map(|stage| Pass::listing(stage).into_iter().chain([Pass::of(stage)]))
                     .collect()
             }
         };
@@ -199,9 +199,6 @@ pub enum Pass {
     Supersample,
     /// Adaptive sampling's first hits of interpolated pixels, for the ground truth.
     Truth,
-    /// Listing the block corners (bookkeeping before [`Pass::Coarse`]).
-    #[serde(rename = "coarse-list")]
-    CoarseList,
     /// Classifying blocks, listing the pixels of those to refine and interpolating the others
     /// (before [`Pass::Refine`]).
     #[serde(rename = "refine-list")]
@@ -232,14 +229,14 @@ impl Pass {
     }
 
     /// The pass that times an adaptive stage's listing of its pixels, the bookkeeping before
-    /// its rays.
-    pub fn listing(stage: Stage) -> Pass {
+    /// its rays; none for the coarse stage, which traces the block corners with no list.
+    pub fn listing(stage: Stage) -> Option<Pass> {
         match stage {
-            Stage::Coarse => Pass::CoarseList,
-            Stage::Refine => Pass::RefineList,
-            Stage::Estimate => Pass::EstimateList,
-            Stage::Supersample => Pass::SupersampleList,
-            Stage::Truth => Pass::TruthList,
+            Stage::Coarse => None,
+            Stage::Refine => Some(Pass::RefineList),
+            Stage::Estimate => Some(Pass::EstimateList),
+            Stage::Supersample => Some(Pass::SupersampleList),
+            Stage::Truth => Some(Pass::TruthList),
         }
     }
 
@@ -255,7 +252,6 @@ impl Pass {
             Pass::Estimate => "estimate",
             Pass::Supersample => "supersample",
             Pass::Truth => "truth",
-            Pass::CoarseList => "coarse list",
             Pass::RefineList => "refine list",
             Pass::EstimateList => "estimate list",
             Pass::SupersampleList => "supersample list",
@@ -463,7 +459,7 @@ impl Offscreen {
                 trace: writes(Pass::Trace),
                 filter: writes(Pass::Filter),
                 adaptive: AdaptiveSpans {
-                    lists: ALL_STAGES.map(|stage| writes(Pass::listing(stage))),
+                    lists: ALL_STAGES.map(|stage| Pass::listing(stage).and_then(writes)),
                     stages: ALL_STAGES.map(|stage| writes(Pass::of(stage))),
                 },
                 cube: CubeSpans {
@@ -490,7 +486,9 @@ impl Offscreen {
             Path::Adaptive(pass) => Some(
                 pass.read_stage_rays(ctx)?
                     .into_iter()
-                    .flat_map(|(_, rays)| [0, rays])
+                    .flat_map(|(stage, rays)| {
+                        Pass::listing(stage).map(|_| 0).into_iter().chain([rays])
+                    })
                     .collect(),
             ),
             Path::Cube(_) => None,

@@ -77,17 +77,25 @@ fn samples_at(stage: Stage, samples_per_side: u32) -> u32 {
     }
 }
 
+/// Where the stages that trace a list (all but [`Stage::Coarse`]) keep their kernels in
+/// [`AdaptivePass`]'s arrays: in [`ALL_STAGES`] order from 0.
+fn listed_at(stage: Stage) -> usize {
+    debug_assert!(stage != Stage::Coarse, "the coarse stage traces no list");
+    stage as usize - 1
+}
+
 /// How many invocations of `trace_samples` (wgsl/adaptive.wgsl) trace each pixel listed at
 /// `stage` side by side: one for each of its samples, at most a workgroup's.
 fn sample_lanes(stage: Stage, samples_per_side: u32) -> u32 {
     samples_at(stage, samples_per_side).min(WORKGROUP_1D)
 }
 
-/// Timestamp writes for the stages of one frame, each in two compute passes: the listing of
-/// its pixels (the bookkeeping), then the tracing of the list; `None` leaves a pass untimed.
+/// Timestamp writes for the stages of one frame, each but the first in two compute passes:
+/// the listing of its pixels (the bookkeeping), then the tracing of the list; the coarse
+/// stage traces the lattice in one pass, with no list. `None` leaves a pass untimed.
 #[derive(Default)]
 pub struct AdaptiveSpans<'a> {
-    /// The listing pass of each [`Stage`], in order.
+    /// The listing pass of each [`Stage`], in order (the coarse stage's is never written).
     pub lists: [Option<wgpu::ComputePassTimestampWrites<'a>>; 5],
     /// The tracing pass of each [`Stage`], in order.
     pub stages: [Option<wgpu::ComputePassTimestampWrites<'a>>; 5],
@@ -100,22 +108,25 @@ pub struct AdaptiveSpans<'a> {
 pub struct AdaptivePass {
     trace: TracePass,
     options: Adaptive,
-    /// The kernels that list each stage's pixels: lattice, classify, select_pixels, more,
+    /// The coarse stage's kernel, `trace_lattice`: a ray through each lattice point.
+    lattice: wgpu::ComputePipeline,
+    /// The kernels that list the later stages' pixels: classify, select_pixels, more,
     /// untraced.
-    builders: [wgpu::ComputePipeline; 5],
-    /// The tracing kernel of each [`Stage`]: `trace_list` (coarse and refine share one) or
-    /// `trace_samples`.
-    trace_lists: [wgpu::ComputePipeline; 5],
-    /// The kernels that size each [`Stage`]'s tracing dispatch over its whole list, then
-    /// supersampling's over the next slice of it (progressive refinement,
+    builders: [wgpu::ComputePipeline; 4],
+    /// The tracing kernel of each listed [`Stage`] (all but the coarse, in order, see
+    /// [`listed_at`]): `trace_list` or `trace_samples`.
+    trace_lists: [wgpu::ComputePipeline; 4],
+    /// The kernels that size each listed [`Stage`]'s tracing dispatch over its whole list,
+    /// then supersampling's over the next slice of it (progressive refinement,
     /// [`AdaptivePass::encode_step`]).
-    args: [wgpu::ComputePipeline; 6],
+    args: [wgpu::ComputePipeline; 5],
     group: wgpu::BindGroup,
     args_group: wgpu::BindGroup,
     work: wgpu::Buffer,
     dispatch: wgpu::Buffer,
     /// The length of each stage's list in the last frame, in [`ALL_STAGES`] order (0 for a
-    /// stage not run), copied from the work buffer's header after each stage.
+    /// stage not run, and for the coarse stage, which has none), copied from the work
+    /// buffer's header after each listed stage.
     listed: wgpu::Buffer,
     params: AdaptiveParams,
 }
@@ -238,13 +249,12 @@ impl AdaptivePass {
                 let composed = (&scene.arrays, source.swaps());
                 shader::scene_pipeline(device, file, composed, entry, &constants, &layouts)
             };
-            let builders = ["lattice", "classify", "select_pixels", "more", "untraced"]
-                .map(|e| kernel(e, 0, 1));
+            let builders =
+                ["classify", "select_pixels", "more", "untraced"].map(|e| kernel(e, 0, 1));
             // The modes of wgsl/adaptive.wgsl: centres, samples, first hits, estimates.
-            let centres = kernel("trace_list", 0, 1);
+            let lattice = kernel("trace_lattice", 0, 1);
             let trace_lists = [
-                centres.clone(),
-                centres,
+                kernel("trace_list", 0, 1),
                 kernel("trace_samples", 3, sample_lanes(Stage::Estimate, side)),
                 kernel("trace_samples", 1, sample_lanes(Stage::Supersample, side)),
                 kernel("trace_list", 2, 1),
@@ -268,9 +278,8 @@ impl AdaptivePass {
                 )
             };
             // The stages that trace centres share one: a pixel a lane.
-            let centres = args_kernel(0, Stage::Coarse);
+            let centres = args_kernel(0, Stage::Refine);
             let args = [
-                centres.clone(),
                 centres.clone(),
                 args_kernel(0, Stage::Estimate),
                 args_kernel(0, Stage::Supersample),
@@ -286,6 +295,7 @@ impl AdaptivePass {
             Self {
                 trace,
                 options,
+                lattice,
                 builders,
                 trace_lists,
                 args,
@@ -339,8 +349,9 @@ impl AdaptivePass {
         stages_for(self.trace.samples_per_side(), self.options)
     }
 
-    /// Records one frame: each stage a compute pass (a kernel lists pixels, a one-invocation
-    /// kernel sizes the dispatch, and `trace_list` traces them), timed by `spans`.
+    /// Records one frame, timed by `spans`: the coarse stage one compute pass
+    /// (`trace_lattice`), each later stage two (a kernel lists pixels; then a one-invocation
+    /// kernel sizes the dispatch, and `trace_list` or `trace_samples` traces them).
     pub fn encode(
         &self,
         encoder: &mut wgpu::CommandEncoder,
@@ -351,10 +362,32 @@ impl AdaptivePass {
         encoder.clear_buffer(&self.listed, 0, None);
         let writes = spans.lists.into_iter().zip(spans.stages);
         for (stage, (list, trace)) in ALL_STAGES.into_iter().zip(writes) {
-            if stages.contains(&stage) {
+            if stage == Stage::Coarse {
+                self.encode_coarse(encoder, scene, trace);
+            } else if stages.contains(&stage) {
                 self.encode_stage(encoder, scene, stage, list, Some(trace));
             }
         }
+    }
+
+    /// Records the coarse stage, a compute pass timed by `writes`: a ray through each
+    /// lattice point, an invocation each (no list: the lattice is known).
+    fn encode_coarse(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        scene: &GpuScene,
+        writes: Option<wgpu::ComputePassTimestampWrites<'_>>,
+    ) {
+        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+            label: Some("fisheye.adaptive.coarse"),
+            timestamp_writes: writes,
+        });
+        pass.set_pipeline(&self.lattice);
+        for (index, group) in self.groups(scene).into_iter().enumerate() {
+            pass.set_bind_group(index as u32, group, &[]);
+        }
+        let [w, h] = self.params.lattice;
+        pass.dispatch_workgroups(w.div_ceil(WORKGROUP_2D), h.div_ceil(WORKGROUP_2D), 1);
     }
 
     /// Records step `step` of a progressive frame, which shows a picture at once and sharpens
@@ -374,7 +407,8 @@ impl AdaptivePass {
         match step {
             0 => {
                 encoder.clear_buffer(&self.listed, 0, None);
-                for stage in [Stage::Coarse, Stage::Refine, Stage::Truth] {
+                self.encode_coarse(encoder, scene, None);
+                for stage in [Stage::Refine, Stage::Truth] {
                     if stages.contains(&stage) {
                         self.encode_stage(encoder, scene, stage, None, Some(None));
                     }
@@ -397,9 +431,9 @@ impl AdaptivePass {
         }
     }
 
-    /// Records `stage`: its list made afresh in a compute pass timed by `list`, then, where
-    /// `trace` is given, traced whole in a second pass timed by it (else listed only, for
-    /// progressive steps to trace part by part).
+    /// Records `stage` (any but the coarse): its list made afresh in a compute pass timed by
+    /// `list`, then, where `trace` is given, traced whole in a second pass timed by it (else
+    /// listed only, for progressive steps to trace part by part).
     fn encode_stage(
         &self,
         encoder: &mut wgpu::CommandEncoder,
@@ -410,18 +444,17 @@ impl AdaptivePass {
     ) {
         let size = self.trace.size();
         // The lister of each stage, by its index in `builders`: supersampling lists the
-        // pixels the estimate marked where there is an estimating stage.
+        // pixels the estimate marked where there is an estimating stage (the coarse stage
+        // lists nothing and never comes here: `encode_coarse`).
         let lister = match stage {
-            Stage::Coarse => 0,
-            Stage::Refine => 1,
-            Stage::Estimate => 2,
-            Stage::Supersample if self.stages().contains(&Stage::Estimate) => 3,
-            Stage::Supersample => 2,
-            Stage::Truth => 4,
+            Stage::Coarse | Stage::Refine => 0,
+            Stage::Estimate => 1,
+            Stage::Supersample if self.stages().contains(&Stage::Estimate) => 2,
+            Stage::Supersample => 1,
+            Stage::Truth => 3,
         };
         let [w, h] = match stage {
-            Stage::Coarse => self.params.lattice,
-            Stage::Refine => self.params.blocks,
+            Stage::Coarse | Stage::Refine => self.params.blocks,
             _ => [size.width, size.height],
         };
         encoder.clear_buffer(&self.work, 0, Some(4 * u64::from(ADAPTIVE_HEADER)));
@@ -457,14 +490,14 @@ impl AdaptivePass {
         sliced: bool,
     ) {
         let args = if sliced {
-            ALL_STAGES.len()
+            self.args.len() - 1
         } else {
-            stage as usize
+            listed_at(stage)
         };
         pass.set_pipeline(&self.args[args]);
         pass.set_bind_group(0, &self.args_group, &[]);
         pass.dispatch_workgroups(1, 1, 1);
-        pass.set_pipeline(&self.trace_lists[stage as usize]);
+        pass.set_pipeline(&self.trace_lists[listed_at(stage)]);
         for (index, group) in self.groups(scene).into_iter().enumerate() {
             pass.set_bind_group(index as u32, group, &[]);
         }
@@ -481,10 +514,10 @@ impl AdaptivePass {
     }
 
     /// The rays each stage of the last frame traced, in [`AdaptivePass::stages`] order: the
-    /// pixels it listed times the samples each takes there (1 at the coarse, refining and
-    /// ground truth's stages, where the last traces first hits alone; 2 × 2 estimating; all
-    /// of them supersampling), counting samples the lens masks (which cost a lens evaluation,
-    /// not a ray) as rays. After progressive steps, supersampling's are the pixels listed,
+    /// lattice points at the coarse stage, then the pixels each stage listed times the
+    /// samples each takes there (1 at the refining and ground truth's stages, where the last
+    /// traces first hits alone; 2 × 2 estimating; all of them supersampling), counting
+    /// samples the lens masks (which cost a lens evaluation, not a ray) as rays. After progressive steps, supersampling's are the pixels listed,
     /// whether or not their slices are traced yet.
     pub fn read_stage_rays(&self, ctx: &GpuContext) -> Result<Vec<(Stage, u64)>> {
         let listed: Vec<u32> = ctx.read_buffer(&self.listed)?;
@@ -493,10 +526,14 @@ impl AdaptivePass {
             .stages()
             .into_iter()
             .map(|stage| {
-                let samples = samples_at(stage, side);
+                let [w, h] = self.params.lattice;
+                let pixels = match stage {
+                    Stage::Coarse => w * h,
+                    _ => listed[stage as usize],
+                };
                 (
                     stage,
-                    u64::from(listed[stage as usize]) * u64::from(samples),
+                    u64::from(pixels) * u64::from(samples_at(stage, side)),
                 )
             })
             .collect())
