@@ -378,15 +378,30 @@ impl AdaptivePass {
         scene: &GpuScene,
         writes: Option<wgpu::ComputePassTimestampWrites<'_>>,
     ) {
+        let label = "fisheye.adaptive.coarse";
+        let size = self.params.lattice;
+        self.dispatch_2d(encoder, scene, label, &self.lattice, size, writes);
+    }
+
+    /// Records a compute pass timed by `writes` that runs `kernel` with the adaptive bind
+    /// groups, an invocation for each of `size`'s points in 2D workgroups.
+    fn dispatch_2d(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        scene: &GpuScene,
+        label: &str,
+        kernel: &wgpu::ComputePipeline,
+        [w, h]: [u32; 2],
+        writes: Option<wgpu::ComputePassTimestampWrites<'_>>,
+    ) {
         let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
-            label: Some("fisheye.adaptive.coarse"),
+            label: Some(label),
             timestamp_writes: writes,
         });
-        pass.set_pipeline(&self.lattice);
+        pass.set_pipeline(kernel);
         for (index, group) in self.groups(scene).into_iter().enumerate() {
             pass.set_bind_group(index as u32, group, &[]);
         }
-        let [w, h] = self.params.lattice;
         pass.dispatch_workgroups(w.div_ceil(WORKGROUP_2D), h.div_ceil(WORKGROUP_2D), 1);
     }
 
@@ -453,22 +468,20 @@ impl AdaptivePass {
             Stage::Supersample => 1,
             Stage::Truth => 3,
         };
-        let [w, h] = match stage {
+        let points = match stage {
             Stage::Coarse | Stage::Refine => self.params.blocks,
             _ => [size.width, size.height],
         };
         encoder.clear_buffer(&self.work, 0, Some(4 * u64::from(ADAPTIVE_HEADER)));
-        {
-            let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
-                label: Some("fisheye.adaptive.list"),
-                timestamp_writes: list,
-            });
-            pass.set_pipeline(&self.builders[lister]);
-            for (index, group) in self.groups(scene).into_iter().enumerate() {
-                pass.set_bind_group(index as u32, group, &[]);
-            }
-            pass.dispatch_workgroups(w.div_ceil(WORKGROUP_2D), h.div_ceil(WORKGROUP_2D), 1);
-        }
+        let lister = &self.builders[lister];
+        self.dispatch_2d(
+            encoder,
+            scene,
+            "fisheye.adaptive.list",
+            lister,
+            points,
+            list,
+        );
         if let Some(writes) = trace {
             let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
                 label: Some("fisheye.adaptive.trace"),
