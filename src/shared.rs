@@ -461,7 +461,7 @@ pub struct Knot {
     pub position: [f32; 4],
 }
 
-/// Adaptive sampling's settings as `wgsl/adaptive.wgsl` reads them (32 bytes).
+/// Adaptive sampling's settings as `wgsl/adaptive.wgsl` reads them (48 bytes).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, PartialEq, Pod, Zeroable)]
 pub struct AdaptiveParams {
@@ -477,6 +477,10 @@ pub struct AdaptiveParams {
     pub lattice: [u32; 2],
     /// Blocks across and down.
     pub blocks: [u32; 2],
+    /// The half-blocks' corners across and down.
+    pub half_lattice: [u32; 2],
+    /// Half-blocks across and down.
+    pub halves: [u32; 2],
 }
 
 /// One triangle as `wgsl/bvh.wgsl` reads it: 48 bytes, three `vec4<f32>` whose `w` carry the

@@ -96,14 +96,16 @@ fn threshold_zero_at(gpu: &GpuScene, cam: &LensCamera, spp: u32) {
         .flat_map(|y| (0..w).map(move |x| (x, y)))
         .filter(|&(x, y)| !on_lattice(x, y) && centres.valid((y * w + x) as usize))
         .count() as u64;
-    let [coarse, refine, supersample, truth] = stages[..] else {
+    let [coarse, midpoints, refine, supersample, truth] = stages[..] else {
         panic!("{stages:?}")
     };
     assert_eq!(coarse, (Stage::Coarse, lattice));
-    assert_eq!(refine.0, Stage::Refine);
+    assert_eq!((midpoints.0, refine.0), (Stage::Midpoints, Stage::Refine));
+    // The midpoints and the half-blocks' other pixels, each listed once.
+    let listed = midpoints.1 + refine.1;
     assert!(
-        (covered_off_lattice..=pixels - lattice).contains(&refine.1),
-        "{refine:?}: {covered_off_lattice} covered"
+        (covered_off_lattice..=pixels - lattice).contains(&listed),
+        "{midpoints:?} {refine:?}: {covered_off_lattice} covered"
     );
     assert_eq!(supersample, (Stage::Supersample, u64::from(spp) * pixels));
     assert_eq!(truth, (Stage::Truth, 0));
@@ -192,7 +194,13 @@ fn a_smooth_scene_is_traced_at_block_corners_only() {
     let lattice = |n: u32| (n - 1).div_ceil(ADAPTIVE_BLOCK) + 1;
     let corners = (lattice(w) * lattice(h)) as usize;
     let c = corners as u64;
-    let none = [Stage::Refine, Stage::Estimate, Stage::Supersample].map(|s| (s, 0));
+    let none = [
+        Stage::Midpoints,
+        Stage::Refine,
+        Stage::Estimate,
+        Stage::Supersample,
+    ]
+    .map(|s| (s, 0));
     assert_eq!(stages, [[(Stage::Coarse, c)].as_slice(), &none].concat());
     assert_eq!(
         rays.iter().filter(|&&n| n == 1).count(),
@@ -217,6 +225,84 @@ fn a_smooth_scene_is_traced_at_block_corners_only() {
     assert!(
         worst > 0.0,
         "pixels between corners were interpolated, not traced"
+    );
+}
+
+/// A plane's straight far edge against the sky: the blocks it crosses (their corners
+/// disagree) get their midpoints traced, and within them only the half-blocks it crosses get
+/// a ray in every pixel; the half-blocks beside it, on the plane or in the sky, are
+/// interpolated (a straight edge that crosses a square separates its corners, so every
+/// half-block it crosses is in a refined block). Judged from uniform sampling's hits.
+#[test]
+fn only_the_half_blocks_an_edge_crosses_are_traced() {
+    let dir = std::env::temp_dir().join(format!("fisheye-halves-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    std::fs::write(
+        dir.join("plane.obj"),
+        "v -1000 -1000 0\nv 1000 -1000 0\nv 1000 20 0\nv -1000 20 0\nf 1 2 3\nf 1 3 4\n",
+    )
+    .unwrap();
+    std::fs::write(
+        dir.join("plane.toml"),
+        "ambient = [0.0, 0.0, 0.0]\nsky = [0.0, 0.0, 0.0]\n[camera]\nposition = [0.0, -19.0, 1.5]\n\
+         look_at = [6.0, 0.0, 1.0]\n[[mesh]]\npath = \"plane.obj\"\n[[light]]\ntype = \"point\"\n\
+         position = [10.0, 6.0, 400.0]\nintensity = [90000.0, 90000.0, 90000.0]\n",
+    )
+    .unwrap();
+    let plane = fisheye_rt::scene::load(dir.join("plane.toml").to_str().unwrap())
+        .unwrap()
+        .scene;
+    std::fs::remove_dir_all(&dir).unwrap();
+    let gpu = upload(&plane);
+    let (w, h) = (65u32, 49u32);
+    let cam = camera("rectilinear:f=1", w, h);
+    let one = uniform(&gpu, &cam, 1);
+    let (_, rays) = adaptive(&gpu, &cam, 1, 0.02, false);
+    let hit = |x: u32, y: u32| one.ids[(y * w + x) as usize] != NO_HIT;
+    let half = ADAPTIVE_BLOCK / 2;
+    let on = |v: u32, n: u32, step: u32| v.is_multiple_of(step) || v == n - 1;
+    let (mut crossed, mut beside) = (0, 0);
+    for y in 0..h {
+        for x in 0..w {
+            if on(x, w, half) && on(y, h, half) {
+                continue;
+            }
+            // The half-block whose half-open square holds the pixel, and its corners.
+            let (x0, y0) = (x / half * half, y / half * half);
+            let (x1, y1) = ((x0 + half).min(w - 1), (y0 + half).min(h - 1));
+            let corners = [hit(x0, y0), hit(x1, y0), hit(x0, y1), hit(x1, y1)];
+            let disagree = corners.contains(&true) && corners.contains(&false);
+            let n = rays[(y * w + x) as usize];
+            assert_eq!(
+                n,
+                u32::from(disagree),
+                "pixel ({x}, {y}), corners {corners:?}"
+            );
+            if disagree {
+                crossed += 1;
+            } else if !(on(x, w, ADAPTIVE_BLOCK) && on(y, h, ADAPTIVE_BLOCK)) {
+                beside += 1;
+            }
+        }
+    }
+    assert!(
+        crossed > 30 && beside > 1000,
+        "{crossed} crossed, {beside} beside"
+    );
+    // Some interpolated pixels lie in blocks the edge crosses (traced whole before).
+    let in_crossed_blocks = (0..h)
+        .flat_map(|y| (0..w).map(move |x| (x, y)))
+        .filter(|&(x, y)| {
+            let b = ADAPTIVE_BLOCK;
+            let (x0, y0) = (x / b * b, y / b * b);
+            let (x1, y1) = ((x0 + b).min(w - 1), (y0 + b).min(h - 1));
+            let c = [hit(x0, y0), hit(x1, y0), hit(x0, y1), hit(x1, y1)];
+            c.contains(&true) && c.contains(&false) && rays[(y * w + x) as usize] == 0
+        })
+        .count();
+    assert!(
+        in_crossed_blocks > 20,
+        "{in_crossed_blocks} interpolated in crossed blocks"
     );
 }
 

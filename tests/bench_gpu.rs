@@ -78,6 +78,8 @@ fn adaptive_frames_time_listing_and_tracing_apart_and_count_their_rays() {
     let renderer = Offscreen::new(ctx(), &cam, &scenes, setup, 256).unwrap();
     let passes = [
         Pass::Coarse,
+        Pass::MidpointList,
+        Pass::Midpoints,
         Pass::RefineList,
         Pass::Refine,
         Pass::SupersampleList,

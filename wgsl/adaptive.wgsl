@@ -1,6 +1,7 @@
 // Adaptive sampling: rays where the picture needs them, every pass on the GPU. The image is
 // covered by blocks of ADAPTIVE_BLOCK × ADAPTIVE_BLOCK pixels whose corners form a lattice of
-// pixel centres (the last row and column of the image are lattice points too):
+// pixel centres (the last row and column of the image are lattice points too), each block by
+// four half-blocks, whose corners form a lattice twice as fine:
 //
 // 1. `trace_lattice` traces one shaded ray through each lattice pixel's centre (a first pass
 //    below one ray per pixel: 1/ADAPTIVE_BLOCK² of them), an invocation a lattice point, with
@@ -10,8 +11,14 @@
 //    displayed colour along each edge that bends by less than the threshold, see `bend`) and
 //    the lens covers every pixel, the block's other pixels are interpolated bilinearly between
 //    the corners in linear radiance, so no interpolation crosses a change of surface or a depth
-//    step. Other blocks list their pixels and `trace_list` traces each one's centre;
-// 3. `select_pixels` lists the pixels traced whose displayed colour bends across them (the
+//    step. `midpoints` lists the half-blocks' corners in the other blocks, the midpoints of
+//    their edges and their centres, and `trace_list` traces them;
+// 3. `classify` at level 1 does the same for the half-blocks of those blocks, and the pixels
+//    of the half-blocks whose corners disagree are listed and traced: rays subdivide where the
+//    image changes, as Painter and Sloan (1989) and Thomas, Netravali and Fox (1989) refined a
+//    coarse sampling level by level, so an edge takes a band of rays half a block wide, and a
+//    block whose colour bends only at its own scale is interpolated from its half-blocks;
+// 4. `select_pixels` lists the pixels traced whose displayed colour bends across them (the
 //    second difference with their neighbours, along either axis) by the threshold or more,
 //    and those on the lens's edge: a one-ray pixel is its box filter's value where colour
 //    changes linearly across it, and the bend estimates how far off it is (Mitchell 1987 drove
@@ -21,13 +28,14 @@
 //    (Dammertz et al. 2010's error estimate); `more` lists those. The last list's pixels take
 //    the SAMPLES_PER_SIDE² jittered stratified samples that uniform supersampling takes, in
 //    its order (`trace_samples` again);
-// 4. with ground truth asked for, `untraced` lists the interpolated pixels and `trace_list`
+// 5. with ground truth asked for, `untraced` lists the interpolated pixels and `trace_list`
 //    traces their centres' first hits, so ids, normals and ranges are never interpolated.
 //
 // The later stages' lists are compacted by one atomic per workgroup; `adaptive_args.wgsl`
 // turns a list's length into the indirect dispatch of `trace_list` or `trace_samples`; nothing
-// is read back between passes. A pixel's result depends on its own samples and its neighbours' alone, so the order
-// in which lists fill does not change the image: reruns are bit-identical.
+// is read back between passes. A pixel's result depends on its own samples and its
+// neighbours' alone, so the order in which lists fill does not change the image: reruns are
+// bit-identical.
 #import pixel
 #import colour
 
@@ -42,16 +50,21 @@ struct AdaptiveParams {
     // the larger range.
     plane_distance: f32,
     _pad0: u32,
-    // Lattice points across and down.
+    // Lattice points across and down: the blocks' corners.
     lattice: vec2<u32>,
     // Blocks across and down.
     blocks: vec2<u32>,
+    // The half-blocks' corners across and down (a lattice twice as fine).
+    half_lattice: vec2<u32>,
+    // Half-blocks across and down.
+    halves: vec2<u32>,
 }
 
 // The list's length (ADAPTIVE_COUNT) and the part of it to trace (ADAPTIVE_FIRST to
 // ADAPTIVE_END, set by `adaptive_args.wgsl`), then the list of pixel indices from
-// ADAPTIVE_HEADER on (room for every pixel), then each pixel's state (`state_slot`). One
-// buffer, so that the kernels bind as few storage buffers as WebGPU's default allows.
+// ADAPTIVE_HEADER on (room for every pixel), then each pixel's state (`state_slot`), then each
+// block's decision (`block_slot`). One buffer, so that the kernels bind as few storage
+// buffers as WebGPU's default allows.
 @group(0) @binding(7) var<storage, read_write> work: array<atomic<u32>>;
 @group(0) @binding(8) var<uniform> adaptive: AdaptiveParams;
 
@@ -64,6 +77,10 @@ const MODE_SAMPLES: u32 = 1u;
 const MODE_TRUTH: u32 = 2u;
 const MODE_ESTIMATE: u32 = 3u;
 override LIST_MODE: u32 = MODE_CENTRE;
+// The level `classify` decides at: 0, the blocks (ADAPTIVE_BLOCK pixels a side, whose corners
+// the coarse stage traced); 1, the half-blocks of the blocks refined at level 0 (whose corners
+// the midpoint stage added). The lattice kernels read it too (level 0: the blocks' corners).
+override LEVEL: u32 = 0u;
 // What a pixel's centre saw: not traced (interpolated), masked by the lens, nothing (sky);
 // else the material and instance hit (`surface_key`).
 const KEY_UNTRACED: u32 = 0xffffffffu;
@@ -74,6 +91,8 @@ const KEY_MORE: u32 = 0xfffffffcu;
 
 var<workgroup> group_count: atomic<u32>;
 var<workgroup> group_base: u32;
+var<workgroup> group_any: atomic<u32>;
+var<workgroup> group_found: u32;
 
 fn size() -> vec2<u32> {
     return vec2<u32>(lens.width, lens.height);
@@ -87,6 +106,25 @@ fn index_of(p: vec2<u32>) -> u32 {
 // its centre ray saw (KEY_*).
 fn state_slot(index: u32) -> u32 {
     return ADAPTIVE_HEADER + lens.width * lens.height + 2u * index;
+}
+
+// Where block `b`'s decision is kept in `work`: BLOCK_INTERPOLATED, or where its corners
+// disagreed (its half-blocks are decided at level 1) BLOCK_COVERED when no lattice point near
+// it is masked (the lens covers all of it, see `lattice_near`), else BLOCK_NEAR_EDGE.
+fn block_slot(b: vec2<u32>) -> u32 {
+    return ADAPTIVE_HEADER + 3u * lens.width * lens.height + b.y * adaptive.blocks.x + b.x;
+}
+
+const BLOCK_INTERPOLATED: u32 = 0u;
+const BLOCK_COVERED: u32 = 1u;
+const BLOCK_NEAR_EDGE: u32 = 2u;
+
+fn block_at(b: vec2<u32>) -> u32 {
+    return atomicLoad(&work[block_slot(b)]);
+}
+
+fn refined_at(b: vec2<u32>) -> bool {
+    return block_at(b) != BLOCK_INTERPOLATED;
 }
 
 fn key_at(index: u32) -> u32 {
@@ -127,6 +165,19 @@ fn reserve(n: u32, local: u32) -> u32 {
     return ADAPTIVE_HEADER + workgroupUniformLoad(&group_base) + mine;
 }
 
+// Whether `pick` holds for any invocation of the workgroup, as a value uniform across it (every
+// invocation must call it, in uniform control flow: it has barriers).
+fn any_in_group(pick: bool, local: u32) -> bool {
+    if pick {
+        atomicStore(&group_any, 1u);
+    }
+    workgroupBarrier();
+    if local == 0u {
+        group_found = atomicLoad(&group_any);
+    }
+    return workgroupUniformLoad(&group_found) == 1u;
+}
+
 // Lists pixel `index` where `pick` holds (`reserve`'s rules: every invocation calls it).
 fn list_if(pick: bool, index: u32, local: u32) {
     let slot = reserve(select(0u, 1u, pick), local);
@@ -135,14 +186,25 @@ fn list_if(pick: bool, index: u32, local: u32) {
     }
 }
 
-// The pixel at lattice point `i`.
+// The side of LEVEL's blocks, in pixels: the spacing of their lattice.
+fn spacing() -> u32 {
+    return ADAPTIVE_BLOCK >> LEVEL;
+}
+
+// LEVEL's lattice points across and down.
+fn level_lattice() -> vec2<u32> {
+    return select(adaptive.lattice, adaptive.half_lattice, LEVEL == 1u);
+}
+
+// The pixel at LEVEL's lattice point `i`.
 fn lattice_pixel(i: vec2<u32>) -> vec2<u32> {
-    return min(i * ADAPTIVE_BLOCK, size() - 1u);
+    return min(i * spacing(), size() - 1u);
 }
 
 fn is_lattice(p: vec2<u32>) -> bool {
     let last = size() - 1u;
-    return (p.x % ADAPTIVE_BLOCK == 0u || p.x == last.x) && (p.y % ADAPTIVE_BLOCK == 0u || p.y == last.y);
+    let s = spacing();
+    return (p.x % s == 0u || p.x == last.x) && (p.y % s == 0u || p.y == last.y);
 }
 
 // Traces the centre of pixel `index` (at `pixel`) as `mode` says: shaded (MODE_CENTRE), or
@@ -288,7 +350,7 @@ fn tile_index(origin: vec2<u32>, l: vec2<i32>) -> u32 {
 // in uniform control flow: it has a barrier). Entries outside the lattice are left as they
 // are: nothing reads them.
 fn load_tile(origin: vec2<u32>, local: u32) {
-    let last = vec2<i32>(adaptive.lattice) - 1;
+    let last = vec2<i32>(level_lattice()) - 1;
     for (var t = local; t < TILE * TILE; t += WORKGROUP_2D * WORKGROUP_2D) {
         let l = vec2<i32>(origin) - 1 + vec2<i32>(i32(t % TILE), i32(t / TILE));
         if any(l < vec2<i32>(0)) || any(l > last) {
@@ -332,14 +394,15 @@ fn same_surface(a: Corner, b: Corner) -> bool {
 // Whether a lattice point among the 4 × 4 around the block at lattice point `l` (its corners
 // and the ring beyond) is masked (`masked`) or not: where none is, the lens's edge is more
 // than a block away and, the lens's valid region being convex (a disk or ellipse, or the
-// whole image), does not cross the block. Reads the tile of the workgroup at `origin`.
+// whole image), does not cross the block. A point not traced (at level 1, in a block
+// interpolated at level 0) may be either. Reads the tile of the workgroup at `origin`.
 fn lattice_near(origin: vec2<u32>, l: vec2<u32>, masked: bool) -> bool {
     let first = vec2<i32>(l) - 1;
-    let last = vec2<i32>(adaptive.lattice) - 1;
+    let last = vec2<i32>(level_lattice()) - 1;
     for (var y = max(first.y, 0); y <= min(first.y + 3, last.y); y++) {
         for (var x = max(first.x, 0); x <= min(first.x + 3, last.x); x++) {
             let key = tile_corner[tile_index(origin, vec2<i32>(x, y))].key;
-            if (key == KEY_MASKED) == masked {
+            if key == KEY_UNTRACED || (key == KEY_MASKED) == masked {
                 return true;
             }
         }
@@ -377,7 +440,7 @@ fn edge_bend(origin: vec2<u32>, a: vec2<u32>, b: vec2<u32>) -> f32 {
     let d = vec2<i32>(b) - vec2<i32>(a);
     let before = vec2<i32>(a) - d;
     let after = vec2<i32>(b) + d;
-    let last = vec2<i32>(adaptive.lattice) - 1;
+    let last = vec2<i32>(level_lattice()) - 1;
     let ta = tile_index(origin, vec2<i32>(a));
     let tb = tile_index(origin, vec2<i32>(b));
     var has = vec2<bool>(false);
@@ -409,6 +472,11 @@ fn block_mask_is(first: vec2<u32>, end: vec2<u32>, covered: bool) -> bool {
     return true;
 }
 
+// Decides LEVEL's blocks (an invocation a block): where its corners agree (see the file's
+// header) the block's other pixels are interpolated between them; else, at level 0, its
+// decision is kept for `midpoints` and its half-blocks (its pixels are left to level 1), and
+// at level 1 its other pixels are listed for `trace_list`. At level 1 only the half-blocks of
+// the blocks refined at level 0 are looked at: the others' pixels are already interpolated.
 @compute @workgroup_size(WORKGROUP_2D, WORKGROUP_2D)
 fn classify(
     @builtin(global_invocation_id) id: vec3<u32>,
@@ -416,14 +484,30 @@ fn classify(
     @builtin(local_invocation_index) local: u32,
 ) {
     let origin = group.xy * WORKGROUP_2D;
+    var inside = all(id.xy < select(adaptive.blocks, adaptive.halves, LEVEL == 1u));
+    // At level 1, whether the lens may mask part of the block (its parent's decision);
+    // at level 0 the tests find out.
+    var near_edge = LEVEL == 0u;
+    if LEVEL == 1u {
+        var parent = BLOCK_INTERPOLATED;
+        if inside {
+            parent = block_at(id.xy / 2u);
+        }
+        inside = parent != BLOCK_INTERPOLATED;
+        near_edge = parent == BLOCK_NEAR_EDGE;
+        // A workgroup none of whose blocks was refined has nothing to do: it leaves before
+        // loading its tile (most of them, where the image is smooth).
+        if !any_in_group(inside, local) {
+            return;
+        }
+    }
     load_tile(origin, local);
-    let inside = all(id.xy < adaptive.blocks);
-    let first = id.xy * ADAPTIVE_BLOCK;
-    let end = min(first + ADAPTIVE_BLOCK, size());
-    let far = min(first + ADAPTIVE_BLOCK, size() - 1u);
+    let first = id.xy * spacing();
+    let end = min(first + spacing(), size());
+    let far = min(first + spacing(), size() - 1u);
     // The block's corners, as lattice points: first (l), across, down, and far (l11).
     let l = id.xy;
-    let l11 = min(l + 1u, adaptive.lattice - 1u);
+    let l11 = min(l + 1u, level_lattice() - 1u);
     let l10 = vec2<u32>(l11.x, l.y);
     let l01 = vec2<u32>(l.x, l11.y);
     let t00 = tile_index(origin, vec2<i32>(l));
@@ -451,16 +535,28 @@ fn classify(
             if !refine {
                 refine = !(same_surface(a, b) && same_surface(a, c) && same_surface(b, d)
                     && same_surface(c, d) && same_surface(a, d) && same_surface(b, c))
-                    || (lattice_near(origin, l, true) && !block_mask_is(first, end, true));
+                    || (near_edge && lattice_near(origin, l, true)
+                        && !block_mask_is(first, end, true));
             }
         }
-        for (var y = first.y; y < end.y; y++) {
-            for (var x = first.x; x < end.x; x++) {
-                listed += select(1u, 0u, is_lattice(vec2<u32>(x, y)));
+        if LEVEL == 0u {
+            var decided = BLOCK_INTERPOLATED;
+            if refine {
+                decided = select(BLOCK_COVERED, BLOCK_NEAR_EDGE, lattice_near(origin, l, true));
+            }
+            atomicStore(&work[block_slot(l)], decided);
+        } else if refine {
+            for (var y = first.y; y < end.y; y++) {
+                for (var x = first.x; x < end.x; x++) {
+                    listed += select(1u, 0u, is_lattice(vec2<u32>(x, y)));
+                }
             }
         }
     }
-    var slot = reserve(select(0u, listed, refine), local);
+    var slot = 0u;
+    if LEVEL == 1u {
+        slot = reserve(listed, local);
+    }
     if !inside {
         return;
     }
@@ -469,7 +565,7 @@ fn classify(
     for (var y = first.y; y < end.y; y++) {
         for (var x = first.x; x < end.x; x++) {
             let p = vec2<u32>(x, y);
-            if is_lattice(p) {
+            if is_lattice(p) || (refine && LEVEL == 0u) {
                 continue;
             }
             let i = index_of(p);
@@ -490,6 +586,47 @@ fn classify(
             let bottom = mix(tile_colour[t01], tile_colour[t11], f.x);
             colour_out[i] = vec4<f32>(mix(top, bottom, f.y).rgb, 1.0);
             set_state(i, 0u, KEY_UNTRACED);
+        }
+    }
+}
+
+// Lists the midpoints that the blocks refined at level 0 need: the half-blocks' corners that
+// are not the blocks' (an invocation a block). Each pixel belongs to the one block whose
+// half-open square holds it, and that block lists it: its centre where it was refined, the
+// midpoints of its top and left edges where it or the block across that edge was, and those of
+// its bottom and right edges where no block lies beyond them (the image's last row or column)
+// and it was refined. So each midpoint is listed once, and a block interpolated at level 0
+// beside a refined one gets the traced midpoint on their shared edge.
+@compute @workgroup_size(WORKGROUP_2D, WORKGROUP_2D)
+fn midpoints(@builtin(global_invocation_id) id: vec3<u32>, @builtin(local_invocation_index) local: u32) {
+    let b = id.xy;
+    // The centre, the top, left, bottom and right midpoints, and whether each is listed.
+    var points: array<vec2<u32>, 5>;
+    var picks = array<bool, 5>();
+    if all(b < adaptive.blocks) {
+        let first = b * ADAPTIVE_BLOCK;
+        let far = min(first + ADAPTIVE_BLOCK, size() - 1u);
+        let mid = first + ADAPTIVE_BLOCK / 2u;
+        let has = mid < far;
+        let refined = refined_at(b);
+        let up = refined || (b.y > 0u && refined_at(b - vec2<u32>(0u, 1u)));
+        let left = refined || (b.x > 0u && refined_at(b - vec2<u32>(1u, 0u)));
+        // No block beyond: this block's square reaches the image's last row or column.
+        let last = (first + ADAPTIVE_BLOCK >= size()) & (far > first);
+        points = array(mid, vec2(mid.x, first.y), vec2(first.x, mid.y), vec2(mid.x, far.y),
+            vec2(far.x, mid.y));
+        picks = array(refined && all(has), has.x && up, has.y && left,
+            has.x && refined && last.y, has.y && refined && last.x);
+    }
+    var n = 0u;
+    for (var i = 0u; i < 5u; i++) {
+        n += select(0u, 1u, picks[i]);
+    }
+    var slot = reserve(n, local);
+    for (var i = 0u; i < 5u; i++) {
+        if picks[i] {
+            atomicStore(&work[slot], index_of(points[i]));
+            slot++;
         }
     }
 }

@@ -189,8 +189,9 @@ pub enum Pass {
     Sampler,
     /// Adaptive sampling's first rays, one per block corner.
     Coarse,
-    /// Adaptive sampling's rays through the pixels of blocks whose corners disagree, and the
-    /// interpolation of the others.
+    /// Adaptive sampling's rays through the midpoints of blocks whose corners disagree.
+    Midpoints,
+    /// Adaptive sampling's rays through the pixels of half-blocks whose corners disagree.
     Refine,
     /// Adaptive sampling's 2 × 2 samples of pixels whose colour differs from a neighbour's,
     /// and the error estimate that picks those which take every sample.
@@ -199,8 +200,12 @@ pub enum Pass {
     Supersample,
     /// Adaptive sampling's first hits of interpolated pixels, for the ground truth.
     Truth,
-    /// Classifying blocks, listing the pixels of those to refine and interpolating the others
-    /// (before [`Pass::Refine`]).
+    /// Classifying blocks, interpolating those whose corners agree and listing the others'
+    /// midpoints (before [`Pass::Midpoints`]).
+    #[serde(rename = "midpoint-list")]
+    MidpointList,
+    /// Classifying the refined blocks' half-blocks, listing the pixels of those to refine
+    /// and interpolating the others (before [`Pass::Refine`]).
     #[serde(rename = "refine-list")]
     RefineList,
     /// Listing the pixels whose colour bends (before [`Pass::Estimate`]).
@@ -221,6 +226,7 @@ impl Pass {
     pub fn of(stage: Stage) -> Pass {
         match stage {
             Stage::Coarse => Pass::Coarse,
+            Stage::Midpoints => Pass::Midpoints,
             Stage::Refine => Pass::Refine,
             Stage::Estimate => Pass::Estimate,
             Stage::Supersample => Pass::Supersample,
@@ -233,6 +239,7 @@ impl Pass {
     pub fn listing(stage: Stage) -> Option<Pass> {
         match stage {
             Stage::Coarse => None,
+            Stage::Midpoints => Some(Pass::MidpointList),
             Stage::Refine => Some(Pass::RefineList),
             Stage::Estimate => Some(Pass::EstimateList),
             Stage::Supersample => Some(Pass::SupersampleList),
@@ -248,10 +255,12 @@ impl Pass {
             Pass::Lighting => "lighting",
             Pass::Sampler => "sampler",
             Pass::Coarse => "coarse",
+            Pass::Midpoints => "midpoints",
             Pass::Refine => "refine",
             Pass::Estimate => "estimate",
             Pass::Supersample => "supersample",
             Pass::Truth => "truth",
+            Pass::MidpointList => "midpoint list",
             Pass::RefineList => "refine list",
             Pass::EstimateList => "estimate list",
             Pass::SupersampleList => "supersample list",

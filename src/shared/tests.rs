@@ -119,7 +119,7 @@ fn gpu_structs_match_their_wgsl_twins() {
 /// `AdaptiveParams` in Rust and WGSL have the same size and field offsets.
 #[test]
 fn adaptive_params_layout_matches_wgsl() {
-    assert_eq!(size_of::<AdaptiveParams>(), 32);
+    assert_eq!(size_of::<AdaptiveParams>(), 48);
     assert_wgsl_layout(
         "adaptive",
         "AdaptiveParams",
@@ -131,6 +131,8 @@ fn adaptive_params_layout_matches_wgsl() {
             ("_pad0", offset_of!(AdaptiveParams, _pad0)),
             ("lattice", offset_of!(AdaptiveParams, lattice)),
             ("blocks", offset_of!(AdaptiveParams, blocks)),
+            ("half_lattice", offset_of!(AdaptiveParams, half_lattice)),
+            ("halves", offset_of!(AdaptiveParams, halves)),
         ],
     );
 }

@@ -1,6 +1,7 @@
 //! Adaptive sampling ([`AdaptivePass`]): a first pass of one ray per
-//! [`ADAPTIVE_BLOCK`]² pixels, then rays only where neighbouring samples disagree, up to the
-//! uniform supersampling of [`super::sampling`] where colours still differ; every pass on the
+//! [`ADAPTIVE_BLOCK`]² pixels, then rays only where neighbouring samples disagree (the blocks'
+//! midpoints, then each pixel of the half-blocks that still disagree), up to the uniform
+//! supersampling of [`super::sampling`] where colours still differ; every pass on the
 //! GPU, with no read-back between them. `wgsl/adaptive.wgsl` says how each pass decides.
 
 use super::pass::{TracePass, check_storage_buffers, shared_entries};
@@ -28,7 +29,10 @@ const PLANE_DISTANCE: f32 = 0.01;
 pub enum Stage {
     /// One ray per block corner.
     Coarse,
-    /// The blocks whose corners disagree: one ray per pixel; the rest interpolated.
+    /// The blocks whose corners disagree: a ray through each of their edges' midpoints and
+    /// their centres (the corners of their half-blocks); the other blocks interpolated.
+    Midpoints,
+    /// The half-blocks whose corners disagree: one ray per pixel; the rest interpolated.
     Refine,
     /// The traced pixels whose colour differs from their neighbours': 2 × 2 samples, and
     /// the error estimate that decides which take all of them (more than 4 samples a pixel,
@@ -42,8 +46,9 @@ pub enum Stage {
 }
 
 /// Every stage, in the order a frame runs them.
-pub const ALL_STAGES: [Stage; 5] = [
+pub const ALL_STAGES: [Stage; 6] = [
     Stage::Coarse,
+    Stage::Midpoints,
     Stage::Refine,
     Stage::Estimate,
     Stage::Supersample,
@@ -54,7 +59,7 @@ pub const ALL_STAGES: [Stage; 5] = [
 /// only with more than one sample a pixel, estimating first with more than 4 and a threshold
 /// above 0, the ground truth's only when asked for.
 pub fn stages_for(samples_per_side: u32, options: Adaptive) -> Vec<Stage> {
-    let mut stages = vec![Stage::Coarse, Stage::Refine];
+    let mut stages = vec![Stage::Coarse, Stage::Midpoints, Stage::Refine];
     if samples_per_side > 2 && options.threshold > 0.0 {
         stages.push(Stage::Estimate);
     }
@@ -73,7 +78,7 @@ fn samples_at(stage: Stage, samples_per_side: u32) -> u32 {
     match stage {
         Stage::Estimate => ADAPTIVE_ESTIMATE_SIDE.pow(2),
         Stage::Supersample => samples_per_side.pow(2),
-        Stage::Coarse | Stage::Refine | Stage::Truth => 1,
+        Stage::Coarse | Stage::Midpoints | Stage::Refine | Stage::Truth => 1,
     }
 }
 
@@ -96,9 +101,9 @@ fn sample_lanes(stage: Stage, samples_per_side: u32) -> u32 {
 #[derive(Default)]
 pub struct AdaptiveSpans<'a> {
     /// The listing pass of each [`Stage`], in order (the coarse stage's is never written).
-    pub lists: [Option<wgpu::ComputePassTimestampWrites<'a>>; 5],
+    pub lists: [Option<wgpu::ComputePassTimestampWrites<'a>>; 6],
     /// The tracing pass of each [`Stage`], in order.
-    pub stages: [Option<wgpu::ComputePassTimestampWrites<'a>>; 5],
+    pub stages: [Option<wgpu::ComputePassTimestampWrites<'a>>; 6],
 }
 
 /// Adaptive sampling of one lens, image size and scene: the trace kernel's outputs and frame
@@ -110,16 +115,16 @@ pub struct AdaptivePass {
     options: Adaptive,
     /// The coarse stage's kernel, `trace_lattice`: a ray through each lattice point.
     lattice: wgpu::ComputePipeline,
-    /// The kernels that list the later stages' pixels: classify, select_pixels, more,
-    /// untraced.
-    builders: [wgpu::ComputePipeline; 4],
+    /// The kernels that list the later stages' pixels: classify (the blocks), midpoints,
+    /// classify (the half-blocks), select_pixels, more, untraced.
+    builders: [wgpu::ComputePipeline; 6],
     /// The tracing kernel of each listed [`Stage`] (all but the coarse, in order, see
     /// [`listed_at`]): `trace_list` or `trace_samples`.
-    trace_lists: [wgpu::ComputePipeline; 4],
+    trace_lists: [wgpu::ComputePipeline; 5],
     /// The kernels that size each listed [`Stage`]'s tracing dispatch over its whole list,
     /// then supersampling's over the next slice of it (progressive refinement,
     /// [`AdaptivePass::encode_step`]).
-    args: [wgpu::ComputePipeline; 5],
+    args: [wgpu::ComputePipeline; 6],
     group: wgpu::BindGroup,
     args_group: wgpu::BindGroup,
     work: wgpu::Buffer,
@@ -187,7 +192,16 @@ impl AdaptivePass {
                 width.div_ceil(ADAPTIVE_BLOCK),
                 height.div_ceil(ADAPTIVE_BLOCK),
             ],
+            half_lattice: [
+                (width - 1).div_ceil(ADAPTIVE_BLOCK / 2) + 1,
+                (height - 1).div_ceil(ADAPTIVE_BLOCK / 2) + 1,
+            ],
+            halves: [
+                width.div_ceil(ADAPTIVE_BLOCK / 2),
+                height.div_ceil(ADAPTIVE_BLOCK / 2),
+            ],
         };
+        let blocks = u64::from(params.blocks[0]) * u64::from(params.blocks[1]);
         ctx.checked("creating the adaptive passes", || {
             let device = &ctx.device;
             let buffer = |label: &str, bytes: u64, usage: wgpu::BufferUsages| {
@@ -198,10 +212,11 @@ impl AdaptivePass {
                     mapped_at_creation: false,
                 })
             };
-            // The header, a list with room for every pixel, two words of state a pixel.
+            // The header, a list with room for every pixel, two words of state a pixel, a
+            // word a block.
             let work = buffer(
                 "fisheye.adaptive.work",
-                4 * (u64::from(ADAPTIVE_HEADER) + 3 * pixels),
+                4 * (u64::from(ADAPTIVE_HEADER) + 3 * pixels + blocks),
                 wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::COPY_SRC,
             );
             let listed = device.create_buffer(&wgpu::BufferDescriptor {
@@ -242,19 +257,29 @@ impl AdaptivePass {
                 None => "adaptive",
             };
             let side = trace.samples_per_side();
-            let kernel = |entry: &str, mode: u32, lanes: u32| {
+            let leveled = |entry: &str, mode: u32, lanes: u32, level: u32| {
                 let mut constants = trace.constants().to_vec();
                 constants.push(("LIST_MODE", f64::from(mode)));
                 constants.push(("SAMPLE_LANES", f64::from(lanes)));
+                constants.push(("LEVEL", f64::from(level)));
                 let composed = (&scene.arrays, source.swaps());
                 shader::scene_pipeline(device, file, composed, entry, &constants, &layouts)
             };
-            let builders =
-                ["classify", "select_pixels", "more", "untraced"].map(|e| kernel(e, 0, 1));
+            let kernel = |entry: &str, mode: u32, lanes: u32| leveled(entry, mode, lanes, 0);
+            let builders = [
+                kernel("classify", 0, 1),
+                kernel("midpoints", 0, 1),
+                leveled("classify", 0, 1, 1),
+                kernel("select_pixels", 0, 1),
+                kernel("more", 0, 1),
+                kernel("untraced", 0, 1),
+            ];
             // The modes of wgsl/adaptive.wgsl: centres, samples, first hits, estimates.
             let lattice = kernel("trace_lattice", 0, 1);
+            let trace_centres = kernel("trace_list", 0, 1);
             let trace_lists = [
-                kernel("trace_list", 0, 1),
+                trace_centres.clone(),
+                trace_centres,
                 kernel("trace_samples", 3, sample_lanes(Stage::Estimate, side)),
                 kernel("trace_samples", 1, sample_lanes(Stage::Supersample, side)),
                 kernel("trace_list", 2, 1),
@@ -280,6 +305,7 @@ impl AdaptivePass {
             // The stages that trace centres share one: a pixel a lane.
             let centres = args_kernel(0, Stage::Refine);
             let args = [
+                centres.clone(),
                 centres.clone(),
                 args_kernel(0, Stage::Estimate),
                 args_kernel(0, Stage::Supersample),
@@ -380,17 +406,18 @@ impl AdaptivePass {
     ) {
         let label = "fisheye.adaptive.coarse";
         let size = self.params.lattice;
-        self.dispatch_2d(encoder, scene, label, &self.lattice, size, writes);
+        self.dispatch_2d(encoder, scene, label, &[&self.lattice], size, writes);
     }
 
-    /// Records a compute pass timed by `writes` that runs `kernel` with the adaptive bind
-    /// groups, an invocation for each of `size`'s points in 2D workgroups.
+    /// Records a compute pass timed by `writes` that runs `kernels` one after another with
+    /// the adaptive bind groups, each an invocation for each of `size`'s points in 2D
+    /// workgroups.
     fn dispatch_2d(
         &self,
         encoder: &mut wgpu::CommandEncoder,
         scene: &GpuScene,
         label: &str,
-        kernel: &wgpu::ComputePipeline,
+        kernels: &[&wgpu::ComputePipeline],
         [w, h]: [u32; 2],
         writes: Option<wgpu::ComputePassTimestampWrites<'_>>,
     ) {
@@ -398,11 +425,13 @@ impl AdaptivePass {
             label: Some(label),
             timestamp_writes: writes,
         });
-        pass.set_pipeline(kernel);
         for (index, group) in self.groups(scene).into_iter().enumerate() {
             pass.set_bind_group(index as u32, group, &[]);
         }
-        pass.dispatch_workgroups(w.div_ceil(WORKGROUP_2D), h.div_ceil(WORKGROUP_2D), 1);
+        for kernel in kernels {
+            pass.set_pipeline(kernel);
+            pass.dispatch_workgroups(w.div_ceil(WORKGROUP_2D), h.div_ceil(WORKGROUP_2D), 1);
+        }
     }
 
     /// Records step `step` of a progressive frame, which shows a picture at once and sharpens
@@ -423,7 +452,7 @@ impl AdaptivePass {
             0 => {
                 encoder.clear_buffer(&self.listed, 0, None);
                 self.encode_coarse(encoder, scene, None);
-                for stage in [Stage::Refine, Stage::Truth] {
+                for stage in [Stage::Midpoints, Stage::Refine, Stage::Truth] {
                     if stages.contains(&stage) {
                         self.encode_stage(encoder, scene, stage, None, Some(None));
                     }
@@ -458,30 +487,22 @@ impl AdaptivePass {
         trace: Option<Option<wgpu::ComputePassTimestampWrites<'_>>>,
     ) {
         let size = self.trace.size();
-        // The lister of each stage, by its index in `builders`: supersampling lists the
-        // pixels the estimate marked where there is an estimating stage (the coarse stage
-        // lists nothing and never comes here: `encode_coarse`).
-        let lister = match stage {
-            Stage::Coarse | Stage::Refine => 0,
-            Stage::Estimate => 1,
-            Stage::Supersample if self.stages().contains(&Stage::Estimate) => 2,
-            Stage::Supersample => 1,
-            Stage::Truth => 3,
-        };
-        let points = match stage {
-            Stage::Coarse | Stage::Refine => self.params.blocks,
-            _ => [size.width, size.height],
+        let [classify, midpoints, classify_halves, select, more, untraced] = &self.builders;
+        // The listers of each stage: the midpoints' decide the blocks first; supersampling
+        // lists the pixels the estimate marked where there is an estimating stage (the coarse
+        // stage lists nothing and never comes here: `encode_coarse`).
+        let pixels = [size.width, size.height];
+        let (listers, points) = match stage {
+            Stage::Coarse | Stage::Midpoints => (vec![classify, midpoints], self.params.blocks),
+            Stage::Refine => (vec![classify_halves], self.params.halves),
+            Stage::Estimate => (vec![select], pixels),
+            Stage::Supersample if self.stages().contains(&Stage::Estimate) => (vec![more], pixels),
+            Stage::Supersample => (vec![select], pixels),
+            Stage::Truth => (vec![untraced], pixels),
         };
         encoder.clear_buffer(&self.work, 0, Some(4 * u64::from(ADAPTIVE_HEADER)));
-        let lister = &self.builders[lister];
-        self.dispatch_2d(
-            encoder,
-            scene,
-            "fisheye.adaptive.list",
-            lister,
-            points,
-            list,
-        );
+        let label = "fisheye.adaptive.list";
+        self.dispatch_2d(encoder, scene, label, &listers, points, list);
         if let Some(writes) = trace {
             let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
                 label: Some("fisheye.adaptive.trace"),
@@ -527,11 +548,12 @@ impl AdaptivePass {
     }
 
     /// The rays each stage of the last frame traced, in [`AdaptivePass::stages`] order: the
-    /// lattice points at the coarse stage, then the pixels each stage listed times the
-    /// samples each takes there (1 at the refining and ground truth's stages, where the last
-    /// traces first hits alone; 2 × 2 estimating; all of them supersampling), counting
-    /// samples the lens masks (which cost a lens evaluation, not a ray) as rays. After progressive steps, supersampling's are the pixels listed,
-    /// whether or not their slices are traced yet.
+    /// lattice points at the coarse stage, then the pixels each stage listed times the samples
+    /// each takes there (1 at the midpoint, refining and ground truth's stages, where the last
+    /// traces first hits alone; 2 × 2 estimating; all of them supersampling), counting samples
+    /// the lens masks (which cost a lens evaluation, not a ray) as rays. After progressive
+    /// steps, supersampling's are the pixels listed, whether or not their slices are traced
+    /// yet.
     pub fn read_stage_rays(&self, ctx: &GpuContext) -> Result<Vec<(Stage, u64)>> {
         let listed: Vec<u32> = ctx.read_buffer(&self.listed)?;
         let side = self.trace.samples_per_side();
@@ -564,9 +586,9 @@ impl AdaptivePass {
     }
 
     /// The rays each pixel's colour took in the last frame, row-major (the spp map): 0 for a
-    /// pixel interpolated between its block's corners or masked, 1 for its centre alone, and
-    /// one more for each sample that the lens covers of a pixel's 2 × 2 estimating samples and
-    /// of its full supersampling.
+    /// pixel interpolated between its block's or half-block's corners or masked, 1 for its
+    /// centre alone, and one more for each sample that the lens covers of a pixel's 2 × 2
+    /// estimating samples and of its full supersampling.
     pub fn read_rays(&self, ctx: &GpuContext) -> Result<Vec<u32>> {
         let pixels = self.trace.size().pixels() as u64;
         let first = 4 * (u64::from(ADAPTIVE_HEADER) + pixels);

@@ -310,6 +310,7 @@ fn adaptive_render_writes_its_spp_map() {
         "trace (rt@auto:0.05)",
         "rays for their colour",
         "coarse",
+        "midpoints",
         "refine",
         "truth",
     ] {
