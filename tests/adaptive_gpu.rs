@@ -55,6 +55,36 @@ fn adaptive_stages(
     (out, pass.read_rays(ctx()).unwrap(), stages)
 }
 
+/// The plane z = 0 from -`half` to `half` in x and y (to 20 at most in y) under one point
+/// light (`light`: its position and intensity, TOML), black ambient and sky, seen from
+/// `camera` (its position and look-at point, TOML), through the scene loader.
+fn lit_plane(tag: &str, half: f64, camera: &str, light: &str) -> Scene {
+    let dir = std::env::temp_dir().join(format!("fisheye-{tag}-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let far = half.min(20.0);
+    std::fs::write(
+        dir.join("plane.obj"),
+        format!(
+            "v -{half} -{half} 0\nv {half} -{half} 0\nv {half} {far} 0\nv -{half} {far} 0\n\
+             f 1 2 3\nf 1 3 4\n"
+        ),
+    )
+    .unwrap();
+    std::fs::write(
+        dir.join("plane.toml"),
+        format!(
+            "ambient = [0.0, 0.0, 0.0]\nsky = [0.0, 0.0, 0.0]\n[camera]\n{camera}\n[[mesh]]\n\
+             path = \"plane.obj\"\n[[light]]\ntype = \"point\"\n{light}\n"
+        ),
+    )
+    .unwrap();
+    let plane = fisheye_rt::scene::load(dir.join("plane.toml").to_str().unwrap())
+        .unwrap()
+        .scene;
+    std::fs::remove_dir_all(&dir).unwrap();
+    plane
+}
+
 fn upload(scene: &Scene) -> GpuScene {
     GpuScene::new(ctx(), scene, &RenderOptions::default()).unwrap()
 }
@@ -163,24 +193,12 @@ fn reruns_are_bit_identical() {
 /// each axis.
 #[test]
 fn a_smooth_scene_is_traced_at_block_corners_only() {
-    let dir = std::env::temp_dir().join(format!("fisheye-adaptive-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    std::fs::write(
-        dir.join("plane.obj"),
-        "v -20 -20 0\nv 20 -20 0\nv 20 20 0\nv -20 20 0\nf 1 2 3\nf 1 3 4\n",
-    )
-    .unwrap();
-    std::fs::write(
-        dir.join("plane.toml"),
-        "ambient = [0.0, 0.0, 0.0]\nsky = [0.0, 0.0, 0.0]\n[camera]\nposition = [0.0, 0.0, 3.0]\n\
-         look_at = [0.0, 0.0, 0.0]\n[[mesh]]\npath = \"plane.obj\"\n[[light]]\ntype = \"point\"\n\
-         position = [10.0, 6.0, 40.0]\nintensity = [1200.0, 1200.0, 1200.0]\n",
-    )
-    .unwrap();
-    let plane = fisheye_rt::scene::load(dir.join("plane.toml").to_str().unwrap())
-        .unwrap()
-        .scene;
-    std::fs::remove_dir_all(&dir).unwrap();
+    let plane = lit_plane(
+        "smooth",
+        20.0,
+        "position = [0.0, 0.0, 3.0]\nlook_at = [0.0, 0.0, 0.0]",
+        "position = [10.0, 6.0, 40.0]\nintensity = [1200.0, 1200.0, 1200.0]",
+    );
     let gpu = upload(&plane);
     let (w, h) = (65, 49);
     let cam = camera("rectilinear:f=1", w, h);
@@ -235,24 +253,13 @@ fn a_smooth_scene_is_traced_at_block_corners_only() {
 /// half-block it crosses is in a refined block). Judged from uniform sampling's hits.
 #[test]
 fn only_the_half_blocks_an_edge_crosses_are_traced() {
-    let dir = std::env::temp_dir().join(format!("fisheye-halves-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    std::fs::write(
-        dir.join("plane.obj"),
-        "v -1000 -1000 0\nv 1000 -1000 0\nv 1000 20 0\nv -1000 20 0\nf 1 2 3\nf 1 3 4\n",
-    )
-    .unwrap();
-    std::fs::write(
-        dir.join("plane.toml"),
-        "ambient = [0.0, 0.0, 0.0]\nsky = [0.0, 0.0, 0.0]\n[camera]\nposition = [0.0, -19.0, 1.5]\n\
-         look_at = [6.0, 0.0, 1.0]\n[[mesh]]\npath = \"plane.obj\"\n[[light]]\ntype = \"point\"\n\
-         position = [10.0, 6.0, 400.0]\nintensity = [90000.0, 90000.0, 90000.0]\n",
-    )
-    .unwrap();
-    let plane = fisheye_rt::scene::load(dir.join("plane.toml").to_str().unwrap())
-        .unwrap()
-        .scene;
-    std::fs::remove_dir_all(&dir).unwrap();
+    // Wide enough that its sides are out of view: the one edge seen is its far one, at y = 20.
+    let plane = lit_plane(
+        "halves",
+        1000.0,
+        "position = [0.0, -19.0, 1.5]\nlook_at = [6.0, 0.0, 1.0]",
+        "position = [10.0, 6.0, 400.0]\nintensity = [90000.0, 90000.0, 90000.0]",
+    );
     let gpu = upload(&plane);
     let (w, h) = (65u32, 49u32);
     let cam = camera("rectilinear:f=1", w, h);
