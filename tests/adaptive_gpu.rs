@@ -148,6 +148,26 @@ fn threshold_zero_at(gpu: &GpuScene, cam: &LensCamera, spp: u32) {
     }
 }
 
+/// An image so small that the lens's circle holds no block corner (5 × 7 and 2 × 3 pixels
+/// through the 180° lens: every lattice point masked) is still traced where the lens covers
+/// it: at threshold 0, uniform sampling's image and one ray a covered pixel (it was once
+/// interpolated as all masked, a blank frame).
+#[test]
+fn a_circle_smaller_than_a_block_is_traced() {
+    let room = scene("builtin:default");
+    let gpu = upload(&room);
+    for (w, h) in [(5, 7), (2, 3)] {
+        let cam = camera("canon-8-15mm@8mm", w, h);
+        let reference = uniform(&gpu, &cam, 1);
+        let covered = reference.counts().0;
+        assert!(covered > 0, "{w}x{h}: the lens covers some pixels");
+        let (out, rays) = adaptive(&gpu, &cam, 1, 0.0, false);
+        assert_eq!(out.colour, reference.colour, "{w}x{h}");
+        let traced = rays.iter().filter(|&&n| n == 1).count();
+        assert_eq!(traced, covered, "{w}x{h}: {rays:?}");
+    }
+}
+
 /// Interpolated pixels get their first hits traced: ids, normals and ranges are never
 /// interpolated, and equal uniform sampling's bit for bit.
 #[test]

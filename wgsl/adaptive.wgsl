@@ -110,7 +110,7 @@ fn state_slot(index: u32) -> u32 {
 
 // Where block `b`'s decision is kept in `work`: BLOCK_INTERPOLATED, or where its corners
 // disagreed (its half-blocks are decided at level 1) BLOCK_COVERED when no lattice point near
-// it is masked (the lens covers all of it, see `lattice_near`), else BLOCK_NEAR_EDGE.
+// it is masked (the lens covers all of it, see `masked_near`), else BLOCK_NEAR_EDGE.
 fn block_slot(b: vec2<u32>) -> u32 {
     return ADAPTIVE_HEADER + 3u * lens.width * lens.height + b.y * adaptive.blocks.x + b.x;
 }
@@ -329,7 +329,7 @@ struct Corner {
 
 // What `classify` reads of the lattice points around its workgroup's blocks, loaded once into
 // workgroup memory by `load_tile`: the WORKGROUP_2D² blocks' corners and the ring beyond them
-// (whose colours `edge_bend` and keys `lattice_near` look at), TILE² points in rows. Each
+// (whose colours `edge_bend` and keys `masked_near` look at), TILE² points in rows. Each
 // point is a corner of up to four blocks and on the lines of up to twelve of their edges: it
 // is read from the outputs, its colour displayed and its ray made (to place its hit) once
 // instead of at each use (measured in the book's Adaptive sampling: a third off the pass
@@ -392,17 +392,17 @@ fn same_surface(a: Corner, b: Corner) -> bool {
 }
 
 // Whether a lattice point among the 4 × 4 around the block at lattice point `l` (its corners
-// and the ring beyond) is masked (`masked`) or not: where none is, the lens's edge is more
-// than a block away and, the lens's valid region being convex (a disk or ellipse, or the
-// whole image), does not cross the block. A point not traced (at level 1, in a block
-// interpolated at level 0) may be either. Reads the tile of the workgroup at `origin`.
-fn lattice_near(origin: vec2<u32>, l: vec2<u32>, masked: bool) -> bool {
+// and the ring beyond) is masked: where none is, the lens's edge is more than a block away
+// and, the lens's valid region being convex (a disk or ellipse, or the whole image), does not
+// cross the block. A point not traced (at level 1, in a block interpolated at level 0) may be
+// masked. Reads the tile of the workgroup at `origin`.
+fn masked_near(origin: vec2<u32>, l: vec2<u32>) -> bool {
     let first = vec2<i32>(l) - 1;
     let last = vec2<i32>(level_lattice()) - 1;
     for (var y = max(first.y, 0); y <= min(first.y + 3, last.y); y++) {
         for (var x = max(first.x, 0); x <= min(first.x + 3, last.x); x++) {
             let key = tile_corner[tile_index(origin, vec2<i32>(x, y))].key;
-            if key == KEY_UNTRACED || (key == KEY_MASKED) == masked {
+            if key == KEY_UNTRACED || key == KEY_MASKED {
                 return true;
             }
         }
@@ -523,7 +523,9 @@ fn classify(
         let d = tile_corner[t11];
         let masked = vec4<u32>(a.key, b.key, c.key, d.key) == vec4<u32>(KEY_MASKED);
         if all(masked) {
-            refine = lattice_near(origin, l, false) && !block_mask_is(first, end, false);
+            // Every pixel is looked at: a valid region smaller than a block (a tiny image's
+            // circle) may hold no lattice point at all.
+            refine = !block_mask_is(first, end, false);
         } else if any(masked) {
             refine = true;
         } else {
@@ -535,14 +537,14 @@ fn classify(
             if !refine {
                 refine = !(same_surface(a, b) && same_surface(a, c) && same_surface(b, d)
                     && same_surface(c, d) && same_surface(a, d) && same_surface(b, c))
-                    || (near_edge && lattice_near(origin, l, true)
+                    || (near_edge && masked_near(origin, l)
                         && !block_mask_is(first, end, true));
             }
         }
         if LEVEL == 0u {
             var decided = BLOCK_INTERPOLATED;
             if refine {
-                decided = select(BLOCK_COVERED, BLOCK_NEAR_EDGE, lattice_near(origin, l, true));
+                decided = select(BLOCK_COVERED, BLOCK_NEAR_EDGE, masked_near(origin, l));
             }
             atomicStore(&work[block_slot(l)], decided);
         } else if refine {
