@@ -522,6 +522,9 @@ fn classify(
         let c = tile_corner[t01];
         let d = tile_corner[t11];
         let masked = vec4<u32>(a.key, b.key, c.key, d.key) == vec4<u32>(KEY_MASKED);
+        // Whether the lens's edge may cross the block (at level 1 only where it may cross
+        // the parent).
+        let edge_near = near_edge && masked_near(origin, l);
         if all(masked) {
             // Every pixel is looked at: a valid region smaller than a block (a tiny image's
             // circle) may hold no lattice point at all.
@@ -537,14 +540,13 @@ fn classify(
             if !refine {
                 refine = !(same_surface(a, b) && same_surface(a, c) && same_surface(b, d)
                     && same_surface(c, d) && same_surface(a, d) && same_surface(b, c))
-                    || (near_edge && masked_near(origin, l)
-                        && !block_mask_is(first, end, true));
+                    || (edge_near && !block_mask_is(first, end, true));
             }
         }
         if LEVEL == 0u {
             var decided = BLOCK_INTERPOLATED;
             if refine {
-                decided = select(BLOCK_COVERED, BLOCK_NEAR_EDGE, masked_near(origin, l));
+                decided = select(BLOCK_COVERED, BLOCK_NEAR_EDGE, edge_near);
             }
             atomicStore(&work[block_slot(l)], decided);
         } else if refine {

@@ -82,6 +82,12 @@ fn samples_at(stage: Stage, samples_per_side: u32) -> u32 {
     }
 }
 
+/// The lattice points along a side of `n` pixels at `spacing`: every `spacing`-th pixel and
+/// the last.
+fn lattice_points(n: u32, spacing: u32) -> u32 {
+    (n - 1).div_ceil(spacing) + 1
+}
+
 /// Where the stages that trace a list (all but [`Stage::Coarse`]) keep their kernels in
 /// [`AdaptivePass`]'s arrays: in [`ALL_STAGES`] order from 0.
 fn listed_at(stage: Stage) -> usize {
@@ -184,22 +190,10 @@ impl AdaptivePass {
             normal_cosine: NORMAL_COSINE,
             plane_distance: PLANE_DISTANCE,
             _pad0: 0,
-            lattice: [
-                (width - 1).div_ceil(ADAPTIVE_BLOCK) + 1,
-                (height - 1).div_ceil(ADAPTIVE_BLOCK) + 1,
-            ],
-            blocks: [
-                width.div_ceil(ADAPTIVE_BLOCK),
-                height.div_ceil(ADAPTIVE_BLOCK),
-            ],
-            half_lattice: [
-                (width - 1).div_ceil(ADAPTIVE_BLOCK / 2) + 1,
-                (height - 1).div_ceil(ADAPTIVE_BLOCK / 2) + 1,
-            ],
-            halves: [
-                width.div_ceil(ADAPTIVE_BLOCK / 2),
-                height.div_ceil(ADAPTIVE_BLOCK / 2),
-            ],
+            lattice: [width, height].map(|n| lattice_points(n, ADAPTIVE_BLOCK)),
+            blocks: [width, height].map(|n| n.div_ceil(ADAPTIVE_BLOCK)),
+            half_lattice: [width, height].map(|n| lattice_points(n, ADAPTIVE_BLOCK / 2)),
+            halves: [width, height].map(|n| n.div_ceil(ADAPTIVE_BLOCK / 2)),
         };
         let blocks = u64::from(params.blocks[0]) * u64::from(params.blocks[1]);
         ctx.checked("creating the adaptive passes", || {
