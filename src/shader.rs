@@ -17,7 +17,7 @@ use crate::split::SceneArrays;
 const SCENE_ARRAYS: &str = "scene_arrays";
 
 /// Every WGSL file of the project, by name (its file stem under `wgsl/`).
-pub const FILES: [(&str, &str); 35] = [
+pub const FILES: [(&str, &str); 36] = [
     ("math", include_str!("../wgsl/math.wgsl")),
     ("quaternion", include_str!("../wgsl/quaternion.wgsl")),
     ("calibrated", include_str!("../wgsl/calibrated.wgsl")),
@@ -32,6 +32,10 @@ pub const FILES: [(&str, &str); 35] = [
     ("frame", include_str!("../wgsl/frame.wgsl")),
     ("colour", include_str!("../wgsl/colour.wgsl")),
     ("adaptive", include_str!("../wgsl/adaptive.wgsl")),
+    (
+        "adaptive_lists",
+        include_str!("../wgsl/adaptive_lists.wgsl"),
+    ),
     ("adaptive_rq", include_str!("../wgsl/adaptive_rq.wgsl")),
     ("adaptive_args", include_str!("../wgsl/adaptive_args.wgsl")),
     ("tent", include_str!("../wgsl/tent.wgsl")),

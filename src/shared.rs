@@ -30,6 +30,10 @@ pub const ADAPTIVE_STORAGE_BUFFERS: u32 = 1;
 /// Side of the blocks of pixels whose corners adaptive sampling traces first: one ray per
 /// `ADAPTIVE_BLOCK`² pixels where the image is smooth.
 pub const ADAPTIVE_BLOCK: u32 = 4;
+/// Pixels side by side in a row that each invocation of adaptive sampling's per-pixel listing
+/// kernels looks at: a workgroup lists `ADAPTIVE_STRIP` times as many pixels for the same
+/// barriers and global atomic.
+pub const ADAPTIVE_STRIP: u32 = 4;
 /// The `u32`s before the list in adaptive sampling's work buffer: the list's length
 /// (at `ADAPTIVE_COUNT`), the part of it `trace_list` traces (from `ADAPTIVE_FIRST` to
 /// `ADAPTIVE_END`), one unused (a 16-byte header).
@@ -314,6 +318,7 @@ pub fn wgsl_constants() -> Vec<(String, u32)> {
         ("MAX_SHADOW_LAYERS", MAX_SHADOW_LAYERS),
         ("NO_HIT", NO_HIT),
         ("ADAPTIVE_BLOCK", ADAPTIVE_BLOCK),
+        ("ADAPTIVE_STRIP", ADAPTIVE_STRIP),
         ("MAX_KNOTS", MAX_KNOTS as u32),
         ("INSTANCE_VEC4S", INSTANCE_VEC4S),
         ("KNOT_VEC4S", KNOT_VEC4S),

@@ -378,6 +378,54 @@ fn edges_get_more_rays_than_flat_pixels() {
     assert!(in_sky <= 0.25, "open sky took {in_sky:.2} rays a pixel");
 }
 
+/// A pixel on the lens's edge (its centre covered and a neighbour's masked, or the other way
+/// round) is supersampled whatever the threshold: at threshold 1, where colour alone picks
+/// almost nothing, each such pixel that has a ray of its own takes the 2 × 2 samples uniform
+/// sampling takes (a covered one its centre too), and so has uniform sampling's colour.
+#[test]
+fn pixels_on_the_lens_edge_are_supersampled() {
+    let room = scene("builtin:default");
+    let gpu = upload(&room);
+    let (w, h) = (61u32, 46u32);
+    let cam = camera("canon-8-15mm@8mm", w, h);
+    let reference = uniform(&gpu, &cam, 4);
+    let centres = uniform(&gpu, &cam, 1);
+    let (out, rays) = adaptive(&gpu, &cam, 4, 1.0, false);
+    let (w, h) = (w as usize, h as usize);
+    let (mut covered, mut masked) = (0, 0);
+    for y in 0..h {
+        for x in 0..w {
+            let i = y * w + x;
+            let inside = centres.valid(i);
+            let neighbours = [
+                (x.wrapping_sub(1), y),
+                (x + 1, y),
+                (x, y.wrapping_sub(1)),
+                (x, y + 1),
+            ];
+            let across = neighbours
+                .iter()
+                .any(|&(a, b)| a < w && b < h && centres.valid(b * w + a) != inside);
+            if !across || (inside && rays[i] == 0) {
+                continue;
+            }
+            let samples = (reference.colour[i][3] * 4.0).round() as u32;
+            assert_eq!(out.colour[i], reference.colour[i], "pixel ({x}, {y})");
+            assert_eq!(rays[i], u32::from(inside) + samples, "pixel ({x}, {y})");
+            if inside {
+                covered += 1;
+            } else {
+                masked += 1;
+            }
+        }
+    }
+    // The 180° circle's rim at 61x46: about 2π·23 pixels on each side of it.
+    assert!(
+        covered > 60 && masked > 60,
+        "{covered} covered, {masked} masked"
+    );
+}
+
 /// Lower thresholds refine more, so the error against a 64-ray reference falls (to uniform
 /// sampling's at threshold 0).
 #[test]

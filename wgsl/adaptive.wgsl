@@ -18,9 +18,9 @@
 //    image changes, as Painter and Sloan (1989) and Thomas, Netravali and Fox (1989) refined a
 //    coarse sampling level by level, so an edge takes a band of rays half a block wide, and a
 //    block whose colour bends only at its own scale is interpolated from its half-blocks;
-// 4. `select_pixels` lists the pixels traced whose displayed colour bends across them (the
-//    second difference with their neighbours, along either axis) by the threshold or more,
-//    and those on the lens's edge: a one-ray pixel is its box filter's value where colour
+// 4. `select_pixels` (in `adaptive_lists.wgsl`, with `more` and `untraced`) lists the pixels
+//    traced whose displayed colour bends across them (the second difference with their
+//    neighbours, along either axis) by the threshold or more, and those on the lens's edge: a one-ray pixel is its box filter's value where colour
 //    changes linearly across it, and the bend estimates how far off it is (Mitchell 1987 drove
 //    supersampling by such local contrast). Where SAMPLES_PER_SIDE > 2 and the threshold is
 //    above 0, `trace_samples` first takes 2 × 2 stratified samples of each (`MODE_ESTIMATE`)
@@ -176,14 +176,6 @@ fn any_in_group(pick: bool, local: u32) -> bool {
         group_found = atomicLoad(&group_any);
     }
     return workgroupUniformLoad(&group_found) == 1u;
-}
-
-// Lists pixel `index` where `pick` holds (`reserve`'s rules: every invocation calls it).
-fn list_if(pick: bool, index: u32, local: u32) {
-    let slot = reserve(select(0u, 1u, pick), local);
-    if pick {
-        atomicStore(&work[slot], index);
-    }
 }
 
 // The side of LEVEL's blocks, in pixels: the spacing of their lattice.
@@ -633,68 +625,4 @@ fn midpoints(@builtin(global_invocation_id) id: vec3<u32>, @builtin(local_invoca
             slot++;
         }
     }
-}
-
-// The second difference of displayed colours `before`, `c`, `after` at `c` (see `bend`); the
-// first difference where only one neighbour exists (`has`), 0 where none does.
-fn curvature(before: vec3<f32>, c: vec3<f32>, after: vec3<f32>, has: vec2<bool>) -> f32 {
-    if all(has) {
-        return largest(abs(before - 2.0 * c + after));
-    }
-    if has.x {
-        return largest(abs(c - before));
-    }
-    if has.y {
-        return largest(abs(after - c));
-    }
-    return 0.0;
-}
-
-// Whether pixel `p` and its neighbour at `q` are on different sides of the lens's edge.
-fn mask_edge(p: vec2<u32>, q: vec2<u32>) -> bool {
-    return (key_at(index_of(p)) == KEY_MASKED) != (key_at(index_of(q)) == KEY_MASKED);
-}
-
-@compute @workgroup_size(WORKGROUP_2D, WORKGROUP_2D)
-fn select_pixels(@builtin(global_invocation_id) id: vec3<u32>, @builtin(local_invocation_index) local: u32) {
-    let p = id.xy;
-    var pick = false;
-    if all(p < size()) && key_at(index_of(p)) != KEY_UNTRACED {
-        // The colour's bend across the pixel along each axis (see `bend`): a one-ray pixel
-        // is its box filter's value where the colour changes linearly across it.
-        let c = shown(colour_out[index_of(p)].rgb);
-        let last = size() - 1u;
-        let x = vec2<u32>(1u, 0u);
-        let y = vec2<u32>(0u, 1u);
-        let left = select(p, p - x, p.x > 0u);
-        let right = select(p, p + x, p.x < last.x);
-        let up = select(p, p - y, p.y > 0u);
-        let down = select(p, p + y, p.y < last.y);
-        let across = curvature(
-            shown(colour_out[index_of(left)].rgb), c, shown(colour_out[index_of(right)].rgb),
-            vec2<bool>(p.x > 0u, p.x < last.x),
-        );
-        let along = curvature(
-            shown(colour_out[index_of(up)].rgb), c, shown(colour_out[index_of(down)].rgb),
-            vec2<bool>(p.y > 0u, p.y < last.y),
-        );
-        pick = max(across, along) >= adaptive.threshold
-            || mask_edge(p, left) || mask_edge(p, right) || mask_edge(p, up) || mask_edge(p, down);
-    }
-    list_if(pick, index_of(p), local);
-}
-
-// Lists the pixels whose state says `key`.
-fn list_keyed(p: vec2<u32>, key: u32, local: u32) {
-    list_if(all(p < size()) && key_at(index_of(p)) == key, index_of(p), local);
-}
-
-@compute @workgroup_size(WORKGROUP_2D, WORKGROUP_2D)
-fn more(@builtin(global_invocation_id) id: vec3<u32>, @builtin(local_invocation_index) local: u32) {
-    list_keyed(id.xy, KEY_MORE, local);
-}
-
-@compute @workgroup_size(WORKGROUP_2D, WORKGROUP_2D)
-fn untraced(@builtin(global_invocation_id) id: vec3<u32>, @builtin(local_invocation_index) local: u32) {
-    list_keyed(id.xy, KEY_UNTRACED, local);
 }

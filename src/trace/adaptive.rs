@@ -14,7 +14,8 @@ use crate::scene::Camera;
 use crate::shader;
 use crate::shared::{
     ADAPTIVE_BLOCK, ADAPTIVE_COUNT, ADAPTIVE_ESTIMATE_SIDE, ADAPTIVE_HEADER,
-    ADAPTIVE_STORAGE_BUFFERS, AdaptiveParams, TRACE_STORAGE_BUFFERS, WORKGROUP_1D, WORKGROUP_2D,
+    ADAPTIVE_STORAGE_BUFFERS, ADAPTIVE_STRIP, AdaptiveParams, TRACE_STORAGE_BUFFERS, WORKGROUP_1D,
+    WORKGROUP_2D,
 };
 
 /// Two corners' shading normals further apart than this (about 25°) are not one smooth
@@ -250,23 +251,33 @@ impl AdaptivePass {
                 }
                 None => "adaptive",
             };
+            // The per-pixel listers' file imports wgsl/adaptive.wgsl; with ray queries it is
+            // composed as adaptive_rq.wgsl composes that.
+            let mut swaps = source.swaps().to_vec();
+            if scene.ray_query.is_some() {
+                swaps.push(("bvh", "bvh_rq"));
+            }
             let side = trace.samples_per_side();
-            let leveled = |entry: &str, mode: u32, lanes: u32, level: u32| {
+            let in_file = |file: &str, entry: &str, mode: u32, lanes: u32, level: u32| {
                 let mut constants = trace.constants().to_vec();
                 constants.push(("LIST_MODE", f64::from(mode)));
                 constants.push(("SAMPLE_LANES", f64::from(lanes)));
                 constants.push(("LEVEL", f64::from(level)));
-                let composed = (&scene.arrays, source.swaps());
+                let composed = (&scene.arrays, swaps.as_slice());
                 shader::scene_pipeline(device, file, composed, entry, &constants, &layouts)
             };
+            let leveled = |entry: &str, mode: u32, lanes: u32, level: u32| {
+                in_file(file, entry, mode, lanes, level)
+            };
             let kernel = |entry: &str, mode: u32, lanes: u32| leveled(entry, mode, lanes, 0);
+            let lister = |entry: &str| in_file("adaptive_lists", entry, 0, 1, 0);
             let builders = [
                 kernel("classify", 0, 1),
                 kernel("midpoints", 0, 1),
                 leveled("classify", 0, 1, 1),
-                kernel("select_pixels", 0, 1),
-                kernel("more", 0, 1),
-                kernel("untraced", 0, 1),
+                lister("select_pixels"),
+                lister("more"),
+                lister("untraced"),
             ];
             // The modes of wgsl/adaptive.wgsl: centres, samples, first hits, estimates.
             let lattice = kernel("trace_lattice", 0, 1);
@@ -485,7 +496,8 @@ impl AdaptivePass {
         // The listers of each stage: the midpoints' decide the blocks first; supersampling
         // lists the pixels the estimate marked where there is an estimating stage (the coarse
         // stage lists nothing and never comes here: `encode_coarse`).
-        let pixels = [size.width, size.height];
+        // The per-pixel listers look at ADAPTIVE_STRIP pixels an invocation, side by side.
+        let pixels = [size.width.div_ceil(ADAPTIVE_STRIP), size.height];
         let (listers, points) = match stage {
             Stage::Coarse | Stage::Midpoints => (vec![classify, midpoints], self.params.blocks),
             Stage::Refine => (vec![classify_halves], self.params.halves),

@@ -1,0 +1,146 @@
+// Adaptive sampling's per-pixel listing kernels (steps 4 and 5 of `adaptive.wgsl`'s header):
+// `select_pixels` lists the traced pixels whose colour bends, `more` those whose estimate asks
+// for every sample, `untraced` the interpolated ones. Each invocation looks at ADAPTIVE_STRIP
+// pixels side by side, so that a workgroup's barriers and global atomic serve more pixels.
+#import adaptive
+
+// The second difference of displayed colours `before`, `c`, `after` at `c` (see `bend`); the
+// first difference where only one neighbour exists (`has`), 0 where none does.
+fn curvature(before: vec3<f32>, c: vec3<f32>, after: vec3<f32>, has: vec2<bool>) -> f32 {
+    if all(has) {
+        return largest(abs(before - 2.0 * c + after));
+    }
+    if has.x {
+        return largest(abs(c - before));
+    }
+    if has.y {
+        return largest(abs(after - c));
+    }
+    return 0.0;
+}
+
+// What `select_pixels` reads around its workgroup's pixels (WORKGROUP_2D rows of WORKGROUP_2D
+// strips, and the ring of pixels around them), loaded once into workgroup memory: each pixel's
+// displayed colour (`shown`), and in w whether the lens masks it (SEEN_MASKED), it is
+// interpolated (SEEN_UNTRACED) or traced (SEEN_TRACED). A pixel is read by itself and its four
+// neighbours: loading it once displays its colour once instead of five times (on lavapipe,
+// whose SIMD lanes run a whole row of strips wherever one pixel of it was traced, for every
+// pixel).
+const PIXEL_TILE_X: u32 = WORKGROUP_2D * ADAPTIVE_STRIP + 2u;
+const PIXEL_TILE_Y: u32 = WORKGROUP_2D + 2u;
+const SEEN_MASKED: f32 = 0.0;
+const SEEN_UNTRACED: f32 = 1.0;
+const SEEN_TRACED: f32 = 2.0;
+var<workgroup> pixel_tile: array<vec4<f32>, PIXEL_TILE_X * PIXEL_TILE_Y>;
+
+// Loads the pixel tile of the workgroup whose first pixel is `origin` (every invocation calls
+// it, in uniform control flow: it has a barrier). Entries outside the image are left as they
+// are: nothing reads them.
+fn load_pixel_tile(origin: vec2<u32>, local: u32) {
+    for (var t = local; t < PIXEL_TILE_X * PIXEL_TILE_Y; t += WORKGROUP_2D * WORKGROUP_2D) {
+        let q = vec2<i32>(origin) - 1 + vec2<i32>(i32(t % PIXEL_TILE_X), i32(t / PIXEL_TILE_X));
+        if any(q < vec2<i32>(0)) || any(q >= vec2<i32>(size())) {
+            continue;
+        }
+        let i = index_of(vec2<u32>(q));
+        let key = key_at(i);
+        var seen = SEEN_TRACED;
+        if key == KEY_MASKED {
+            seen = SEEN_MASKED;
+        } else if key == KEY_UNTRACED {
+            seen = SEEN_UNTRACED;
+        }
+        pixel_tile[t] = vec4<f32>(shown(colour_out[i].rgb), seen);
+    }
+    workgroupBarrier();
+}
+
+// Pixel `p`'s entry in the pixel tile of the workgroup whose first pixel is `origin`.
+fn pixel_seen(origin: vec2<u32>, p: vec2<u32>) -> vec4<f32> {
+    let t = p + 1u - origin;
+    return pixel_tile[t.y * PIXEL_TILE_X + t.x];
+}
+
+// Whether pixel `p` is supersampled: traced, and its displayed colour bends across it (the
+// second difference with its neighbours along either axis, see `bend`) by the threshold or
+// more (a one-ray pixel is its box filter's value where the colour changes linearly across
+// it), or on the lens's edge (a neighbour masked and it not, or the other way round). Reads
+// the pixel tile of the workgroup at `origin`.
+fn bends(origin: vec2<u32>, p: vec2<u32>) -> bool {
+    let c = pixel_seen(origin, p);
+    if c.w == SEEN_UNTRACED {
+        return false;
+    }
+    let last = size() - 1u;
+    let has = vec4<bool>(p.x > 0u, (p.x < last.x), p.y > 0u, (p.y < last.y));
+    // A neighbour beyond the image's edge stands in as the pixel itself: no bend, no edge.
+    let x = vec2<u32>(1u, 0u);
+    let y = vec2<u32>(0u, 1u);
+    let left = pixel_seen(origin, select(p, p - x, has.x));
+    let right = pixel_seen(origin, select(p, p + x, has.y));
+    let up = pixel_seen(origin, select(p, p - y, has.z));
+    let down = pixel_seen(origin, select(p, p + y, has.w));
+    let across = curvature(left.rgb, c.rgb, right.rgb, has.xy);
+    let along = curvature(up.rgb, c.rgb, down.rgb, has.zw);
+    let masked = c.w == SEEN_MASKED;
+    let edge = vec4<f32>(left.w, right.w, up.w, down.w) == vec4<f32>(SEEN_MASKED);
+    return max(across, along) >= adaptive.threshold || any(edge != vec4<bool>(masked));
+}
+
+// Pixel `k` of the strip that invocation `id` of a per-pixel listing kernel looks at:
+// ADAPTIVE_STRIP pixels side by side in a row.
+fn strip_pixel(id: vec3<u32>, k: u32) -> vec2<u32> {
+    return vec2<u32>(id.x * ADAPTIVE_STRIP + k, id.y);
+}
+
+// Lists the pixels of invocation `id`'s strip that `picks` marks (`reserve`'s rules: every
+// invocation calls it).
+fn list_strip(id: vec3<u32>, picks: array<bool, ADAPTIVE_STRIP>, local: u32) {
+    var n = 0u;
+    for (var k = 0u; k < ADAPTIVE_STRIP; k++) {
+        n += select(0u, 1u, picks[k]);
+    }
+    var slot = reserve(n, local);
+    for (var k = 0u; k < ADAPTIVE_STRIP; k++) {
+        if picks[k] {
+            atomicStore(&work[slot], index_of(strip_pixel(id, k)));
+            slot++;
+        }
+    }
+}
+
+@compute @workgroup_size(WORKGROUP_2D, WORKGROUP_2D)
+fn select_pixels(
+    @builtin(global_invocation_id) id: vec3<u32>,
+    @builtin(workgroup_id) group: vec3<u32>,
+    @builtin(local_invocation_index) local: u32,
+) {
+    let origin = vec2<u32>(group.x * WORKGROUP_2D * ADAPTIVE_STRIP, group.y * WORKGROUP_2D);
+    load_pixel_tile(origin, local);
+    var picks: array<bool, ADAPTIVE_STRIP>;
+    for (var k = 0u; k < ADAPTIVE_STRIP; k++) {
+        let p = strip_pixel(id, k);
+        picks[k] = all(p < size()) && bends(origin, p);
+    }
+    list_strip(id, picks, local);
+}
+
+// Which pixels of invocation `id`'s strip have the state `key`.
+fn keyed(id: vec3<u32>, key: u32) -> array<bool, ADAPTIVE_STRIP> {
+    var picks: array<bool, ADAPTIVE_STRIP>;
+    for (var k = 0u; k < ADAPTIVE_STRIP; k++) {
+        let p = strip_pixel(id, k);
+        picks[k] = all(p < size()) && key_at(index_of(p)) == key;
+    }
+    return picks;
+}
+
+@compute @workgroup_size(WORKGROUP_2D, WORKGROUP_2D)
+fn more(@builtin(global_invocation_id) id: vec3<u32>, @builtin(local_invocation_index) local: u32) {
+    list_strip(id, keyed(id, KEY_MORE), local);
+}
+
+@compute @workgroup_size(WORKGROUP_2D, WORKGROUP_2D)
+fn untraced(@builtin(global_invocation_id) id: vec3<u32>, @builtin(local_invocation_index) local: u32) {
+    list_strip(id, keyed(id, KEY_UNTRACED), local);
+}
