@@ -20,9 +20,10 @@
 //    block whose colour bends only at its own scale is interpolated from its half-blocks;
 // 4. `select_pixels` (in `adaptive_lists.wgsl`, with `more` and `untraced`) lists the pixels
 //    traced whose displayed colour bends across them (the second difference with their
-//    neighbours, along either axis) by the threshold or more, and those on the lens's edge: a one-ray pixel is its box filter's value where colour
-//    changes linearly across it, and the bend estimates how far off it is (Mitchell 1987 drove
-//    supersampling by such local contrast). Where SAMPLES_PER_SIDE > 2 and the threshold is
+//    neighbours, along either axis) by the threshold or more, and those on the lens's edge: a
+//    one-ray pixel is its box filter's value where colour changes linearly across it, and the
+//    bend estimates how far off it is (Mitchell 1987 drove supersampling by such local
+//    contrast). Where SAMPLES_PER_SIDE > 2 and the threshold is
 //    above 0, `trace_samples` first takes 2 × 2 stratified samples of each (`MODE_ESTIMATE`)
 //    and marks those whose half-sample mean differs from the mean by the threshold or more
 //    (Dammertz et al. 2010's error estimate); `more` lists those. The last list's pixels take

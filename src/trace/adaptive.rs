@@ -253,24 +253,28 @@ impl AdaptivePass {
             };
             // The per-pixel listers' file imports wgsl/adaptive.wgsl; with ray queries it is
             // composed as adaptive_rq.wgsl composes that.
-            let mut swaps = source.swaps().to_vec();
+            let mut lister_swaps = source.swaps().to_vec();
             if scene.ray_query.is_some() {
-                swaps.push(("bvh", "bvh_rq"));
+                lister_swaps.push(("bvh", "bvh_rq"));
             }
             let side = trace.samples_per_side();
-            let in_file = |file: &str, entry: &str, mode: u32, lanes: u32, level: u32| {
+            let in_file = |(file, swaps): (&str, &[(&str, &str)]),
+                           entry: &str,
+                           mode: u32,
+                           lanes: u32,
+                           level: u32| {
                 let mut constants = trace.constants().to_vec();
                 constants.push(("LIST_MODE", f64::from(mode)));
                 constants.push(("SAMPLE_LANES", f64::from(lanes)));
                 constants.push(("LEVEL", f64::from(level)));
-                let composed = (&scene.arrays, swaps.as_slice());
+                let composed = (&scene.arrays, swaps);
                 shader::scene_pipeline(device, file, composed, entry, &constants, &layouts)
             };
             let leveled = |entry: &str, mode: u32, lanes: u32, level: u32| {
-                in_file(file, entry, mode, lanes, level)
+                in_file((file, source.swaps()), entry, mode, lanes, level)
             };
             let kernel = |entry: &str, mode: u32, lanes: u32| leveled(entry, mode, lanes, 0);
-            let lister = |entry: &str| in_file("adaptive_lists", entry, 0, 1, 0);
+            let lister = |entry: &str| in_file(("adaptive_lists", &lister_swaps), entry, 0, 1, 0);
             let builders = [
                 kernel("classify", 0, 1),
                 kernel("midpoints", 0, 1),
