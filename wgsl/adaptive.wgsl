@@ -9,10 +9,12 @@
 // 2. `classify` looks at each block's four corners (Whitted 1980 subdivided a pixel whose
 //    corners disagree): where they agree (the same surface, normals and tangent planes, and
 //    displayed colour along each edge that bends by less than the threshold, see `bend`) and
-//    the lens covers every pixel, the block's other pixels are interpolated bilinearly between
-//    the corners in linear radiance, so no interpolation crosses a change of surface or a depth
-//    step. `midpoints` lists the half-blocks' corners in the other blocks, the midpoints of
-//    their edges and their centres, and `trace_list` traces them;
+//    the lens covers every pixel, the block's other pixels are interpolated between the
+//    corners in linear radiance (bicubically through the ring of lattice points beyond them
+//    where those see the same surface, see `catmull_rom`; else bilinearly), so no
+//    interpolation crosses a change of surface or a depth step. `midpoints` (in
+//    `adaptive_lists.wgsl`) lists the half-blocks' corners in the other blocks, the midpoints of their edges and their
+//    centres, and `trace_list` traces them;
 // 3. `classify` at level 1 does the same for the half-blocks of those blocks, and the pixels
 //    of the half-blocks whose corners disagree are listed and traced: rays subdivide where the
 //    image changes, as Painter and Sloan (1989) and Thomas, Netravali and Fox (1989) refined a
@@ -452,6 +454,51 @@ fn edge_bend(origin: vec2<u32>, a: vec2<u32>, b: vec2<u32>) -> f32 {
     return bend(cb, tile_shown[ta], tile_shown[tb], ca, has);
 }
 
+// Whether the 4 × 4 lattice points around the level-0 block at lattice point `l` (its
+// corners and the ring beyond, in the tile of the workgroup at `origin`) are evenly spaced and
+// see the material and instance that its corners see (`key`): then a bicubic through them
+// interpolates the block. Its corners agree already, and the ring's points on the lines of its
+// edges are those `edge_bend` weighed, so no step in colour lies among them either; the
+// interpolant is kept within the corners' colours, so a crease or a depth step on one material
+// beyond the block bends it no further than bilinear interpolation could.
+fn smooth_around(origin: vec2<u32>, l: vec2<u32>, key: u32) -> bool {
+    let first = vec2<i32>(l) - 1;
+    let last = vec2<i32>(level_lattice()) - 1;
+    if any(first < vec2<i32>(0)) || any(first + 3 > last) {
+        return false;
+    }
+    // The image's last row and column of lattice points may lie nearer than the spacing.
+    let across = lattice_pixel(vec2<u32>(first + 3)) - lattice_pixel(vec2<u32>(first));
+    if any(across != vec2<u32>(3u * spacing())) {
+        return false;
+    }
+    let top = tile_index(origin, first);
+    for (var k = 0u; k < 16u; k++) {
+        if tile_corner[top + (k / 4u) * TILE + k % 4u].key != key {
+            return false;
+        }
+    }
+    return true;
+}
+
+// The weights of the points at -1, 0, 1 and 2 for a point at `t` in [0, 1] on the Catmull-Rom
+// spline through them: Keys's cubic convolution with a = -1/2 ("Cubic convolution
+// interpolation for digital image processing", 1981), which reproduces quadratics, so its
+// error falls as h³ where linear interpolation's falls as h²; its slope is continuous across
+// the blocks' edges, where bilinear interpolation's kinks (which ꟻLIP sees as edges).
+fn catmull_rom(t: f32) -> vec4<f32> {
+    let t2 = t * t;
+    let t3 = t2 * t;
+    return 0.5 * vec4<f32>(-t3 + 2.0 * t2 - t, 3.0 * t3 - 5.0 * t2 + 2.0, -3.0 * t3 + 4.0 * t2 + t, t3 - t2);
+}
+
+// The spline with weights `w` down the column of four lattice points whose top one is tile
+// entry `top`, in linear radiance.
+fn column(top: u32, w: vec4<f32>) -> vec3<f32> {
+    return w.x * tile_colour[top].rgb + w.y * tile_colour[top + TILE].rgb
+        + w.z * tile_colour[top + 2u * TILE].rgb + w.w * tile_colour[top + 3u * TILE].rgb;
+}
+
 // Whether the lens gives a ray to every pixel of the block from `first` to `end` (exclusive),
 // or (with `covered` false) to none.
 fn block_mask_is(first: vec2<u32>, end: vec2<u32>, covered: bool) -> bool {
@@ -559,7 +606,39 @@ fn classify(
     }
     let span = vec2<f32>(max(far - first, vec2<u32>(1u)));
     let all_masked = tile_corner[t00].key == KEY_MASKED;
+    let interpolated = !refine && !all_masked;
+    // Level 1 keeps the bilinear: measured on lavapipe (the Cornell box, 256 × 192), a spline
+    // there too (half-blocks beside edges, whose rings are mostly interpolated) lowered ꟻLIP
+    // by 1-2 % more and cost the level a tenth more time.
+    let spline = LEVEL == 0u && interpolated && smooth_around(origin, l, tile_corner[t00].key);
+    // The tile entry of the first of the 4 × 4 points around the block.
+    let ring = tile_index(origin, vec2<i32>(l) - 1);
+    // The spline is kept within the block's corners' colours, as the bilinear is.
+    let c00 = tile_colour[t00].rgb;
+    let c10 = tile_colour[t10].rgb;
+    let c01 = tile_colour[t01].rgb;
+    let c11 = tile_colour[t11].rgb;
+    let low = min(min(c00, c10), min(c01, c11));
+    let high = max(max(c00, c10), max(c01, c11));
     for (var y = first.y; y < end.y; y++) {
+        // The interpolant down each column of lattice points at this row, then across them at
+        // each pixel: the bicubic (Catmull-Rom splines down the four columns, then across), or
+        // the bilinear (lines down the block's two sides, then across).
+        var down0 = vec3<f32>(0.0);
+        var down1 = vec3<f32>(0.0);
+        var down2 = vec3<f32>(0.0);
+        var down3 = vec3<f32>(0.0);
+        let fy = f32(y - first.y) / span.y;
+        if spline {
+            let w = catmull_rom(fy);
+            down0 = column(ring, w);
+            down1 = column(ring + 1u, w);
+            down2 = column(ring + 2u, w);
+            down3 = column(ring + 3u, w);
+        } else if interpolated {
+            down1 = mix(c00, c01, fy);
+            down2 = mix(c10, c11, fy);
+        }
         for (var x = first.x; x < end.x; x++) {
             let p = vec2<u32>(x, y);
             if is_lattice(p) || (refine && LEVEL == 0u) {
@@ -578,52 +657,14 @@ fn classify(
                 set_state(i, 0u, KEY_MASKED);
                 continue;
             }
-            let f = vec2<f32>(p - first) / span;
-            let top = mix(tile_colour[t00], tile_colour[t10], f.x);
-            let bottom = mix(tile_colour[t01], tile_colour[t11], f.x);
-            colour_out[i] = vec4<f32>(mix(top, bottom, f.y).rgb, 1.0);
+            let fx = f32(x - first.x) / span.x;
+            var c = mix(down1, down2, fx);
+            if spline {
+                let w = catmull_rom(fx);
+                c = clamp(w.x * down0 + w.y * down1 + w.z * down2 + w.w * down3, low, high);
+            }
+            colour_out[i] = vec4<f32>(c, 1.0);
             set_state(i, 0u, KEY_UNTRACED);
-        }
-    }
-}
-
-// Lists the midpoints that the blocks refined at level 0 need: the half-blocks' corners that
-// are not the blocks' (an invocation a block). Each pixel belongs to the one block whose
-// half-open square holds it, and that block lists it: its centre where it was refined, the
-// midpoints of its top and left edges where it or the block across that edge was, and those of
-// its bottom and right edges where no block lies beyond them (the image's last row or column)
-// and it was refined. So each midpoint is listed once, and a block interpolated at level 0
-// beside a refined one gets the traced midpoint on their shared edge.
-@compute @workgroup_size(WORKGROUP_2D, WORKGROUP_2D)
-fn midpoints(@builtin(global_invocation_id) id: vec3<u32>, @builtin(local_invocation_index) local: u32) {
-    let b = id.xy;
-    // The centre, the top, left, bottom and right midpoints, and whether each is listed.
-    var points: array<vec2<u32>, 5>;
-    var picks = array<bool, 5>();
-    if all(b < adaptive.blocks) {
-        let first = b * ADAPTIVE_BLOCK;
-        let far = min(first + ADAPTIVE_BLOCK, size() - 1u);
-        let mid = first + ADAPTIVE_BLOCK / 2u;
-        let has = mid < far;
-        let refined = refined_at(b);
-        let up = refined || (b.y > 0u && refined_at(b - vec2<u32>(0u, 1u)));
-        let left = refined || (b.x > 0u && refined_at(b - vec2<u32>(1u, 0u)));
-        // No block beyond: this block's square reaches the image's last row or column.
-        let last = (first + ADAPTIVE_BLOCK >= size()) & (far > first);
-        points = array(mid, vec2(mid.x, first.y), vec2(first.x, mid.y), vec2(mid.x, far.y),
-            vec2(far.x, mid.y));
-        picks = array(refined && all(has), has.x && up, has.y && left,
-            has.x && refined && last.y, has.y && refined && last.x);
-    }
-    var n = 0u;
-    for (var i = 0u; i < 5u; i++) {
-        n += select(0u, 1u, picks[i]);
-    }
-    var slot = reserve(n, local);
-    for (var i = 0u; i < 5u; i++) {
-        if picks[i] {
-            atomicStore(&work[slot], index_of(points[i]));
-            slot++;
         }
     }
 }

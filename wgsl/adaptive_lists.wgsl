@@ -1,8 +1,51 @@
-// Adaptive sampling's per-pixel listing kernels (steps 4 and 5 of `adaptive.wgsl`'s header):
-// `select_pixels` lists the traced pixels whose colour bends, `more` those whose estimate asks
-// for every sample, `untraced` the interpolated ones. Each invocation looks at ADAPTIVE_STRIP
-// pixels side by side, so that a workgroup's barriers and global atomic serve more pixels.
+// Adaptive sampling's listing kernels but `classify` (steps 2, 4 and 5 of `adaptive.wgsl`'s
+// header): `midpoints` lists the midpoints of the blocks refined at level 0; `select_pixels`
+// lists the traced pixels whose colour bends, `more` those whose estimate asks for every
+// sample, `untraced` the interpolated ones. Each invocation of the per-pixel listers looks at
+// ADAPTIVE_STRIP pixels side by side, so that a workgroup's barriers and global atomic serve
+// more pixels.
 #import adaptive
+
+// Lists the midpoints that the blocks refined at level 0 need: the half-blocks' corners that
+// are not the blocks' (an invocation a block). Each pixel belongs to the one block whose
+// half-open square holds it, and that block lists it: its centre where it was refined, the
+// midpoints of its top and left edges where it or the block across that edge was, and those of
+// its bottom and right edges where no block lies beyond them (the image's last row or column)
+// and it was refined. So each midpoint is listed once, and a block interpolated at level 0
+// beside a refined one gets the traced midpoint on their shared edge.
+@compute @workgroup_size(WORKGROUP_2D, WORKGROUP_2D)
+fn midpoints(@builtin(global_invocation_id) id: vec3<u32>, @builtin(local_invocation_index) local: u32) {
+    let b = id.xy;
+    // The centre, the top, left, bottom and right midpoints, and whether each is listed.
+    var points: array<vec2<u32>, 5>;
+    var picks = array<bool, 5>();
+    if all(b < adaptive.blocks) {
+        let first = b * ADAPTIVE_BLOCK;
+        let far = min(first + ADAPTIVE_BLOCK, size() - 1u);
+        let mid = first + ADAPTIVE_BLOCK / 2u;
+        let has = mid < far;
+        let refined = refined_at(b);
+        let up = refined || (b.y > 0u && refined_at(b - vec2<u32>(0u, 1u)));
+        let left = refined || (b.x > 0u && refined_at(b - vec2<u32>(1u, 0u)));
+        // No block beyond: this block's square reaches the image's last row or column.
+        let last = (first + ADAPTIVE_BLOCK >= size()) & (far > first);
+        points = array(mid, vec2(mid.x, first.y), vec2(first.x, mid.y), vec2(mid.x, far.y),
+            vec2(far.x, mid.y));
+        picks = array(refined && all(has), has.x && up, has.y && left,
+            has.x && refined && last.y, has.y && refined && last.x);
+    }
+    var n = 0u;
+    for (var i = 0u; i < 5u; i++) {
+        n += select(0u, 1u, picks[i]);
+    }
+    var slot = reserve(n, local);
+    for (var i = 0u; i < 5u; i++) {
+        if picks[i] {
+            atomicStore(&work[slot], index_of(points[i]));
+            slot++;
+        }
+    }
+}
 
 // The second difference of displayed colours `before`, `c`, `after` at `c` (see `bend`); the
 // first difference where only one neighbour exists (`has`), 0 where none does.

@@ -251,8 +251,9 @@ impl AdaptivePass {
                 }
                 None => "adaptive",
             };
-            // The per-pixel listers' file imports wgsl/adaptive.wgsl; with ray queries it is
-            // composed as adaptive_rq.wgsl composes that.
+            // The listers but `classify` are in wgsl/adaptive_lists.wgsl, which imports
+            // wgsl/adaptive.wgsl; with ray queries it is composed as adaptive_rq.wgsl composes
+            // that.
             let mut lister_swaps = source.swaps().to_vec();
             if scene.ray_query.is_some() {
                 lister_swaps.push(("bvh", "bvh_rq"));
@@ -277,7 +278,7 @@ impl AdaptivePass {
             let lister = |entry: &str| in_file(("adaptive_lists", &lister_swaps), entry, 0, 1, 0);
             let builders = [
                 kernel("classify", 0, 1),
-                kernel("midpoints", 0, 1),
+                lister("midpoints"),
                 leveled("classify", 0, 1, 1),
                 lister("select_pixels"),
                 lister("more"),
