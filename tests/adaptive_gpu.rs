@@ -267,13 +267,14 @@ fn a_smooth_scene_is_traced_at_block_corners_only() {
 }
 
 /// The same plane under a nearer light, whose falloff bends the colour within a block, at
-/// threshold 1 (every block interpolated, no colour test): each block whose ring of lattice
-/// points lies a whole spacing out inside the image takes the bicubic through its 4 × 4
-/// lattice points (Catmull-Rom down the columns, then across; kept within its corners'
-/// colours), every other block the bilinear between its corners, as computed here in f64 from
-/// the one-ray image's lattice pixels. The width, 67, puts the last lattice column 2 pixels
-/// from the one before: the blocks whose ring reaches it are bilinear. And the bicubic is
-/// nearer the one-ray image than the bilinear through the same corners would be.
+/// threshold 1 (every block interpolated, no colour test): each block takes the bicubic
+/// through its 4 × 4 lattice points (Catmull-Rom splines down the columns, then across; kept
+/// within its corners' colours), where a point of its ring lies outside the image or not a
+/// whole spacing on (the width, 67, puts the last lattice column 2 pixels from the one before)
+/// the line through the block's own points continued instead, and a block shorter than the
+/// spacing none of its ring (so bilinearly): as computed here in f64 from the one-ray image's
+/// lattice pixels. And where the whole ring is there, the bicubic is nearer the one-ray image
+/// than the bilinear through the same corners would be.
 #[test]
 fn smooth_blocks_are_interpolated_bicubically() {
     let plane = lit_plane(
@@ -288,15 +289,6 @@ fn smooth_blocks_are_interpolated_bicubically() {
     let one = uniform(&gpu, &cam, 1);
     let (out, rays) = adaptive(&gpu, &cam, 1, 1.0, false);
     let block = ADAPTIVE_BLOCK as usize;
-    let lattice = |n: usize| -> Vec<usize> {
-        let mut points: Vec<usize> = (0..n).step_by(block).collect();
-        if *points.last().unwrap() != n - 1 {
-            points.push(n - 1);
-        }
-        points
-    };
-    let (xs, ys) = (lattice(w), lattice(h));
-    let colour = |x: usize, y: usize, k: usize| f64::from(one.colour[y * w + x][k]);
     // Catmull-Rom weights of the points at -1, 0, 1, 2 at t in [0, 1] (Keys 1981, a = -1/2).
     let weights = |t: f64| {
         [
@@ -306,69 +298,80 @@ fn smooth_blocks_are_interpolated_bicubically() {
             (t * t * t - t * t) / 2.0,
         ]
     };
-    let (mut bicubic, mut bilinear) = (0, 0);
+    // The spline through four points, an end that is not there (None) replaced by the line
+    // through the middle two continued.
+    let spline = |t: f64, p: [Option<f64>; 4]| {
+        let (b, c) = (p[1].unwrap(), p[2].unwrap());
+        let ends = [p[0].unwrap_or(2.0 * b - c), p[3].unwrap_or(2.0 * c - b)];
+        let w = weights(t);
+        w[0] * ends[0] + w[1] * b + w[2] * c + w[3] * ends[1]
+    };
+    // A block's lattice coordinates along an axis of `n` pixels: from `first` to its far
+    // corner (the image's last pixel where it is nearer than a block), then the points either
+    // side, where they are in the image, on the lattice and a whole block on, and the block
+    // itself is whole.
+    let points = |first: usize, n: usize| -> [Option<usize>; 4] {
+        let far = (first + block).min(n - 1);
+        let whole = far - first == block;
+        let ring = |q: Option<usize>| q.filter(|&q| whole && q < n && q % block == 0);
+        [
+            ring(first.checked_sub(block)),
+            Some(first),
+            Some(far),
+            ring(Some(far + block)),
+        ]
+    };
+    let is_lattice = |v: usize, n: usize| v % block == 0 || v == n - 1;
+    let (mut whole, mut partial) = (0, 0);
     let (mut cubic_error, mut linear_error) = (0.0f64, 0.0f64);
-    for (j, pair_y) in ys.windows(2).enumerate() {
-        for (i, pair_x) in xs.windows(2).enumerate() {
-            let (x0, x1, y0, y1) = (pair_x[0], pair_x[1], pair_y[0], pair_y[1]);
-            let even = |points: &[usize], first: usize| {
-                first >= 1
-                    && first + 2 < points.len()
-                    && points[first + 2] - points[first - 1] == 3 * block
-            };
-            let cubic = even(&xs, i) && even(&ys, j);
-            let x_end = if x1 == w - 1 { x1 + 1 } else { x1 };
-            let y_end = if y1 == h - 1 { y1 + 1 } else { y1 };
-            for y in y0..y_end {
-                for x in x0..x_end {
+    for y0 in (0..h).step_by(block) {
+        for x0 in (0..w).step_by(block) {
+            let (columns, rows) = (points(x0, w), points(y0, h));
+            let (x1, y1) = (columns[2].unwrap(), rows[2].unwrap());
+            let ring = columns.iter().chain(&rows).all(Option::is_some);
+            for y in y0..(y0 + block).min(h) {
+                for x in x0..(x0 + block).min(w) {
                     let p = y * w + x;
-                    if xs.contains(&x) && ys.contains(&y) {
+                    if is_lattice(x, w) && is_lattice(y, h) {
                         assert_eq!(rays[p], 1, "lattice pixel ({x}, {y}) traced");
                         assert_eq!(out.colour[p], one.colour[p], "lattice pixel ({x}, {y})");
                         continue;
                     }
                     assert_eq!(rays[p], 0, "pixel ({x}, {y}) interpolated");
-                    let u = (x - x0) as f64 / (x1 - x0) as f64;
-                    let v = (y - y0) as f64 / (y1 - y0) as f64;
+                    let u = (x - x0) as f64 / (x1 - x0).max(1) as f64;
+                    let v = (y - y0) as f64 / (y1 - y0).max(1) as f64;
                     for k in 0..3 {
+                        let colour = |x: usize, y: usize| f64::from(one.colour[y * w + x][k]);
+                        let down = columns.map(|column| {
+                            let column = column?;
+                            Some(spline(v, rows.map(|row| row.map(|y| colour(column, y)))))
+                        });
                         let corners =
-                            [(x0, y0), (x1, y0), (x0, y1), (x1, y1)].map(|(x, y)| colour(x, y, k));
-                        let linear = (corners[0] * (1.0 - u) + corners[1] * u) * (1.0 - v)
-                            + (corners[2] * (1.0 - u) + corners[3] * u) * v;
-                        let expected = if cubic {
-                            let (wu, wv) = (weights(u), weights(v));
-                            let mut sum = 0.0;
-                            for (b, wy) in wv.iter().enumerate() {
-                                for (a, wx) in wu.iter().enumerate() {
-                                    sum += wy * wx * colour(xs[i + a - 1], ys[j + b - 1], k);
-                                }
-                            }
-                            let low = corners.iter().copied().fold(f64::INFINITY, f64::min);
-                            let high = corners.iter().copied().fold(0.0, f64::max);
-                            sum.clamp(low, high)
-                        } else {
-                            linear
-                        };
+                            [(x0, y0), (x1, y0), (x0, y1), (x1, y1)].map(|(x, y)| colour(x, y));
+                        let low = corners.iter().copied().fold(f64::INFINITY, f64::min);
+                        let high = corners.iter().copied().fold(0.0, f64::max);
+                        let expected = spline(u, down).clamp(low, high);
                         let got = f64::from(out.colour[p][k]);
                         assert!(
                             (got - expected).abs() <= 1e-5 * expected.max(1.0),
-                            "pixel ({x}, {y}) channel {k}: {got} against {expected} ({})",
-                            if cubic { "bicubic" } else { "bilinear" }
+                            "pixel ({x}, {y}) channel {k}: {got} against {expected}"
                         );
-                        if cubic {
-                            let traced = colour(x, y, k);
+                        if ring {
+                            let linear = (corners[0] * (1.0 - u) + corners[1] * u) * (1.0 - v)
+                                + (corners[2] * (1.0 - u) + corners[3] * u) * v;
+                            let traced = colour(x, y);
                             cubic_error = cubic_error.max((got - traced).abs());
                             linear_error = linear_error.max((linear - traced).abs());
                         }
                     }
-                    if cubic { bicubic += 1 } else { bilinear += 1 }
+                    if ring { whole += 1 } else { partial += 1 }
                 }
             }
         }
     }
     assert!(
-        bicubic > 1000 && bilinear > 300,
-        "{bicubic} bicubic, {bilinear} bilinear pixels"
+        whole > 1000 && partial > 300,
+        "{whole} pixels in blocks with their whole ring, {partial} in others"
     );
     assert!(
         cubic_error < 0.5 * linear_error,

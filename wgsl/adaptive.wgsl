@@ -454,31 +454,36 @@ fn edge_bend(origin: vec2<u32>, a: vec2<u32>, b: vec2<u32>) -> f32 {
     return bend(cb, tile_shown[ta], tile_shown[tb], ca, has);
 }
 
-// Whether the 4 × 4 lattice points around the level-0 block at lattice point `l` (its
-// corners and the ring beyond, in the tile of the workgroup at `origin`) are evenly spaced and
-// see the material and instance that its corners see (`key`): then a bicubic through them
-// interpolates the block. Its corners agree already, and the ring's points on the lines of its
-// edges are those `edge_bend` weighed, so no step in colour lies among them either; the
-// interpolant is kept within the corners' colours, so a crease or a depth step on one material
-// beyond the block bends it no further than bilinear interpolation could.
-fn smooth_around(origin: vec2<u32>, l: vec2<u32>, key: u32) -> bool {
-    let first = vec2<i32>(l) - 1;
+// Which of the 4 × 4 lattice points around the level-0 block from lattice point `l` to `l11`
+// (its corners, and the ring beyond them, in the tile of the workgroup at `origin`) a spline
+// may pass through: bit 4y + x. The corners always; a point of the ring where it lies in the
+// image, sees the material and instance that the corners see (`key`), and along each axis is
+// the block's own or a whole spacing on from the next (the image's last row and column of
+// lattice points may lie nearer: along an axis where the block itself is short, only its own).
+fn spline_points(origin: vec2<u32>, l: vec2<u32>, l11: vec2<u32>, key: u32) -> u32 {
     let last = vec2<i32>(level_lattice()) - 1;
-    if any(first < vec2<i32>(0)) || any(first + 3 > last) {
-        return false;
-    }
-    // The image's last row and column of lattice points may lie nearer than the spacing.
-    let across = lattice_pixel(vec2<u32>(first + 3)) - lattice_pixel(vec2<u32>(first));
-    if any(across != vec2<u32>(3u * spacing())) {
-        return false;
-    }
-    let top = tile_index(origin, first);
+    let step = i32(spacing());
+    let corner = vec2<i32>(lattice_pixel(l));
+    let whole = vec2<i32>(lattice_pixel(l11)) - corner == vec2<i32>(step);
+    var points = 0u;
     for (var k = 0u; k < 16u; k++) {
-        if tile_corner[top + (k / 4u) * TILE + k % 4u].key != key {
-            return false;
+        let d = vec2<i32>(i32(k % 4u), i32(k / 4u)) - 1;
+        let own = (d == vec2<i32>(0)) | (d == vec2<i32>(1));
+        // Along a short axis (the image's last row or column) the far corner is `l11`.
+        let q = select(vec2<i32>(l) + d, vec2<i32>(l11) + d - 1, d >= vec2<i32>(1));
+        if all(own) {
+            points |= 1u << k;
+            continue;
+        }
+        if !all(own | whole) || any(q < vec2<i32>(0)) || any(q > last) {
+            continue;
+        }
+        let even = all(own | (vec2<i32>(lattice_pixel(vec2<u32>(q))) - corner == d * step));
+        if even && tile_corner[tile_index(origin, q)].key == key {
+            points |= 1u << k;
         }
     }
-    return true;
+    return points;
 }
 
 // The weights of the points at -1, 0, 1 and 2 for a point at `t` in [0, 1] on the Catmull-Rom
@@ -492,11 +497,30 @@ fn catmull_rom(t: f32) -> vec4<f32> {
     return 0.5 * vec4<f32>(-t3 + 2.0 * t2 - t, 3.0 * t3 - 5.0 * t2 + 2.0, -3.0 * t3 + 4.0 * t2 + t, t3 - t2);
 }
 
-// The spline with weights `w` down the column of four lattice points whose top one is tile
-// entry `top`, in linear radiance.
-fn column(top: u32, w: vec4<f32>) -> vec3<f32> {
-    return w.x * tile_colour[top].rgb + w.y * tile_colour[top + TILE].rgb
-        + w.z * tile_colour[top + 2u * TILE].rgb + w.w * tile_colour[top + 3u * TILE].rgb;
+// The spline with weights `w` through `a`, `b`, `c`, `d`, where an end the spline may not pass
+// through (`has` false) is replaced by the line through the middle two continued (2b - a, as
+// Keys does past an image's edge): with neither end, the weights sum to linear interpolation
+// between `b` and `c`.
+fn spline(w: vec4<f32>, a: vec3<f32>, b: vec3<f32>, c: vec3<f32>, d: vec3<f32>, has: vec2<bool>) -> vec3<f32> {
+    let before = select(2.0 * b - c, a, has.x);
+    let after = select(2.0 * c - b, d, has.y);
+    return w.x * before + w.y * b + w.z * c + w.w * after;
+}
+
+// `spline` down column `x` (0 to 3) of the 4 × 4 points (`spline_points`, whose bits are
+// `points`), whose points beside the block are tile entries `at` (its first row) and `below`
+// (its last); the column's ends are read only where the spline may pass through them.
+fn column(at: u32, below: u32, x: u32, w: vec4<f32>, points: u32) -> vec3<f32> {
+    let has = vec2<bool>((points & (1u << x)) != 0u, (points & (1u << (12u + x))) != 0u);
+    var a = vec3<f32>(0.0);
+    var d = vec3<f32>(0.0);
+    if has.x {
+        a = tile_colour[at - TILE].rgb;
+    }
+    if has.y {
+        d = tile_colour[below + TILE].rgb;
+    }
+    return spline(w, a, tile_colour[at].rgb, tile_colour[below].rgb, d, has);
 }
 
 // Whether the lens gives a ray to every pixel of the block from `first` to `end` (exclusive),
@@ -610,9 +634,13 @@ fn classify(
     // Level 1 keeps the bilinear: measured on lavapipe (the Cornell box, 256 × 192), a spline
     // there too (half-blocks beside edges, whose rings are mostly interpolated) lowered ꟻLIP
     // by 1-2 % more and cost the level a tenth more time.
-    let spline = LEVEL == 0u && interpolated && smooth_around(origin, l, tile_corner[t00].key);
-    // The tile entry of the first of the 4 × 4 points around the block.
-    let ring = tile_index(origin, vec2<i32>(l) - 1);
+    var points = 0u;
+    if LEVEL == 0u && interpolated {
+        points = spline_points(origin, l, l11, tile_corner[t00].key);
+    }
+    // The ring's columns either side of the block, where both their points beside it may be
+    // used (else the spline across continues the line through the block's columns).
+    let sides = vec2<bool>((points & 0x110u) == 0x110u, (points & 0x880u) == 0x880u);
     // The spline is kept within the block's corners' colours, as the bilinear is.
     let c00 = tile_colour[t00].rgb;
     let c10 = tile_colour[t10].rgb;
@@ -623,18 +651,22 @@ fn classify(
     for (var y = first.y; y < end.y; y++) {
         // The interpolant down each column of lattice points at this row, then across them at
         // each pixel: the bicubic (Catmull-Rom splines down the four columns, then across), or
-        // the bilinear (lines down the block's two sides, then across).
+        // at level 1 the bilinear (lines down the block's two sides, then across).
         var down0 = vec3<f32>(0.0);
         var down1 = vec3<f32>(0.0);
         var down2 = vec3<f32>(0.0);
         var down3 = vec3<f32>(0.0);
         let fy = f32(y - first.y) / span.y;
-        if spline {
+        if LEVEL == 0u && interpolated {
             let w = catmull_rom(fy);
-            down0 = column(ring, w);
-            down1 = column(ring + 1u, w);
-            down2 = column(ring + 2u, w);
-            down3 = column(ring + 3u, w);
+            if sides.x {
+                down0 = column(t00 - 1u, t01 - 1u, 0u, w, points);
+            }
+            down1 = column(t00, t01, 1u, w, points);
+            down2 = column(t10, t11, 2u, w, points);
+            if sides.y {
+                down3 = column(t10 + 1u, t11 + 1u, 3u, w, points);
+            }
         } else if interpolated {
             down1 = mix(c00, c01, fy);
             down2 = mix(c10, c11, fy);
@@ -659,9 +691,8 @@ fn classify(
             }
             let fx = f32(x - first.x) / span.x;
             var c = mix(down1, down2, fx);
-            if spline {
-                let w = catmull_rom(fx);
-                c = clamp(w.x * down0 + w.y * down1 + w.z * down2 + w.w * down3, low, high);
+            if LEVEL == 0u {
+                c = clamp(spline(catmull_rom(fx), down0, down1, down2, down3, sides), low, high);
             }
             colour_out[i] = vec4<f32>(c, 1.0);
             set_state(i, 0u, KEY_UNTRACED);
