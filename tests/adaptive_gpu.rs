@@ -313,7 +313,7 @@ fn smooth_blocks_are_interpolated_bicubically() {
     let points = |first: usize, n: usize| -> [Option<usize>; 4] {
         let far = (first + block).min(n - 1);
         let whole = far - first == block;
-        let ring = |q: Option<usize>| q.filter(|&q| whole && q < n && q % block == 0);
+        let ring = |q: Option<usize>| q.filter(|&q| whole && q < n && q.is_multiple_of(block));
         [
             ring(first.checked_sub(block)),
             Some(first),
@@ -321,7 +321,7 @@ fn smooth_blocks_are_interpolated_bicubically() {
             ring(Some(far + block)),
         ]
     };
-    let is_lattice = |v: usize, n: usize| v % block == 0 || v == n - 1;
+    let is_lattice = |v: usize, n: usize| v.is_multiple_of(block) || v == n - 1;
     let (mut whole, mut partial) = (0, 0);
     let (mut cubic_error, mut linear_error) = (0.0f64, 0.0f64);
     for y0 in (0..h).step_by(block) {
