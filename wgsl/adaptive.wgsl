@@ -10,16 +10,18 @@
 //    corners disagree): where they agree (the same surface, normals and tangent planes, and
 //    displayed colour along each edge that bends by less than the threshold, see `bend`) and
 //    the lens covers every pixel, the block's other pixels are interpolated between the
-//    corners in linear radiance (bicubically through the ring of lattice points beyond them
-//    where those see the same surface, see `catmull_rom`; else bilinearly), so no
-//    interpolation crosses a change of surface or a depth step. `midpoints` (in
-//    `adaptive_lists.wgsl`) lists the half-blocks' corners in the other blocks, the midpoints of their edges and their
-//    centres, and `trace_list` traces them;
-// 3. `classify` at level 1 does the same for the half-blocks of those blocks, and the pixels
-//    of the half-blocks whose corners disagree are listed and traced: rays subdivide where the
-//    image changes, as Painter and Sloan (1989) and Thomas, Netravali and Fox (1989) refined a
-//    coarse sampling level by level, so an edge takes a band of rays half a block wide, and a
-//    block whose colour bends only at its own scale is interpolated from its half-blocks;
+//    corners in linear radiance, bicubically (Catmull-Rom splines through the corners and the
+//    ring of lattice points beyond them, a point of the ring on another surface replaced by a
+//    line: `spline_points`, `catmull_rom`), so no interpolation crosses a change of surface or
+//    a depth step. `midpoints` (in `adaptive_lists.wgsl`) lists the half-blocks' corners in
+//    the other blocks, the midpoints of their edges and their centres, and `trace_list`
+//    traces them;
+// 3. `classify` at level 1 does the same for the half-blocks of those blocks (interpolating
+//    bilinearly), and the pixels of the half-blocks whose corners disagree are listed and
+//    traced: rays subdivide where the image changes, as Painter and Sloan (1989) and Thomas,
+//    Netravali and Fox (1989) refined a coarse sampling level by level, so an edge takes a
+//    band of rays half a block wide, and a block whose colour bends only at its own scale is
+//    interpolated from its half-blocks;
 // 4. `select_pixels` (in `adaptive_lists.wgsl`, with `more` and `untraced`) lists the pixels
 //    traced whose displayed colour bends across them (the second difference with their
 //    neighbours, along either axis) by the threshold or more, and those on the lens's edge: a
@@ -497,19 +499,17 @@ fn catmull_rom(t: f32) -> vec4<f32> {
     return 0.5 * vec4<f32>(-t3 + 2.0 * t2 - t, 3.0 * t3 - 5.0 * t2 + 2.0, -3.0 * t3 + 4.0 * t2 + t, t3 - t2);
 }
 
-// The spline with weights `w` through `a`, `b`, `c`, `d`, where an end the spline may not pass
-// through (`has` false) is replaced by the line through the middle two continued (2b - a, as
-// Keys does past an image's edge): with neither end, the weights sum to linear interpolation
-// between `b` and `c`.
+// The spline with weights `w` through `a`, `b`, `c`, `d`, an end it may not pass through (`has`
+// false) replaced by the line through the middle two continued (2b - c, as Keys does past an
+// image's edge): with neither end, it is the linear interpolation between `b` and `c`.
 fn spline(w: vec4<f32>, a: vec3<f32>, b: vec3<f32>, c: vec3<f32>, d: vec3<f32>, has: vec2<bool>) -> vec3<f32> {
     let before = select(2.0 * b - c, a, has.x);
     let after = select(2.0 * c - b, d, has.y);
     return w.x * before + w.y * b + w.z * c + w.w * after;
 }
 
-// `spline` down column `x` (0 to 3) of the 4 × 4 points (`spline_points`, whose bits are
-// `points`), whose points beside the block are tile entries `at` (its first row) and `below`
-// (its last); the column's ends are read only where the spline may pass through them.
+// `spline` down column `x` of the 4 × 4 points (`spline_points`: `points`), from tile entries
+// `at` and `below` beside the block; its ends are read only where the spline may use them.
 fn column(at: u32, below: u32, x: u32, w: vec4<f32>, points: u32) -> vec3<f32> {
     let has = vec2<bool>((points & (1u << x)) != 0u, (points & (1u << (12u + x))) != 0u);
     var a = vec3<f32>(0.0);
@@ -631,9 +631,8 @@ fn classify(
     let span = vec2<f32>(max(far - first, vec2<u32>(1u)));
     let all_masked = tile_corner[t00].key == KEY_MASKED;
     let interpolated = !refine && !all_masked;
-    // Level 1 keeps the bilinear: measured on lavapipe (the Cornell box, 256 × 192), a spline
-    // there too (half-blocks beside edges, whose rings are mostly interpolated) lowered ꟻLIP
-    // by 1-2 % more and cost the level a tenth more time.
+    // Level 1 stays bilinear: a spline there too lowered ꟻLIP by 1-2 % more for a tenth more
+    // of the level's time (lavapipe, the Cornell box; most of its rings are interpolated).
     var points = 0u;
     if LEVEL == 0u && interpolated {
         points = spline_points(origin, l, l11, tile_corner[t00].key);
@@ -650,8 +649,7 @@ fn classify(
     let high = max(max(c00, c10), max(c01, c11));
     for (var y = first.y; y < end.y; y++) {
         // The interpolant down each column of lattice points at this row, then across them at
-        // each pixel: the bicubic (Catmull-Rom splines down the four columns, then across), or
-        // at level 1 the bilinear (lines down the block's two sides, then across).
+        // each pixel: splines down the four columns (level 0), or lines down the block's sides.
         var down0 = vec3<f32>(0.0);
         var down1 = vec3<f32>(0.0);
         var down2 = vec3<f32>(0.0);
