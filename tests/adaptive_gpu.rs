@@ -57,19 +57,30 @@ fn adaptive_stages(
 
 /// The plane z = 0 from -`half` to `half` in x and y (to 20 at most in y) under one point
 /// light (`light`: its position and intensity, TOML), black ambient and sky, seen from
-/// `camera` (its position and look-at point, TOML), through the scene loader.
-fn lit_plane(tag: &str, half: f64, camera: &str, light: &str) -> Scene {
+/// `camera` (its position and look-at point, TOML), through the scene loader. With `split`,
+/// its halves x < 0 and x > 0 are of two materials (diffuse 0.8 and 0.5).
+fn lit_plane(tag: &str, half: f64, camera: &str, light: &str, split: bool) -> Scene {
     let dir = std::env::temp_dir().join(format!("fisheye-{tag}-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let far = half.min(20.0);
-    std::fs::write(
-        dir.join("plane.obj"),
+    let obj = if split {
+        std::fs::write(
+            dir.join("plane.mtl"),
+            "newmtl light\nKd 0.8 0.8 0.8\nnewmtl dark\nKd 0.5 0.5 0.5\n",
+        )
+        .unwrap();
+        format!(
+            "mtllib plane.mtl\nv -{half} -{half} 0\nv 0 -{half} 0\nv 0 {far} 0\nv -{half} {far} 0\n\
+             v {half} -{half} 0\nv {half} {far} 0\nusemtl light\nf 1 2 3\nf 1 3 4\n\
+             usemtl dark\nf 2 5 6\nf 2 6 3\n"
+        )
+    } else {
         format!(
             "v -{half} -{half} 0\nv {half} -{half} 0\nv {half} {far} 0\nv -{half} {far} 0\n\
              f 1 2 3\nf 1 3 4\n"
-        ),
-    )
-    .unwrap();
+        )
+    };
+    std::fs::write(dir.join("plane.obj"), obj).unwrap();
     std::fs::write(
         dir.join("plane.toml"),
         format!(
@@ -218,6 +229,7 @@ fn a_smooth_scene_is_traced_at_block_corners_only() {
         20.0,
         "position = [0.0, 0.0, 3.0]\nlook_at = [0.0, 0.0, 0.0]",
         "position = [10.0, 6.0, 40.0]\nintensity = [1200.0, 1200.0, 1200.0]",
+        false,
     );
     let gpu = upload(&plane);
     let (w, h) = (65, 49);
@@ -266,28 +278,33 @@ fn a_smooth_scene_is_traced_at_block_corners_only() {
     );
 }
 
-/// The same plane under a nearer light, whose falloff bends the colour within a block, at
-/// threshold 1 (every block interpolated, no colour test): each block takes the bicubic
-/// through its 4 × 4 lattice points (Catmull-Rom splines down the columns, then across; kept
-/// within its corners' colours), where a point of its ring lies outside the image or not a
-/// whole spacing on (the width, 67, puts the last lattice column 2 pixels from the one before)
-/// the line through the block's own points continued instead, and a block shorter than the
-/// spacing none of its ring (so bilinearly): as computed here in f64 from the one-ray image's
-/// lattice pixels. And where the whole ring is there, the bicubic is nearer the one-ray image
-/// than the bilinear through the same corners would be.
+/// The same plane under a nearer light, whose falloff bends the colour within a block, its
+/// halves of two materials, at threshold 1 (every block whose corners see one material
+/// interpolated, no colour test): each such block takes the bicubic through its 4 × 4 lattice
+/// points (Catmull-Rom splines down the columns, then across; kept within its corners'
+/// colours), where a point of its ring sees the other material, lies outside the image or not
+/// a whole spacing on (the width, 67, puts the last lattice column 2 pixels from the one
+/// before) the line through the block's own points continued instead, and a block shorter than
+/// the spacing none of its ring along that axis: as computed here in f64 from the one-ray
+/// image's lattice pixels. And where the whole ring is there, the bicubic is nearer the one-ray
+/// image than the bilinear through the same corners would be.
 #[test]
 fn smooth_blocks_are_interpolated_bicubically() {
     let plane = lit_plane(
         "bicubic",
         20.0,
-        "position = [0.0, 0.0, 3.0]\nlook_at = [0.0, 0.0, 0.0]",
+        "position = [0.3, 0.0, 3.0]\nlook_at = [0.3, 0.0, 0.0]",
         "position = [1.0, 0.5, 1.5]\nintensity = [6.0, 6.0, 6.0]",
+        true,
     );
     let gpu = upload(&plane);
     let (w, h) = (67usize, 49usize);
     let cam = camera("rectilinear:f=1", w as u32, h as u32);
     let one = uniform(&gpu, &cam, 1);
     let (out, rays) = adaptive(&gpu, &cam, 1, 1.0, false);
+    // The first two triangles are the light half's.
+    let light = |x: usize, y: usize| one.ids[y * w + x] < 2;
+    assert!(one.ids.iter().all(|&id| id < 4), "the plane fills the view");
     let block = ADAPTIVE_BLOCK as usize;
     // Catmull-Rom weights of the points at -1, 0, 1, 2 at t in [0, 1] (Keys 1981, a = -1/2).
     let weights = |t: f64| {
@@ -322,32 +339,53 @@ fn smooth_blocks_are_interpolated_bicubically() {
         ]
     };
     let is_lattice = |v: usize, n: usize| v.is_multiple_of(block) || v == n - 1;
-    let (mut whole, mut partial) = (0, 0);
+    let (mut whole, mut partial, mut across) = (0, 0, 0);
     let (mut cubic_error, mut linear_error) = (0.0f64, 0.0f64);
     for y0 in (0..h).step_by(block) {
         for x0 in (0..w).step_by(block) {
             let (columns, rows) = (points(x0, w), points(y0, h));
             let (x1, y1) = (columns[2].unwrap(), rows[2].unwrap());
-            let ring = columns.iter().chain(&rows).all(Option::is_some);
+            let corners = [(x0, y0), (x1, y0), (x0, y1), (x1, y1)];
+            let material = light(x0, y0);
+            if corners.iter().any(|&(x, y)| light(x, y) != material) {
+                continue; // refined: its pixels are the half-blocks' (level 1)
+            }
+            // Ring point (a, b) of the 4 × 4, where the spline may pass through it.
+            let at = |a: usize, b: usize| -> Option<(usize, usize)> {
+                let (x, y) = (columns[a]?, rows[b]?);
+                let own = (1..3).contains(&a) && (1..3).contains(&b);
+                (own || light(x, y) == material).then_some((x, y))
+            };
+            let ring = (0..16).all(|k| at(k % 4, k / 4).is_some());
+            let other = (0..16).any(|k| {
+                let (x, y) = (columns[k % 4], rows[k / 4]);
+                x.zip(y).is_some_and(|(x, y)| light(x, y) != material)
+            });
             for y in y0..(y0 + block).min(h) {
                 for x in x0..(x0 + block).min(w) {
                     let p = y * w + x;
-                    if is_lattice(x, w) && is_lattice(y, h) {
-                        assert_eq!(rays[p], 1, "lattice pixel ({x}, {y}) traced");
-                        assert_eq!(out.colour[p], one.colour[p], "lattice pixel ({x}, {y})");
+                    if rays[p] == 1 {
+                        // A lattice point, or a midpoint traced for the refined block beside.
+                        assert!(
+                            is_lattice(x, w) && is_lattice(y, h)
+                                || x == x0 + block / 2
+                                || y == y0 + block / 2
+                        );
+                        assert_eq!(out.colour[p], one.colour[p], "traced pixel ({x}, {y})");
                         continue;
                     }
                     assert_eq!(rays[p], 0, "pixel ({x}, {y}) interpolated");
                     let u = (x - x0) as f64 / (x1 - x0).max(1) as f64;
                     let v = (y - y0) as f64 / (y1 - y0).max(1) as f64;
                     for k in 0..3 {
-                        let colour = |x: usize, y: usize| f64::from(one.colour[y * w + x][k]);
-                        let down = columns.map(|column| {
-                            let column = column?;
-                            Some(spline(v, rows.map(|row| row.map(|y| colour(column, y)))))
+                        let colour = |(x, y): (usize, usize)| f64::from(one.colour[y * w + x][k]);
+                        // Down each column whose points beside the block may be used.
+                        let down: [Option<f64>; 4] = std::array::from_fn(|a| {
+                            at(a, 1)?;
+                            at(a, 2)?;
+                            Some(spline(v, std::array::from_fn(|b| at(a, b).map(colour))))
                         });
-                        let corners =
-                            [(x0, y0), (x1, y0), (x0, y1), (x1, y1)].map(|(x, y)| colour(x, y));
+                        let corners = corners.map(colour);
                         let low = corners.iter().copied().fold(f64::INFINITY, f64::min);
                         let high = corners.iter().copied().fold(0.0, f64::max);
                         let expected = spline(u, down).clamp(low, high);
@@ -359,19 +397,27 @@ fn smooth_blocks_are_interpolated_bicubically() {
                         if ring {
                             let linear = (corners[0] * (1.0 - u) + corners[1] * u) * (1.0 - v)
                                 + (corners[2] * (1.0 - u) + corners[3] * u) * v;
-                            let traced = colour(x, y);
+                            let traced = colour((x, y));
                             cubic_error = cubic_error.max((got - traced).abs());
                             linear_error = linear_error.max((linear - traced).abs());
                         }
                     }
-                    if ring { whole += 1 } else { partial += 1 }
+                    if ring {
+                        whole += 1
+                    } else {
+                        partial += 1
+                    }
+                    if other {
+                        across += 1
+                    }
                 }
             }
         }
     }
     assert!(
-        whole > 1000 && partial > 300,
-        "{whole} pixels in blocks with their whole ring, {partial} in others"
+        whole > 1000 && partial > 300 && across > 100,
+        "{whole} pixels in blocks with their whole ring, {partial} in others, {across} in \
+         blocks whose ring sees the other material"
     );
     assert!(
         cubic_error < 0.5 * linear_error,
@@ -392,6 +438,7 @@ fn only_the_half_blocks_an_edge_crosses_are_traced() {
         1000.0,
         "position = [0.0, -19.0, 1.5]\nlook_at = [6.0, 0.0, 1.0]",
         "position = [10.0, 6.0, 400.0]\nintensity = [90000.0, 90000.0, 90000.0]",
+        false,
     );
     let gpu = upload(&plane);
     let (w, h) = (65u32, 49u32);
