@@ -1,0 +1,322 @@
+//! Adaptive sampling on planes made for the purpose: a smooth one traced at its block corners
+//! only and interpolated bicubically, and a straight edge refined only where it crosses.
+
+use super::*;
+
+/// The plane z = 0 from -`half` to `half` in x and y (to 20 at most in y) under one point
+/// light (`light`: its position and intensity, TOML), black ambient and sky, seen from
+/// `camera` (its position and look-at point, TOML), through the scene loader. With `split`,
+/// its halves x < 0 and x > 0 are of two materials (diffuse 0.8 and 0.5).
+fn lit_plane(tag: &str, half: f64, camera: &str, light: &str, split: bool) -> Scene {
+    let dir = std::env::temp_dir().join(format!("fisheye-{tag}-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let far = half.min(20.0);
+    let obj = if split {
+        std::fs::write(
+            dir.join("plane.mtl"),
+            "newmtl light\nKd 0.8 0.8 0.8\nnewmtl dark\nKd 0.5 0.5 0.5\n",
+        )
+        .unwrap();
+        format!(
+            "mtllib plane.mtl\nv -{half} -{half} 0\nv 0 -{half} 0\nv 0 {far} 0\nv -{half} {far} 0\n\
+             v {half} -{half} 0\nv {half} {far} 0\nusemtl light\nf 1 2 3\nf 1 3 4\n\
+             usemtl dark\nf 2 5 6\nf 2 6 3\n"
+        )
+    } else {
+        format!(
+            "v -{half} -{half} 0\nv {half} -{half} 0\nv {half} {far} 0\nv -{half} {far} 0\n\
+             f 1 2 3\nf 1 3 4\n"
+        )
+    };
+    std::fs::write(dir.join("plane.obj"), obj).unwrap();
+    std::fs::write(
+        dir.join("plane.toml"),
+        format!(
+            "ambient = [0.0, 0.0, 0.0]\nsky = [0.0, 0.0, 0.0]\n[camera]\n{camera}\n[[mesh]]\n\
+             path = \"plane.obj\"\n[[light]]\ntype = \"point\"\n{light}\n"
+        ),
+    )
+    .unwrap();
+    let plane = fisheye_rt::scene::load(dir.join("plane.toml").to_str().unwrap())
+        .unwrap()
+        .scene;
+    std::fs::remove_dir_all(&dir).unwrap();
+    plane
+}
+
+/// A plane lit by a distant point light fills a pinhole's view: no edges, colour changing smoothly.
+/// Only the lattice of block corners is traced, and bilinear interpolation between them stays
+/// within a quarter of the threshold of the one-ray image in displayed colour: the blocks are
+/// kept only where the colour bends by less than the threshold along their edges (second
+/// differences h²f'' below it), and linear interpolation is off by at most h² max|f''| / 8 on
+/// each axis.
+#[test]
+fn a_smooth_scene_is_traced_at_block_corners_only() {
+    let plane = lit_plane(
+        "smooth",
+        20.0,
+        "position = [0.0, 0.0, 3.0]\nlook_at = [0.0, 0.0, 0.0]",
+        "position = [10.0, 6.0, 40.0]\nintensity = [1200.0, 1200.0, 1200.0]",
+        false,
+    );
+    let gpu = upload(&plane);
+    let (w, h) = (65, 49);
+    let cam = camera("rectilinear:f=1", w, h);
+    let one = uniform(&gpu, &cam, 1);
+    assert!(
+        one.ids.iter().all(|&id| id != NO_HIT),
+        "the plane fills the view"
+    );
+    let threshold = 0.02;
+    let (out, rays, stages) = adaptive_stages(&gpu, &cam, 16, threshold, false);
+    let lattice = |n: u32| (n - 1).div_ceil(ADAPTIVE_BLOCK) + 1;
+    let corners = (lattice(w) * lattice(h)) as usize;
+    let c = corners as u64;
+    let none = [
+        Stage::Midpoints,
+        Stage::Refine,
+        Stage::Estimate,
+        Stage::Supersample,
+    ]
+    .map(|s| (s, 0));
+    assert_eq!(stages, [[(Stage::Coarse, c)].as_slice(), &none].concat());
+    assert_eq!(
+        rays.iter().filter(|&&n| n == 1).count(),
+        corners,
+        "{rays:?}"
+    );
+    assert_eq!(
+        rays.iter().filter(|&&n| n == 0).count(),
+        rays.len() - corners
+    );
+    let shown = |c: f32| linear_to_srgb(c.clamp(0.0, 1.0));
+    let worst = one
+        .colour
+        .iter()
+        .zip(&out.colour)
+        .flat_map(|(a, b)| (0..3).map(move |k| (shown(a[k]) - shown(b[k])).abs()))
+        .fold(0.0f32, f32::max);
+    assert!(
+        worst <= threshold / 4.0,
+        "interpolated {worst} from the one-ray image"
+    );
+    assert!(
+        worst > 0.0,
+        "pixels between corners were interpolated, not traced"
+    );
+}
+
+/// The same plane under a nearer light, whose falloff bends the colour within a block, its
+/// halves of two materials, at threshold 1 (every block whose corners see one material
+/// interpolated, no colour test): each such block takes the bicubic through its 4 × 4 lattice
+/// points (Catmull-Rom splines down the columns, then across; kept within its corners'
+/// colours), where a point of its ring sees the other material, lies outside the image or not
+/// a whole spacing on (the width, 67, puts the last lattice column 2 pixels from the one
+/// before) the line through the block's own points continued instead, and a block shorter than
+/// the spacing none of its ring along that axis: as computed here in f64 from the one-ray
+/// image's lattice pixels. And where the whole ring is there, the bicubic is nearer the one-ray
+/// image than the bilinear through the same corners would be.
+#[test]
+fn smooth_blocks_are_interpolated_bicubically() {
+    let plane = lit_plane(
+        "bicubic",
+        20.0,
+        "position = [0.3, 0.0, 3.0]\nlook_at = [0.3, 0.0, 0.0]",
+        "position = [1.0, 0.5, 1.5]\nintensity = [6.0, 6.0, 6.0]",
+        true,
+    );
+    let gpu = upload(&plane);
+    let (w, h) = (67usize, 49usize);
+    let cam = camera("rectilinear:f=1", w as u32, h as u32);
+    let one = uniform(&gpu, &cam, 1);
+    let (out, rays) = adaptive(&gpu, &cam, 1, 1.0, false);
+    // The first two triangles are the light half's.
+    let light = |x: usize, y: usize| one.ids[y * w + x] < 2;
+    assert!(one.ids.iter().all(|&id| id < 4), "the plane fills the view");
+    let block = ADAPTIVE_BLOCK as usize;
+    // Catmull-Rom weights of the points at -1, 0, 1, 2 at t in [0, 1] (Keys 1981, a = -1/2).
+    let weights = |t: f64| {
+        [
+            (-t * t * t + 2.0 * t * t - t) / 2.0,
+            (3.0 * t * t * t - 5.0 * t * t + 2.0) / 2.0,
+            (-3.0 * t * t * t + 4.0 * t * t + t) / 2.0,
+            (t * t * t - t * t) / 2.0,
+        ]
+    };
+    // The spline through four points, an end that is not there (None) replaced by the line
+    // through the middle two continued.
+    let spline = |t: f64, p: [Option<f64>; 4]| {
+        let (b, c) = (p[1].unwrap(), p[2].unwrap());
+        let ends = [p[0].unwrap_or(2.0 * b - c), p[3].unwrap_or(2.0 * c - b)];
+        let w = weights(t);
+        w[0] * ends[0] + w[1] * b + w[2] * c + w[3] * ends[1]
+    };
+    // A block's lattice coordinates along an axis of `n` pixels: from `first` to its far
+    // corner (the image's last pixel where it is nearer than a block), then the points either
+    // side, where they are in the image, on the lattice and a whole block on, and the block
+    // itself is whole.
+    let points = |first: usize, n: usize| -> [Option<usize>; 4] {
+        let far = (first + block).min(n - 1);
+        let whole = far - first == block;
+        let ring = |q: Option<usize>| q.filter(|&q| whole && q < n && q.is_multiple_of(block));
+        [
+            ring(first.checked_sub(block)),
+            Some(first),
+            Some(far),
+            ring(Some(far + block)),
+        ]
+    };
+    let is_lattice = |v: usize, n: usize| v.is_multiple_of(block) || v == n - 1;
+    let (mut whole, mut partial, mut across) = (0, 0, 0);
+    let (mut cubic_error, mut linear_error) = (0.0f64, 0.0f64);
+    for y0 in (0..h).step_by(block) {
+        for x0 in (0..w).step_by(block) {
+            let (columns, rows) = (points(x0, w), points(y0, h));
+            let (x1, y1) = (columns[2].unwrap(), rows[2].unwrap());
+            let corners = [(x0, y0), (x1, y0), (x0, y1), (x1, y1)];
+            let material = light(x0, y0);
+            if corners.iter().any(|&(x, y)| light(x, y) != material) {
+                continue; // refined: its pixels are the half-blocks' (level 1)
+            }
+            // Ring point (a, b) of the 4 × 4, where the spline may pass through it.
+            let at = |a: usize, b: usize| -> Option<(usize, usize)> {
+                let (x, y) = (columns[a]?, rows[b]?);
+                let own = (1..3).contains(&a) && (1..3).contains(&b);
+                (own || light(x, y) == material).then_some((x, y))
+            };
+            let ring = (0..16).all(|k| at(k % 4, k / 4).is_some());
+            let other = (0..16).any(|k| {
+                let (x, y) = (columns[k % 4], rows[k / 4]);
+                x.zip(y).is_some_and(|(x, y)| light(x, y) != material)
+            });
+            for y in y0..(y0 + block).min(h) {
+                for x in x0..(x0 + block).min(w) {
+                    let p = y * w + x;
+                    if rays[p] == 1 {
+                        // A lattice point, or a midpoint traced for the refined block beside.
+                        assert!(
+                            is_lattice(x, w) && is_lattice(y, h)
+                                || x == x0 + block / 2
+                                || y == y0 + block / 2
+                        );
+                        assert_eq!(out.colour[p], one.colour[p], "traced pixel ({x}, {y})");
+                        continue;
+                    }
+                    assert_eq!(rays[p], 0, "pixel ({x}, {y}) interpolated");
+                    let u = (x - x0) as f64 / (x1 - x0).max(1) as f64;
+                    let v = (y - y0) as f64 / (y1 - y0).max(1) as f64;
+                    for k in 0..3 {
+                        let colour = |(x, y): (usize, usize)| f64::from(one.colour[y * w + x][k]);
+                        // Down each column whose points beside the block may be used.
+                        let down: [Option<f64>; 4] = std::array::from_fn(|a| {
+                            at(a, 1)?;
+                            at(a, 2)?;
+                            Some(spline(v, std::array::from_fn(|b| at(a, b).map(colour))))
+                        });
+                        let corners = corners.map(colour);
+                        let low = corners.iter().copied().fold(f64::INFINITY, f64::min);
+                        let high = corners.iter().copied().fold(0.0, f64::max);
+                        let expected = spline(u, down).clamp(low, high);
+                        let got = f64::from(out.colour[p][k]);
+                        assert!(
+                            (got - expected).abs() <= 1e-5 * expected.max(1.0),
+                            "pixel ({x}, {y}) channel {k}: {got} against {expected}"
+                        );
+                        if ring {
+                            let linear = (corners[0] * (1.0 - u) + corners[1] * u) * (1.0 - v)
+                                + (corners[2] * (1.0 - u) + corners[3] * u) * v;
+                            let traced = colour((x, y));
+                            cubic_error = cubic_error.max((got - traced).abs());
+                            linear_error = linear_error.max((linear - traced).abs());
+                        }
+                    }
+                    if ring {
+                        whole += 1
+                    } else {
+                        partial += 1
+                    }
+                    if other {
+                        across += 1
+                    }
+                }
+            }
+        }
+    }
+    assert!(
+        whole > 1000 && partial > 300 && across > 100,
+        "{whole} pixels in blocks with their whole ring, {partial} in others, {across} in \
+         blocks whose ring sees the other material"
+    );
+    assert!(
+        cubic_error < 0.5 * linear_error,
+        "bicubic off the one-ray image by {cubic_error}, bilinear by {linear_error}"
+    );
+}
+
+/// A plane's straight far edge against the sky: the blocks it crosses (their corners
+/// disagree) get their midpoints traced, and within them only the half-blocks it crosses get
+/// a ray in every pixel; the half-blocks beside it, on the plane or in the sky, are
+/// interpolated (a straight edge that crosses a square separates its corners, so every
+/// half-block it crosses is in a refined block). Judged from uniform sampling's hits.
+#[test]
+fn only_the_half_blocks_an_edge_crosses_are_traced() {
+    // Wide enough that its sides are out of view: the one edge seen is its far one, at y = 20.
+    let plane = lit_plane(
+        "halves",
+        1000.0,
+        "position = [0.0, -19.0, 1.5]\nlook_at = [6.0, 0.0, 1.0]",
+        "position = [10.0, 6.0, 400.0]\nintensity = [90000.0, 90000.0, 90000.0]",
+        false,
+    );
+    let gpu = upload(&plane);
+    let (w, h) = (65u32, 49u32);
+    let cam = camera("rectilinear:f=1", w, h);
+    let one = uniform(&gpu, &cam, 1);
+    let (_, rays) = adaptive(&gpu, &cam, 1, 0.02, false);
+    let hit = |x: u32, y: u32| one.ids[(y * w + x) as usize] != NO_HIT;
+    let half = ADAPTIVE_BLOCK / 2;
+    let on = |v: u32, n: u32, step: u32| v.is_multiple_of(step) || v == n - 1;
+    let (mut crossed, mut beside) = (0, 0);
+    for y in 0..h {
+        for x in 0..w {
+            if on(x, w, half) && on(y, h, half) {
+                continue;
+            }
+            // The half-block whose half-open square holds the pixel, and its corners.
+            let (x0, y0) = (x / half * half, y / half * half);
+            let (x1, y1) = ((x0 + half).min(w - 1), (y0 + half).min(h - 1));
+            let corners = [hit(x0, y0), hit(x1, y0), hit(x0, y1), hit(x1, y1)];
+            let disagree = corners.contains(&true) && corners.contains(&false);
+            let n = rays[(y * w + x) as usize];
+            assert_eq!(
+                n,
+                u32::from(disagree),
+                "pixel ({x}, {y}), corners {corners:?}"
+            );
+            if disagree {
+                crossed += 1;
+            } else if !(on(x, w, ADAPTIVE_BLOCK) && on(y, h, ADAPTIVE_BLOCK)) {
+                beside += 1;
+            }
+        }
+    }
+    assert!(
+        crossed > 30 && beside > 1000,
+        "{crossed} crossed, {beside} beside"
+    );
+    // Some interpolated pixels lie in blocks the edge crosses (traced whole before).
+    let in_crossed_blocks = (0..h)
+        .flat_map(|y| (0..w).map(move |x| (x, y)))
+        .filter(|&(x, y)| {
+            let b = ADAPTIVE_BLOCK;
+            let (x0, y0) = (x / b * b, y / b * b);
+            let (x1, y1) = ((x0 + b).min(w - 1), (y0 + b).min(h - 1));
+            let c = [hit(x0, y0), hit(x1, y0), hit(x0, y1), hit(x1, y1)];
+            c.contains(&true) && c.contains(&false) && rays[(y * w + x) as usize] == 0
+        })
+        .count();
+    assert!(
+        in_crossed_blocks > 20,
+        "{in_crossed_blocks} interpolated in crossed blocks"
+    );
+}
