@@ -376,8 +376,8 @@ pub struct GpuMaterial {
     pub texture_width: u32,
     /// Its height.
     pub texture_height: u32,
-    /// Padding.
-    pub pad: u32,
+    /// Its mip levels, level 0 included, one after another from `texture` (0 without).
+    pub texture_levels: u32,
 }
 
 /// A light as `wgsl/surface.wgsl`'s `light_at` reads it (32 bytes).

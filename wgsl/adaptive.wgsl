@@ -223,7 +223,7 @@ fn trace_centre(index: u32, pixel: vec2<u32>, mode: u32) {
         ids_out[index] = hit.triangle;
         return;
     }
-    let traced = shade(centre_ray(pixel, ray.xyz));
+    let traced = shade_centre(pixel, ray.xyz);
     colour_out[index] = vec4<f32>(traced.colour, 1.0);
     geometry_out[index] = geometry_of(traced);
     ids_out[index] = traced.triangle;

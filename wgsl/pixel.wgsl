@@ -39,6 +39,32 @@ struct SampleSums {
     half_covered: u32,
 }
 
+// The change of the camera-space direction `d`, the lens's at image point `p`, a step `s`
+// on: to the lens's direction there, or from its direction a step back where the lens masks
+// the one ahead (zero where it masks both).
+fn direction_step(p: vec2<f32>, d: vec3<f32>, s: vec2<f32>) -> vec3<f32> {
+    let ahead = lens_unproject(lens, p + s);
+    if ahead.w != 0.0 {
+        return ahead.xyz - d;
+    }
+    let behind = lens_unproject(lens, p - s);
+    if behind.w != 0.0 {
+        return d - behind.xyz;
+    }
+    return vec3<f32>(0.0);
+}
+
+// Sets `primary_spread` for the ray along camera-space direction `d` through image point `p`
+// of the camera placed `at`, whose pixel's samples are `step` pixels apart (1 for one a pixel,
+// 1/side for side² samples). Only where the scene has textures to filter.
+fn set_spread(at: Placement, p: vec2<f32>, d: vec3<f32>, step: f32) {
+    if HAS_TEXTURES {
+        let x = direction_step(p, d, vec2<f32>(step, 0.0));
+        let y = direction_step(p, d, vec2<f32>(0.0, step));
+        primary_spread = at.axes * mat2x3<f32>(x, y);
+    }
+}
+
 // Sample `k` of the `side`² jittered stratified samples of pixel `pixel` (index `index`): its
 // radiance with w = 1, or all zero where the lens masks it.
 fn sample_radiance(pixel: vec2<u32>, index: u32, k: u32, side: u32) -> vec4<f32> {
@@ -48,6 +74,7 @@ fn sample_radiance(pixel: vec2<u32>, index: u32, k: u32, side: u32) -> vec4<f32>
         return vec4<f32>(0.0);
     }
     let at = camera_at(sample_time(pixel, index, k, side * side));
+    set_spread(at, p, d.xyz, 1.0 / f32(side));
     return vec4<f32>(shade(placed_ray(at, vec3<f32>(0.0), d.xyz)).colour, 1.0);
 }
 
@@ -113,6 +140,13 @@ fn through_glass(pixel: vec2<u32>, index: u32) -> vec3<f32> {
         }
     }
     return sum / f32(side * side);
+}
+
+// Shades pixel `pixel`'s centre ray, along camera-space direction `d`.
+fn shade_centre(pixel: vec2<u32>, d: vec3<f32>) -> Traced {
+    let ray = centre_ray(pixel, d);
+    set_spread(camera_at(line_time(pixel)), vec2<f32>(pixel) + 0.5, d, 1.0);
+    return shade(ray);
 }
 
 // The ground truth of a primary hit: normal and distance, zero on a miss.

@@ -30,8 +30,8 @@ struct ShadowView {
 }
 
 @group(0) @binding(0) var<uniform> views: Views;
-// The deferred G-buffer: BVH slot + 1 (0 where nothing was drawn) and the barycentrics u, v
-// as bits.
+// The deferred G-buffer: BVH slot + 1 (0 where nothing was drawn), the barycentrics u, v
+// and the texture's level of detail, as bits.
 @group(0) @binding(1) var gbuffer: texture_2d_array<u32>;
 // The cube's bordered faces, which the deferred lighting writes (forward passes draw into
 // them as colour attachments).
@@ -112,10 +112,11 @@ fn shadow_visibility(light: Light, s: Surface, to_light: vec3<f32>) -> f32 {
     return textureSampleCompareLevel(shadow_map, shadow_sampler, uv, layer, ndc.z);
 }
 
-// The radiance the eye sees at the barycentrics `bary` of BVH slot `slot`, at `world`.
-fn raster_shade(slot: u32, bary: vec2<f32>, world: vec3<f32>) -> vec3<f32> {
+// The radiance the eye sees at the barycentrics `bary` of BVH slot `slot`, at `world`, where
+// its texture (if any) is filtered at level of detail `lod` (`texture_lod`).
+fn raster_shade(slot: u32, bary: vec2<f32>, world: vec3<f32>, lod: f32) -> vec3<f32> {
     let dir = normalize(world - views.eye.xyz);
-    let s = surface_at(Ray(views.eye.xyz, dir, 0.0, 3.0e38), Hit(0.0, bary.x, bary.y, slot, 0u));
+    let s = surface_at(Ray(views.eye.xyz, dir, 0.0, 3.0e38), Hit(0.0, bary.x, bary.y, slot, 0u), lod);
     var colour = s.material.emission;
     if HAS_MIRRORS && s.material.surface == SURFACE_MIRROR {
         return colour + s.material.specular * shading.sky;
@@ -139,16 +140,28 @@ fn raster_shade(slot: u32, bary: vec2<f32>, world: vec3<f32>) -> vec3<f32> {
     return colour;
 }
 
+// The level of detail of the texture a fragment shows: its footprint is how its point moves
+// to the next texel right and down, the screen-space derivatives of its position, as the
+// tracer's ray differentials give its hits (`hit_footprint`).
+fn fragment_lod(in: Varyings) -> f32 {
+    if !HAS_TEXTURES {
+        return 0.0;
+    }
+    return texture_lod(Hit(0.0, in.bary.x, in.bary.y, in.slot, 0u), mat2x3<f32>(dpdx(in.world), dpdy(in.world)));
+}
+
 // Forward: lighting in the fragment shader.
 @fragment
 fn forward_fs(in: Varyings) -> @location(0) vec4<f32> {
-    return vec4<f32>(raster_shade(in.slot, in.bary, in.world), 1.0);
+    return vec4<f32>(raster_shade(in.slot, in.bary, in.world, fragment_lod(in)), 1.0);
 }
 
-// Deferred, first pass: what each texel sees, to be lit in `deferred_lighting`.
+// Deferred, first pass: what each texel sees, and its texture's level of detail, to be lit in
+// `deferred_lighting`.
 @fragment
 fn gbuffer_fs(in: Varyings) -> @location(0) vec4<u32> {
-    return vec4<u32>(in.slot + 1u, bitcast<u32>(in.bary.x), bitcast<u32>(in.bary.y), 0u);
+    let lod = fragment_lod(in);
+    return vec4<u32>(in.slot + 1u, bitcast<u32>(in.bary.x), bitcast<u32>(in.bary.y), bitcast<u32>(lod));
 }
 
 // Deferred, second pass: lights the visible surface of every rendered texel (the sky where
@@ -162,7 +175,7 @@ fn deferred_lighting(@builtin(global_invocation_id) id: vec3<u32>) {
     var colour = shading.sky;
     if g.x != 0u {
         let hit = Hit(0.0, bitcast<f32>(g.y), bitcast<f32>(g.z), g.x - 1u, 0u);
-        colour = raster_shade(hit.slot, vec2<f32>(hit.u, hit.v), hit_position(hit));
+        colour = raster_shade(hit.slot, vec2<f32>(hit.u, hit.v), hit_position(hit), bitcast<f32>(g.w));
     }
     textureStore(cube_out, id.xy, id.z, vec4<f32>(colour, 1.0));
 }

@@ -13,8 +13,10 @@ fn multiview_vs(@builtin(vertex_index) vertex: u32, @builtin(view_index) face: u
 // the fragments outside its own region before shading them.
 @fragment
 fn multiview_fs(in: Varyings, @builtin(view_index) face: u32) -> @location(0) vec4<f32> {
+    // Derivatives before the discard, in uniform control flow.
+    let lod = fragment_lod(in);
     if !in_region(face, vec2<u32>(in.position.xy)) {
         discard;
     }
-    return vec4<f32>(raster_shade(in.slot, in.bary, in.world), 1.0);
+    return vec4<f32>(raster_shade(in.slot, in.bary, in.world, lod), 1.0);
 }

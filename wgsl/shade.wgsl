@@ -81,6 +81,23 @@ struct Pending {
     weight: vec3<f32>,
 }
 
+// How the direction of the primary ray being traced changes a pixel right (column 0) and a
+// pixel down (column 1) on the image, or a sample's spacing where a pixel has several (world
+// space, not normalized): the ray generators set it (`ray_spread`) and `shade` filters the
+// textures its primary hit shows at that footprint (Igehy, "Tracing Ray Differentials",
+// SIGGRAPH 1999). Zero: the finest level, as for secondary rays.
+var<private> primary_spread: mat2x3<f32>;
+
+// Where `hit` of `ray` moves on its triangle's plane as the ray's direction moves by
+// `primary_spread`'s columns (Igehy's transfer of a ray differential to a surface).
+fn hit_footprint(ray: Ray, hit: Hit) -> mat2x3<f32> {
+    let n = hit_face_normal(hit);
+    let facing = dot(ray.dir, n);
+    let x = primary_spread[0];
+    let y = primary_spread[1];
+    return hit.t * mat2x3<f32>(x - (dot(x, n) / facing) * ray.dir, y - (dot(y, n) / facing) * ray.dir);
+}
+
 // What a primary ray sees, and its first hit.
 struct Traced {
     colour: vec3<f32>,
@@ -98,7 +115,7 @@ fn first_hit(primary: Ray) -> Traced {
     var out = Traced(vec3<f32>(0.0), Hit(0.0, 0.0, 0.0, NO_HIT, 0u), vec3<f32>(0.0), NO_HIT);
     let hit = bvh_trace(primary, false);
     if hit.slot != NO_HIT {
-        let s = surface_at(primary, hit);
+        let s = surface_at(primary, hit, 0.0);
         out.hit = hit;
         out.normal = s.normal;
         out.triangle = s.triangle;
@@ -122,7 +139,11 @@ fn shade(primary: Ray) -> Traced {
             out.colour += ray_in.weight * shading.sky;
             continue;
         }
-        let s = surface_at(ray, hit);
+        var lod = 0.0;
+        if HAS_TEXTURES && ray_in.depth == 0u {
+            lod = texture_lod(hit, hit_footprint(ray, hit));
+        }
+        let s = surface_at(ray, hit, lod);
         if ray_in.depth == 0u {
             out.hit = hit;
             out.normal = s.normal;

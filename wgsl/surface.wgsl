@@ -19,7 +19,9 @@ struct Material {
     opacity: f32,
     texture_width: u32,
     texture_height: u32,
-    pad: u32,
+    // Its mip levels (`fisheye_rt::scene::Texture::mip_levels`), level 0 included, one after
+    // another from `texture`.
+    texture_levels: u32,
 }
 
 // Mirrors `fisheye_rt::trace::GpuLight` (32 bytes): a point light (position) or a directional
@@ -68,7 +70,7 @@ fn material_at(i: u32) -> Material {
         records[k + 4u]);
     return Material(bitcast<vec3<f32>>(v[0].xyz), v[0].w, bitcast<vec3<f32>>(v[1].xyz),
         bitcast<f32>(v[1].w), bitcast<vec3<f32>>(v[2].xyz), bitcast<f32>(v[2].w),
-        bitcast<vec3<f32>>(v[3].xyz), v[3].w, bitcast<f32>(v[4].x), v[4].y, v[4].z, 0u);
+        bitcast<vec3<f32>>(v[3].xyz), v[3].w, bitcast<f32>(v[4].x), v[4].y, v[4].z, v[4].w);
 }
 
 override HAS_MIRRORS: bool;
@@ -92,9 +94,9 @@ fn texel(info: vec3<u32>, x: i32, y: i32) -> vec3<f32> {
     return srgb_to_linear(unpack4x8unorm(records[word >> 2u][word & 3u]).rgb);
 }
 
-// Bilinear filtering in linear space, repeat wrapping, v = 0 at the bottom (OBJ convention).
-fn sample_texture(m: Material, uv: vec2<f32>) -> vec3<f32> {
-    let info = vec3<u32>(m.texture, m.texture_width, m.texture_height);
+// Bilinear filtering in linear space, repeat wrapping, v = 0 at the bottom (OBJ convention),
+// of the texture level whose first texel, width and height are `info`'s x, y, z.
+fn bilinear(info: vec3<u32>, uv: vec2<f32>) -> vec3<f32> {
     let size = vec2<f32>(f32(info.y), f32(info.z));
     let st = vec2<f32>(uv.x, 1.0 - uv.y) * size - 0.5;
     let base = floor(st);
@@ -104,6 +106,63 @@ fn sample_texture(m: Material, uv: vec2<f32>) -> vec3<f32> {
     let top = mix(texel(info, x, y), texel(info, x + 1, y), f.x);
     let bottom = mix(texel(info, x, y + 1), texel(info, x + 1, y + 1), f.x);
     return mix(top, bottom, f.y);
+}
+
+// Material `m`'s texture at `uv`, filtered trilinearly at level of detail `lod` (log2 of the
+// footprint's size in level-0 texels, `texture_lod`): bilinear in the two levels around it,
+// blended (OpenGL 4.6, 8.14). Level 0 alone at lod <= 0, the last level beyond it.
+fn sample_texture(m: Material, uv: vec2<f32>, lod: f32) -> vec3<f32> {
+    let last = f32(m.texture_levels - 1u);
+    let l = clamp(lod, 0.0, last);
+    let k = u32(floor(l));
+    var info = vec3<u32>(m.texture, m.texture_width, m.texture_height);
+    for (var i = 0u; i < k; i++) {
+        info = vec3<u32>(info.x + info.y * info.z, max(info.y / 2u, 1u), max(info.z / 2u, 1u));
+    }
+    let near = bilinear(info, uv);
+    let f = l - f32(k);
+    if f == 0.0 {
+        return near;
+    }
+    let next = vec3<u32>(info.x + info.y * info.z, max(info.y / 2u, 1u), max(info.z / 2u, 1u));
+    return mix(near, bilinear(next, uv), f);
+}
+
+// The level of detail of the texture of the triangle `hit` is on, where a pixel's step right
+// and down moves the hit by `footprint`'s columns (world space; zero: the finest level): log2
+// of the side of the square with the footprint's area in level-0 texels. The steps become
+// barycentric ones through the triangle's dual basis, then texel ones through its UVs. (A
+// GPU sampler takes the longer step instead, OpenGL 4.6 §8.14.1, which blurs more across a
+// slanted footprint: against the box-filtered reference the area measured 6 % less MSE and 4 %
+// less ꟻLIP at one ray a pixel on Šibenik through the Samyang.) 0 without a texture.
+fn texture_lod(hit: Hit, footprint: mat2x3<f32>) -> f32 {
+    let tri = triangle_at(hit.slot);
+    let m = material_at(tri.material);
+    if !HAS_TEXTURES || m.texture == NO_TEXTURE {
+        return 0.0;
+    }
+    var steps = footprint;
+    if INSTANCED {
+        let to_mesh = hit_instance(hit).to_mesh;
+        steps = mat2x3<f32>(linear(to_mesh, steps[0]), linear(to_mesh, steps[1]));
+    }
+    let e1 = tri.v1 - tri.v0;
+    let e2 = tri.v2 - tri.v0;
+    let n = cross(e1, e2);
+    let dual = mat2x3<f32>(cross(e2, n), cross(n, e1)) * (1.0 / dot(n, n));
+    var base = tri.triangle * select(2u, 5u, SMOOTH_NORMALS);
+    if SMOOTH_NORMALS {
+        base += 3u;
+    }
+    let a = vertex_at(base);
+    let b = vertex_at(base + 1u);
+    let size = vec2<f32>(f32(m.texture_width), f32(m.texture_height));
+    // Texels per unit of u and of v.
+    let along = mat2x2<f32>((a.zw - a.xy) * size, (b.xy - a.xy) * size);
+    let x = along * vec2<f32>(dot(dual[0], steps[0]), dot(dual[1], steps[0]));
+    let y = along * vec2<f32>(dot(dual[0], steps[1]), dot(dual[1], steps[1]));
+    let area = abs(x.x * y.y - x.y * y.x);
+    return select(0.0, 0.5 * log2(area), area > 1.0);
 }
 
 // Everything shading needs about a hit.
@@ -128,7 +187,9 @@ fn vertex_normal(hit: Hit, n: vec3<f32>) -> vec3<f32> {
     return n;
 }
 
-fn surface_at(ray: Ray, hit: Hit) -> Surface {
+// The surface at `hit` of `ray`, its texture (if any) filtered at level of detail `lod`
+// (`texture_lod`).
+fn surface_at(ray: Ray, hit: Hit, lod: f32) -> Surface {
     let tri = triangle_at(hit.slot);
     var material = material_at(tri.material);
     let w = 1.0 - hit.u - hit.v;
@@ -163,7 +224,7 @@ fn surface_at(ray: Ray, hit: Hit) -> Surface {
         let a = vertex_at(uv_base);
         let b = vertex_at(uv_base + 1u);
         let uv = w * a.xy + hit.u * a.zw + hit.v * b.xy;
-        material.diffuse *= sample_texture(material, uv);
+        material.diffuse *= sample_texture(material, uv, lod);
     }
     return Surface(position, geometric, normal, front, material, scene_triangle(hit.slot, hit.instance));
 }

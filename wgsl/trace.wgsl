@@ -39,7 +39,7 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
         traced = first_hit(centre);
         colour_out[stored] = supersampled(pixel, index);
     } else {
-        traced = shade(centre);
+        traced = shade_centre(pixel, ray.xyz);
         colour_out[stored] = vec4<f32>(traced.colour, 1.0);
     }
     geometry_out[stored] = geometry_of(traced);

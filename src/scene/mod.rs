@@ -9,6 +9,7 @@ pub mod file;
 pub mod gltf;
 mod lint;
 mod mesh;
+mod mip;
 pub mod obj;
 mod view;
 

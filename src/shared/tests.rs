@@ -62,7 +62,7 @@ fn gpu_structs_match_their_wgsl_twins() {
             ("opacity", offset_of!(GpuMaterial, opacity)),
             ("texture_width", offset_of!(GpuMaterial, texture_width)),
             ("texture_height", offset_of!(GpuMaterial, texture_height)),
-            ("pad", offset_of!(GpuMaterial, pad)),
+            ("texture_levels", offset_of!(GpuMaterial, texture_levels)),
         ],
     );
     assert_wgsl_layout(

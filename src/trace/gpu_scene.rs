@@ -82,14 +82,18 @@ fn check_records(ctx: &GpuContext, scene: &Scene, features: Features) -> Result<
         .textures
         .iter()
         .filter(|_| features.textures)
-        .map(|t| 4 * u64::from(t.width) * u64::from(t.height))
+        .map(|t| {
+            let level_bytes =
+                |k: u32| 4 * u64::from((t.width >> k).max(1)) * u64::from((t.height >> k).max(1));
+            (0..t.mip_level_count()).map(level_bytes).sum::<u64>()
+        })
         .sum();
     let others = size_of::<crate::bvh::GpuInstance>() * scene.instances.len()
         + size_of::<GpuLight>() * scene.lights.len()
         + size_of::<GpuMaterial>() * scene.materials.len();
     if texels + others as u64 > limit {
         return Err(Error::Limit(format!(
-            "the scene's {} textures take {:.1} MiB, and with its instances, lights and \
+            "the scene's {} textures take {:.1} MiB with their mip levels, and with its instances, lights and \
              materials {:.1} MiB, above this adapter's limit of {:.0} MiB per storage binding, \
              which they share; use smaller textures",
             scene.textures.len(),
@@ -265,7 +269,8 @@ impl GpuScene {
         check_bindings(ctx, &arrays, stored)?;
         // The scene's records (`records` in wgsl/triangles.wgsl), in vec4s of words: the
         // instances, with room for every one to show at some time and for moving ones' knots;
-        // the lights; the materials; the textures' texels one after another.
+        // the lights; the materials; the textures' texels one after another, each texture's
+        // mip levels after it.
         let mut records: Vec<[u32; 4]> = bytemuck::cast_slice(&bvh.instances).to_vec();
         if let Some(top) = &bvh.top {
             let knots = top.knot_capacity(scene) as u32 * crate::shared::KNOT_VEC4S;
@@ -280,18 +285,22 @@ impl GpuScene {
         let mut placed = Vec::new();
         if features.textures {
             for t in &scene.textures {
-                placed.push((texels_at + texels.len() as u32, t.width, t.height));
+                let levels = t.mip_level_count();
+                placed.push((texels_at + texels.len() as u32, t.width, t.height, levels));
                 texels.extend(bytemuck::cast_slice::<u8, u32>(&t.rgba));
+                for level in t.mip_levels() {
+                    texels.extend(bytemuck::cast_slice::<u8, u32>(&level.rgba));
+                }
             }
         }
         let materials: Vec<GpuMaterial> = scene
             .materials
             .iter()
             .map(|m| {
-                let (texture, texture_width, texture_height) = m
+                let (texture, texture_width, texture_height, texture_levels) = m
                     .diffuse_texture
                     .and_then(|t| placed.get(t as usize).copied())
-                    .unwrap_or((NO_TEXTURE, 0, 0));
+                    .unwrap_or((NO_TEXTURE, 0, 0, 0));
                 GpuMaterial {
                     diffuse: to3(m.diffuse),
                     surface: surface_id(m.surface),
@@ -304,7 +313,7 @@ impl GpuScene {
                     opacity: m.opacity,
                     texture_width,
                     texture_height,
-                    pad: 0,
+                    texture_levels,
                 }
             })
             .collect();

@@ -16,7 +16,7 @@ use tree::*;
 
 use super::{MAX_DEPTH_LIMIT, MAX_SHADOW_LAYERS, NO_HIT, RenderOutput};
 use crate::lens::LensCamera;
-use crate::scene::{Features, Scene, Surface};
+use crate::scene::{Features, Scene, Surface, Texture};
 
 /// Rays whose weight falls below this are not traced (as on the GPU).
 const MIN_WEIGHT: f64 = crate::shared::MIN_WEIGHT as f64;
@@ -64,6 +64,8 @@ pub struct Reference<'a> {
     rotation: DMat3,
     lights: Vec<(bool, DVec3, DVec3)>,
     max_depth: u32,
+    /// Each texture's mip levels after the first (`Texture::mip_levels`), if textures show.
+    mips: Vec<Vec<Texture>>,
 }
 
 fn round32(v: DVec3) -> DVec3 {
@@ -144,9 +146,15 @@ impl<'a> Reference<'a> {
                 (point, vector.as_dvec3(), colour.as_dvec3())
             })
             .collect();
+        let features = scene.features();
+        let mips = match features.textures {
+            true => scene.textures.iter().map(Texture::mip_levels).collect(),
+            false => Vec::new(),
+        };
         Self {
             scene,
-            features: scene.features(),
+            features,
+            mips,
             corners,
             meshes,
             instances,
@@ -310,8 +318,14 @@ impl<'a> Reference<'a> {
             {
                 s.spawn(move || {
                     for (j, (o, d)) in out.iter_mut().zip(dirs).enumerate() {
+                        let index = c * chunk + j;
+                        let width = size.width as usize;
+                        let centre =
+                            DVec2::new((index % width) as f64, (index / width) as f64) + 0.5;
                         *o = match d {
-                            Some(d) => self.pixel(self.rotation * *d),
+                            Some(d) => {
+                                self.pixel(self.rotation * *d, self.spread(camera, centre, *d, 1.0))
+                            }
                             None => ([0.0; 4], [0.0; 4], NO_HIT),
                         };
                         if samples_per_side > 1 {
@@ -337,7 +351,8 @@ impl<'a> Reference<'a> {
         for k in 0..side * side {
             let p = corner + super::sampling::sample_offset(index as u32, k, side);
             if let Some(d) = camera.unproject(p) {
-                let c = self.pixel(self.rotation * d).0;
+                let spread = self.spread(camera, p, d, 1.0 / f64::from(side));
+                let c = self.pixel(self.rotation * d, spread).0;
                 sum += DVec3::new(c[0].into(), c[1].into(), c[2].into());
                 covered += 1;
             }
@@ -349,8 +364,57 @@ impl<'a> Reference<'a> {
         [c.x, c.y, c.z, covered as f32 / (side * side) as f32]
     }
 
-    /// One primary ray (world direction from the camera): colour with w = 1, geometry, id.
-    fn pixel(&self, dir: DVec3) -> ([f32; 4], [f32; 4], u32) {
+    /// How the camera-space direction `d` of image point `p` changes a step of `step` pixels
+    /// right and down (or from a step back where the lens masks the one ahead; zero where it
+    /// masks both), in the world: the primary ray's differentials, as `wgsl/pixel.wgsl`'s
+    /// `set_spread` makes them (only where textures show).
+    fn spread(&self, camera: &LensCamera, p: DVec2, d: DVec3, step: f64) -> [DVec3; 2] {
+        if !self.features.textures {
+            return [DVec3::ZERO; 2];
+        }
+        [DVec2::X, DVec2::Y].map(|axis| {
+            let s = axis * step;
+            let change = match (camera.unproject(p + s), camera.unproject(p - s)) {
+                (Some(ahead), _) => ahead - d,
+                (None, Some(behind)) => d - behind,
+                (None, None) => DVec3::ZERO,
+            };
+            self.rotation * change
+        })
+    }
+
+    /// The level of detail of the texture at `hit` of a primary ray along `dir` whose
+    /// differentials are `spread`, as `wgsl/surface.wgsl`'s `texture_lod` takes it from
+    /// `wgsl/shade.wgsl`'s `hit_footprint`: the hit's moves on its plane, into barycentric
+    /// steps by the triangle's dual basis (in its mesh's space), into texels by its UVs; log2
+    /// of the square root of the footprint's area in texels, 0 below one texel.
+    fn texture_lod(&self, dir: DVec3, hit: &Hit, spread: [DVec3; 2]) -> f64 {
+        let i = hit.stored as usize;
+        let m = &self.scene.materials[self.scene.material_of[i] as usize];
+        let Some(t) = m.diffuse_texture.filter(|_| self.features.textures) else {
+            return 0.0;
+        };
+        let t = &self.scene.textures[t as usize];
+        let [a, b, c] = self.corners[i];
+        let placed = hit.instance.map(|k| &self.instances[k as usize]);
+        let n = (b - a).cross(c - a);
+        let world_n = placed.map_or(n, |p| p.normal * n);
+        let steps = spread.map(|x| {
+            let on_plane = hit.t * (x - x.dot(world_n) / dir.dot(world_n) * dir);
+            placed.map_or(on_plane, |p| p.to_mesh.m * on_plane)
+        });
+        let dual = [(c - a).cross(n), n.cross(b - a)].map(|e| e / n.length_squared());
+        let uv = self.scene.uvs.as_ref().expect("textures need UVs")[i].map(|v| v.as_dvec2());
+        let size = DVec2::new(t.width.into(), t.height.into());
+        let texels = steps
+            .map(|s| (dual[0].dot(s) * (uv[1] - uv[0]) + dual[1].dot(s) * (uv[2] - uv[0])) * size);
+        let area = texels[0].perp_dot(texels[1]).abs();
+        if area > 1.0 { 0.5 * area.log2() } else { 0.0 }
+    }
+
+    /// One primary ray (world direction from the camera, its differentials `spread`): colour
+    /// with w = 1, geometry, id.
+    fn pixel(&self, dir: DVec3, spread: [DVec3; 2]) -> ([f32; 4], [f32; 4], u32) {
         let mut colour = DVec3::ZERO;
         let mut first = ([0.0f32; 4], NO_HIT);
         let mut stack = vec![(DVec3::ZERO, dir, DVec3::ONE, 0u32)];
@@ -359,7 +423,11 @@ impl<'a> Reference<'a> {
                 colour += weight * v3(self.scene.sky);
                 continue;
             };
-            let s = self.surface(dir, &hit);
+            let lod = match depth {
+                0 => self.texture_lod(dir, &hit, spread),
+                _ => 0.0,
+            };
+            let s = self.surface(dir, &hit, lod);
             if depth == 0 {
                 let n = s.normal.as_vec3();
                 first = ([n.x, n.y, n.z, hit.t as f32], hit.triangle);
@@ -437,7 +505,8 @@ impl<'a> Reference<'a> {
         }
     }
 
-    fn surface(&self, dir: DVec3, hit: &Hit) -> SurfacePoint {
+    /// The surface at `hit` of a ray along `dir`, its texture filtered at level of detail `lod`.
+    fn surface(&self, dir: DVec3, hit: &Hit, lod: f64) -> SurfacePoint {
         let i = hit.stored as usize;
         let [a, b, c] = self.corners[i];
         let w = 1.0 - hit.u - hit.v;
@@ -475,7 +544,12 @@ impl<'a> Reference<'a> {
         if let (true, Some(t)) = (self.features.textures, m.diffuse_texture) {
             let uv = self.scene.uvs.as_ref().unwrap()[i];
             let uv = w * uv[0].as_dvec2() + hit.u * uv[1].as_dvec2() + hit.v * uv[2].as_dvec2();
-            diffuse *= sample(&self.scene.textures[t as usize], uv);
+            diffuse *= trilinear(
+                &self.scene.textures[t as usize],
+                &self.mips[t as usize],
+                uv,
+                lod,
+            );
         }
         SurfacePoint {
             position,

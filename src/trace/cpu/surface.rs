@@ -52,7 +52,21 @@ pub(super) fn srgb_to_linear(c: f64) -> f64 {
     }
 }
 
-/// Bilinear, repeat-wrapped, in linear space; v = 0 at the bottom (as `wgsl/shade.wgsl`).
+/// Trilinear: bilinear in the two mip levels around level of detail `lod` (`first`, then
+/// `levels`), blended; the first alone at `lod` <= 0, the last beyond (as `wgsl/surface.wgsl`).
+pub(super) fn trilinear(first: &Texture, levels: &[Texture], uv: DVec2, lod: f64) -> DVec3 {
+    let l = lod.clamp(0.0, levels.len() as f64);
+    let k = l.floor() as usize;
+    let level = |k: usize| if k == 0 { first } else { &levels[k - 1] };
+    let near = sample(level(k), uv);
+    let f = l - k as f64;
+    if f == 0.0 {
+        return near;
+    }
+    near.lerp(sample(level(k + 1), uv), f)
+}
+
+/// Bilinear, repeat-wrapped, in linear space; v = 0 at the bottom (as `wgsl/surface.wgsl`).
 pub(super) fn sample(t: &Texture, uv: DVec2) -> DVec3 {
     let (w, h) = (i64::from(t.width), i64::from(t.height));
     let texel = |x: i64, y: i64| {
