@@ -35,7 +35,7 @@ fn scene(floor: bool) -> Scene {
     b.sphere(DVec3::new(-0.5, 0.45, 0.0), 0.45, 32, 16, false, mirror);
     let texture = b.texture(checker(
         "checks",
-        64,
+        48,
         8,
         [200, 40, 40],
         [240, 240, 240],
@@ -303,9 +303,9 @@ fn scenes_split_across_bindings_render_bit_identically() {
         // Bindings of a third of the triangles' bytes: three chunks of them or more, and more
         // of the shading data (80 bytes a triangle). The instanced scene's few nodes are split
         // too, at half their bytes (the flattened one's would take too many bindings: lavapipe
-        // has 48 a stage). The rest of the scene's buffers fit (the records: the texture's 16
-        // KiB with the instances, lights and materials, in one binding), and the 64x48 outputs
-        // (in bands).
+        // has 48 a stage). The rest of the scene's buffers fit (the records: the texture's 12
+        // KiB with its mip levels, the instances, lights and materials, in one binding), and
+        // the 64x48 outputs (in bands).
         let nodes = 80 * whole.bvh_nodes as u64;
         let third = whole.bytes.geometry / 3;
         let records = whole.bytes.textures as usize

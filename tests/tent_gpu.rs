@@ -142,15 +142,20 @@ fn adaptive_sampling_at_one_ray_is_filtered_whole() {
     );
 }
 
-/// What the filter is for: one centre sample aliases at edges and texture detail, and the
-/// filtered frame is nearer the many-ray reference's box averages. Measured on the shared
-/// scenes at 256×192 (the book's "Adaptive sampling") the MSE falls 2.1 to 3.2 times, and
-/// 2.1 to 2.6 times here (two built-in scenes at 96×72, lavapipe): it must fall by 40 % at
+/// What the filter is for: one centre sample aliases at edges, and the filtered frame is
+/// nearer the many-ray reference's box averages. Textures are left off: a ray's lookup is
+/// filtered at its pixel's footprint already, and the tent blurs them a second time (on the
+/// textured room here the MSE rises, 1.22e-3 to 1.34e-3). Measured on the shared scenes at
+/// 256×192 before textures were filtered (the book's "Adaptive sampling") the MSE fell 2.1 to
+/// 3.2 times, and here 2.1 to 2.5 times (two built-in scenes at 96×72, lavapipe): it must fall by 40 % at
 /// least.
 #[test]
 fn the_tent_filter_brings_one_ray_nearer_the_reference() {
     for name in ["builtin:default", "builtin:many-small"] {
-        let room = scene(name);
+        let mut room = scene(name);
+        for m in &mut room.materials {
+            m.diffuse_texture = None;
+        }
         let cam = camera("samyang-7.5mm", 96, 72);
         let reference = render(ctx(), &room, &cam, &sampled(64, None, PixelFilter::Box)).unwrap();
         for threshold in [None, Some(0.1)] {

@@ -15,7 +15,7 @@ use common::{camera, ctx};
 use fisheye_rt::cube::{CubeMap, CubeMethod, CubeSettings};
 use fisheye_rt::raster::RasterMethod;
 use fisheye_rt::scene::{Camera, Material, MeshBuilder, Scene, Texture, checker};
-use fisheye_rt::trace::{Adaptive, GpuScene, RenderOptions, render};
+use fisheye_rt::trace::{Adaptive, GpuScene, RenderOptions, mip_level_count, mip_levels, render};
 use glam::{DVec3, Vec2, Vec3};
 
 const AMBIENT: f32 = 0.8;
@@ -116,8 +116,9 @@ fn minified_textures_are_filtered_to_their_mean_by_every_method() {
         ("rt, adaptive", adaptive),
     ] {
         let out = render(ctx(), &scene, &cam, &options).unwrap();
+        // The image circle covers 1396 pixels of the 64 × 48.
         let checked = assert_grey(what, &out.colour);
-        assert!(checked > 1500, "{what}: {checked} covered pixels");
+        assert!(checked >= 1396, "{what}: {checked} covered pixels");
     }
     let gpu = GpuScene::new(ctx(), &scene, &RenderOptions::default()).unwrap();
     for method in [
@@ -135,7 +136,7 @@ fn minified_textures_are_filtered_to_their_mean_by_every_method() {
             .unwrap();
         let checked = assert_grey(method.name(), &colour);
         assert!(
-            checked > 1500,
+            checked >= 1396,
             "{}: {checked} covered pixels",
             method.name()
         );
@@ -156,8 +157,8 @@ fn mip_levels_halve_and_average_in_linear_light() {
         height: 2,
         rgba: values.iter().flat_map(|&v| [v, v, v, 255 - v]).collect(),
     };
-    assert_eq!(texture.mip_level_count(), 3);
-    let levels = texture.mip_levels();
+    assert_eq!(mip_level_count(&texture), 3);
+    let levels = mip_levels(&texture);
     let sizes: Vec<(u32, u32)> = levels.iter().map(|l| (l.width, l.height)).collect();
     assert_eq!(sizes, [(2, 1), (1, 1)]);
     let mean = |of: &[u8]| {
@@ -184,8 +185,8 @@ fn mip_levels_halve_and_average_in_linear_light() {
     assert_eq!(levels[1].rgba[0], (255.0 * encode(grey)).round() as u8);
 
     let square = checker("cells", 64, 64, [0; 3], [255; 3], None);
-    assert_eq!(square.mip_level_count(), 7);
-    let levels = square.mip_levels();
+    assert_eq!(mip_level_count(&square), 7);
+    let levels = mip_levels(&square);
     assert_eq!((levels[5].width, levels[5].height), (1, 1));
     assert!(
         levels

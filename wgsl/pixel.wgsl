@@ -39,29 +39,31 @@ struct SampleSums {
     half_covered: u32,
 }
 
-// The change of the camera-space direction `d`, the lens's at image point `p`, a step `s`
-// on: to the lens's direction there, or from its direction a step back where the lens masks
-// the one ahead (zero where it masks both).
-fn direction_step(p: vec2<f32>, d: vec3<f32>, s: vec2<f32>) -> vec3<f32> {
-    let ahead = lens_unproject(lens, p + s);
-    if ahead.w != 0.0 {
-        return ahead.xyz - d;
-    }
-    let behind = lens_unproject(lens, p - s);
-    if behind.w != 0.0 {
-        return d - behind.xyz;
-    }
-    return vec3<f32>(0.0);
-}
-
 // Sets `primary_spread` for the ray along camera-space direction `d` through image point `p`
 // of the camera placed `at`, whose pixel's samples are `step` pixels apart (1 for one a pixel,
-// 1/side for side² samples). Only where the scene has textures to filter.
+// 1/side for side² samples): along each axis the change to the lens's direction a step on,
+// or from its direction a step back where the lens masks the one ahead (zero where it masks
+// both). Only where the scene has textures to filter. One call of the lens in a loop, not
+// four: lavapipe inlines every call, and each copy of a calibrated lens costs it memory.
 fn set_spread(at: Placement, p: vec2<f32>, d: vec3<f32>, step: f32) {
     if HAS_TEXTURES {
-        let x = direction_step(p, d, vec2<f32>(step, 0.0));
-        let y = direction_step(p, d, vec2<f32>(0.0, step));
-        primary_spread = at.axes * mat2x3<f32>(x, y);
+        var steps = mat2x3<f32>();
+        var found = vec2<bool>(false);
+        // Ahead along x, then y; then back along those the lens masked ahead.
+        for (var k = 0u; k < 4u; k++) {
+            let axis = k % 2u;
+            let back = k >= 2u;
+            if found[axis] {
+                continue;
+            }
+            let s = select(step, -step, back) * vec2<f32>(f32(axis == 0u), f32(axis == 1u));
+            let q = lens_unproject(lens, p + s);
+            if q.w != 0.0 {
+                steps[axis] = select(q.xyz - d, d - q.xyz, back);
+                found[axis] = true;
+            }
+        }
+        primary_spread = at.axes * steps;
     }
 }
 
@@ -142,11 +144,11 @@ fn through_glass(pixel: vec2<u32>, index: u32) -> vec3<f32> {
     return sum / f32(side * side);
 }
 
-// Shades pixel `pixel`'s centre ray, along camera-space direction `d`.
+// Shades pixel `pixel`'s centre ray (`centre_ray`), along camera-space direction `d`.
 fn shade_centre(pixel: vec2<u32>, d: vec3<f32>) -> Traced {
-    let ray = centre_ray(pixel, d);
-    set_spread(camera_at(line_time(pixel)), vec2<f32>(pixel) + 0.5, d, 1.0);
-    return shade(ray);
+    let at = camera_at(line_time(pixel));
+    set_spread(at, vec2<f32>(pixel) + 0.5, d, 1.0);
+    return shade(placed_ray(at, vec3<f32>(0.0), d));
 }
 
 // The ground truth of a primary hit: normal and distance, zero on a miss.

@@ -19,7 +19,7 @@ struct Material {
     opacity: f32,
     texture_width: u32,
     texture_height: u32,
-    // Its mip levels (`fisheye_rt::scene::Texture::mip_levels`), level 0 included, one after
+    // Its mip levels (`fisheye_rt::trace::mip_levels`), level 0 included, one after
     // another from `texture`.
     texture_levels: u32,
 }

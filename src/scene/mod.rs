@@ -9,7 +9,6 @@ pub mod file;
 pub mod gltf;
 mod lint;
 mod mesh;
-mod mip;
 pub mod obj;
 mod view;
 

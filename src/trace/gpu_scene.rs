@@ -85,7 +85,7 @@ fn check_records(ctx: &GpuContext, scene: &Scene, features: Features) -> Result<
         .map(|t| {
             let level_bytes =
                 |k: u32| 4 * u64::from((t.width >> k).max(1)) * u64::from((t.height >> k).max(1));
-            (0..t.mip_level_count()).map(level_bytes).sum::<u64>()
+            (0..super::mip_level_count(t)).map(level_bytes).sum::<u64>()
         })
         .sum();
     let others = size_of::<crate::bvh::GpuInstance>() * scene.instances.len()
@@ -285,10 +285,10 @@ impl GpuScene {
         let mut placed = Vec::new();
         if features.textures {
             for t in &scene.textures {
-                let levels = t.mip_level_count();
+                let levels = super::mip_level_count(t);
                 placed.push((texels_at + texels.len() as u32, t.width, t.height, levels));
                 texels.extend(bytemuck::cast_slice::<u8, u32>(&t.rgba));
-                for level in t.mip_levels() {
+                for level in super::mip_levels(t) {
                     texels.extend(bytemuck::cast_slice::<u8, u32>(&level.rgba));
                 }
             }

@@ -11,6 +11,7 @@ pub mod cpu;
 mod display;
 mod frame;
 mod gpu_scene;
+mod mip;
 mod motion;
 mod options;
 mod output;
@@ -29,6 +30,7 @@ pub use display::{
 };
 pub use frame::FramePass;
 pub use gpu_scene::{GpuScene, SceneBytes, gpu_lights, shading_vertices};
+pub use mip::{mip_level_count, mip_levels};
 pub use motion::{Motion, moving_directions};
 pub use options::{
     Adaptive, PixelFilter, RenderOptions, Sampling, Traversal, surface_constants, surface_id,

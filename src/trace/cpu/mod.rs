@@ -10,6 +10,8 @@
 mod surface;
 mod tree;
 
+pub(super) use surface::srgb_to_linear;
+
 use glam::{DMat3, DVec2, DVec3, Vec3};
 use surface::*;
 use tree::*;
@@ -64,7 +66,7 @@ pub struct Reference<'a> {
     rotation: DMat3,
     lights: Vec<(bool, DVec3, DVec3)>,
     max_depth: u32,
-    /// Each texture's mip levels after the first (`Texture::mip_levels`), if textures show.
+    /// Each texture's mip levels after the first (`super::mip_levels`), if textures show.
     mips: Vec<Vec<Texture>>,
 }
 
@@ -148,7 +150,7 @@ impl<'a> Reference<'a> {
             .collect();
         let features = scene.features();
         let mips = match features.textures {
-            true => scene.textures.iter().map(Texture::mip_levels).collect(),
+            true => scene.textures.iter().map(super::mip_levels).collect(),
             false => Vec::new(),
         };
         Self {

@@ -44,7 +44,7 @@ pub(super) fn fresnel(cos_i: f64, cos_t: f64, eta: f64) -> f64 {
     0.5 * (rs * rs + rp * rp)
 }
 
-pub(super) fn srgb_to_linear(c: f64) -> f64 {
+pub(in crate::trace) fn srgb_to_linear(c: f64) -> f64 {
     if c <= 0.04045 {
         c / 12.92
     } else {
