@@ -83,7 +83,7 @@ struct Pending {
 
 // How the direction of the primary ray being traced changes a pixel right (column 0) and a
 // pixel down (column 1) on the image, or a sample's spacing where a pixel has several (world
-// space, not normalized): the ray generators set it (`ray_spread`) and `shade` filters the
+// space, not normalized): the ray generators set it (`set_spread`, `pixel.wgsl`) and `shade` filters the
 // textures its primary hit shows at that footprint (Igehy, "Tracing Ray Differentials",
 // SIGGRAPH 1999). Zero: the finest level, as for secondary rays.
 var<private> primary_spread: mat2x3<f32>;

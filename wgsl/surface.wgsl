@@ -108,6 +108,18 @@ fn bilinear(info: vec3<u32>, uv: vec2<f32>) -> vec3<f32> {
     return mix(top, bottom, f.y);
 }
 
+// The vec4s of `vertex_data` a stored triangle has (vertex normals, UVs).
+fn shading_stride() -> u32 {
+    return select(0u, 3u, SMOOTH_NORMALS) + select(0u, 2u, HAS_TEXTURES);
+}
+
+// Stored triangle `triangle`'s corners' UVs (with textures): corner 0's in the first vec4's
+// xy, 1's in its zw, 2's in the second's xy.
+fn uv_corners(triangle: u32) -> array<vec4<f32>, 2> {
+    let at = triangle * shading_stride() + select(0u, 3u, SMOOTH_NORMALS);
+    return array<vec4<f32>, 2>(vertex_at(at), vertex_at(at + 1u));
+}
+
 // Material `m`'s texture at `uv`, filtered trilinearly at level of detail `lod` (log2 of the
 // footprint's size in level-0 texels, `texture_lod`): bilinear in the two levels around it,
 // blended (OpenGL 4.6, 8.14). Level 0 alone at lod <= 0, the last level beyond it.
@@ -150,12 +162,9 @@ fn texture_lod(hit: Hit, footprint: mat2x3<f32>) -> f32 {
     let e2 = tri.v2 - tri.v0;
     let n = cross(e1, e2);
     let dual = mat2x3<f32>(cross(e2, n), cross(n, e1)) * (1.0 / dot(n, n));
-    var base = tri.triangle * select(2u, 5u, SMOOTH_NORMALS);
-    if SMOOTH_NORMALS {
-        base += 3u;
-    }
-    let a = vertex_at(base);
-    let b = vertex_at(base + 1u);
+    let corners = uv_corners(tri.triangle);
+    let a = corners[0];
+    let b = corners[1];
     let size = vec2<f32>(f32(m.texture_width), f32(m.texture_height));
     // Texels per unit of u and of v.
     let along = mat2x2<f32>((a.zw - a.xy) * size, (b.xy - a.xy) * size);
@@ -200,14 +209,7 @@ fn surface_at(ray: Ray, hit: Hit, lod: f32) -> Surface {
         geometric = -geometric;
     }
     var normal = geometric;
-    var stride = 0u;
-    if SMOOTH_NORMALS {
-        stride = 3u;
-    }
-    if HAS_TEXTURES {
-        stride += 2u;
-    }
-    let base = tri.triangle * stride;
+    let base = tri.triangle * shading_stride();
     if SMOOTH_NORMALS {
         // Each vertex normal in the world before interpolation, as a flattened copy has it.
         let n = normalize(w * vertex_normal(hit, vertex_at(base).xyz)
@@ -217,12 +219,9 @@ fn surface_at(ray: Ray, hit: Hit, lod: f32) -> Surface {
         normal = select(-n, n, dot(n, geometric) >= 0.0);
     }
     if HAS_TEXTURES && material.texture != NO_TEXTURE {
-        var uv_base = base;
-        if SMOOTH_NORMALS {
-            uv_base += 3u;
-        }
-        let a = vertex_at(uv_base);
-        let b = vertex_at(uv_base + 1u);
+        let corners = uv_corners(tri.triangle);
+        let a = corners[0];
+        let b = corners[1];
         let uv = w * a.xy + hit.u * a.zw + hit.v * b.xy;
         material.diffuse *= sample_texture(material, uv, lod);
     }
