@@ -120,6 +120,12 @@ fn uv_corners(triangle: u32) -> array<vec4<f32>, 2> {
     return array<vec4<f32>, 2>(vertex_at(at), vertex_at(at + 1u));
 }
 
+// The level after the one whose first texel, width and height are `info`'s x, y, z: it
+// follows that one's texels, half its size (rounded down, at least 1).
+fn next_level(info: vec3<u32>) -> vec3<u32> {
+    return vec3<u32>(info.x + info.y * info.z, max(info.y / 2u, 1u), max(info.z / 2u, 1u));
+}
+
 // Material `m`'s texture at `uv`, filtered trilinearly at level of detail `lod` (log2 of the
 // footprint's size in level-0 texels, `texture_lod`): bilinear in the two levels around it,
 // blended (OpenGL 4.6, 8.14). Level 0 alone at lod <= 0, the last level beyond it.
@@ -129,15 +135,14 @@ fn sample_texture(m: Material, uv: vec2<f32>, lod: f32) -> vec3<f32> {
     let k = u32(floor(l));
     var info = vec3<u32>(m.texture, m.texture_width, m.texture_height);
     for (var i = 0u; i < k; i++) {
-        info = vec3<u32>(info.x + info.y * info.z, max(info.y / 2u, 1u), max(info.z / 2u, 1u));
+        info = next_level(info);
     }
     let near = bilinear(info, uv);
     let f = l - f32(k);
     if f == 0.0 {
         return near;
     }
-    let next = vec3<u32>(info.x + info.y * info.z, max(info.y / 2u, 1u), max(info.z / 2u, 1u));
-    return mix(near, bilinear(next, uv), f);
+    return mix(near, bilinear(next_level(info), uv), f);
 }
 
 // The level of detail of the texture of the triangle `hit` is on, where a pixel's step right

@@ -376,10 +376,11 @@ impl<'a> Reference<'a> {
         }
         [DVec2::X, DVec2::Y].map(|axis| {
             let s = axis * step;
-            let change = match (camera.unproject(p + s), camera.unproject(p - s)) {
-                (Some(ahead), _) => ahead - d,
-                (None, Some(behind)) => d - behind,
-                (None, None) => DVec3::ZERO,
+            let change = match camera.unproject(p + s) {
+                Some(ahead) => ahead - d,
+                None => camera
+                    .unproject(p - s)
+                    .map_or(DVec3::ZERO, |behind| d - behind),
             };
             self.rotation * change
         })
