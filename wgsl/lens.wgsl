@@ -246,3 +246,28 @@ fn lens_unproject(lens: LensParams, p: vec2<f32>) -> vec4<f32> {
     }
     return vec4<f32>(0.0);
 }
+
+// The change to the lens's direction `d` at image point `p` a `step` on along each axis (x,
+// then y), or from the direction a step back where the lens masks the one ahead (zero where
+// it masks both): the pixel's footprint as directions (ray differentials, texture filtering;
+// the cube map's resampler). One call of the lens in a loop, not four: lavapipe inlines every
+// call, and each copy of a calibrated lens costs it memory.
+fn lens_steps(lens: LensParams, p: vec2<f32>, d: vec3<f32>, step: f32) -> mat2x3<f32> {
+    var steps = mat2x3<f32>();
+    var found = vec2<bool>(false);
+    // Ahead along x, then y; then back along those the lens masked ahead.
+    for (var k = 0u; k < 4u; k++) {
+        let axis = k % 2u;
+        let back = k >= 2u;
+        if found[axis] {
+            continue;
+        }
+        let s = select(step, -step, back) * vec2<f32>(f32(axis == 0u), f32(axis == 1u));
+        let q = lens_unproject(lens, p + s);
+        if q.w != 0.0 {
+            steps[axis] = select(q.xyz - d, d - q.xyz, back);
+            found[axis] = true;
+        }
+    }
+    return steps;
+}

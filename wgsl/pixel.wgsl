@@ -41,29 +41,11 @@ struct SampleSums {
 
 // Sets `primary_spread` for the ray along camera-space direction `d` through image point `p`
 // of the camera placed `at`, whose pixel's samples are `step` pixels apart (1 for one a pixel,
-// 1/side for side² samples): along each axis the change to the lens's direction a step on,
-// or from its direction a step back where the lens masks the one ahead (zero where it masks
-// both). Only where the scene has textures to filter. One call of the lens in a loop, not
-// four: lavapipe inlines every call, and each copy of a calibrated lens costs it memory.
+// 1/side for side² samples): `lens_steps` turned with the camera. Only where the scene has
+// textures to filter.
 fn set_spread(at: Placement, p: vec2<f32>, d: vec3<f32>, step: f32) {
     if HAS_TEXTURES {
-        var steps = mat2x3<f32>();
-        var found = vec2<bool>(false);
-        // Ahead along x, then y; then back along those the lens masked ahead.
-        for (var k = 0u; k < 4u; k++) {
-            let axis = k % 2u;
-            let back = k >= 2u;
-            if found[axis] {
-                continue;
-            }
-            let s = select(step, -step, back) * vec2<f32>(f32(axis == 0u), f32(axis == 1u));
-            let q = lens_unproject(lens, p + s);
-            if q.w != 0.0 {
-                steps[axis] = select(q.xyz - d, d - q.xyz, back);
-                found[axis] = true;
-            }
-        }
-        primary_spread = at.axes * steps;
+        primary_spread = at.axes * lens_steps(lens, p, d, step);
     }
 }
 

@@ -4,7 +4,7 @@
 //! reads it too; `wgsl/cube.wgsl` is the GPU twin of [`face_uv`], and a test checks that both
 //! pick the same face and UV.
 
-use glam::{DVec3, Vec2, Vec3};
+use glam::{DVec2, DVec3, Vec2, Vec3};
 
 use crate::error::Result;
 use crate::lens::{ClassicLens, ImageSize, LensCamera, LensModel};
@@ -59,6 +59,67 @@ pub fn sample_bordered(texels: &[[f32; 4]], size: u32, face: u32, uv: Vec2) -> [
     let top = mix(at(x, y), at(x + 1, y), f.x);
     let bottom = mix(at(x, y + 1), at(x + 1, y + 1), f.x);
     mix(top, bottom, f.y)
+}
+
+/// Lookups across a pixel at most in the resampler (`wgsl/cube_sample.wgsl`'s `MOST_TAPS`).
+pub const MOST_TAPS: u32 = 8;
+
+/// Face texels across the pixel whose ray is `d` and whose neighbours' rays are `steps` away
+/// ([`LensCamera::steps`]), on `face`: the longer of the pixel's two sides there.
+pub fn texels_across(size: u32, face: u32, d: Vec3, steps: [Vec3; 2]) -> f32 {
+    let f = &FACES[face as usize];
+    let on_face = |q: Vec3| Vec2::new(q.dot(f.right), q.dot(f.down)) / q.dot(f.forward);
+    let at = on_face(d);
+    let longest = steps
+        .iter()
+        .map(|&s| (on_face(d + s) - at).length())
+        .fold(0.0, f32::max);
+    // Face coordinates span [-1, 1]: half the face's texels a unit.
+    longest * 0.5 * size as f32
+}
+
+/// The directions the resampler reads for the pixel whose ray is `d` and whose neighbours'
+/// are `steps` away, as `wgsl/cube_sample.wgsl` makes them: the centres of an n × n grid of
+/// the pixel's square, n the face texels across it rounded, from 1 (its centre alone) to
+/// [`MOST_TAPS`], moved from `d` along `steps`.
+pub fn resample_taps(size: u32, d: Vec3, steps: [Vec3; 2]) -> impl Iterator<Item = Vec3> {
+    let n = (texels_across(size, face_uv(d).0, d, steps).round() as u32).clamp(1, MOST_TAPS);
+    (0..n * n).map(move |k| {
+        let o = (Vec2::new((k % n) as f32, (k / n) as f32) + 0.5) / n as f32 - 0.5;
+        d + steps[0] * o.x + steps[1] * o.y
+    })
+}
+
+/// The resampler's colour of the pixel whose ray is `d` and whose neighbours' are `steps`
+/// away (w = 1): the mean of the bilinear lookups at its [`resample_taps`].
+pub fn resample(texels: &[[f32; 4]], size: u32, d: Vec3, steps: [Vec3; 2]) -> [f32; 4] {
+    let mut sum = [0.0f32; 3];
+    let mut taps = 0;
+    for tap in resample_taps(size, d, steps) {
+        let (face, uv) = face_uv(tap);
+        let c = sample_bordered(texels, size, face, uv);
+        sum.iter_mut().zip(c).for_each(|(s, c)| *s += c);
+        taps += 1;
+    }
+    let taps = taps as f32;
+    [sum[0] / taps, sum[1] / taps, sum[2] / taps, 1.0]
+}
+
+/// Every direction the resampler reads through `camera` from faces of `size` texels
+/// ([`resample_taps`] of each pixel with a ray), for [`face_regions`].
+pub fn resampled_directions(camera: &LensCamera, size: u32) -> impl Iterator<Item = DVec3> + '_ {
+    let width = camera.size.width as usize;
+    camera
+        .directions()
+        .into_iter()
+        .enumerate()
+        .flat_map(move |(i, d)| {
+            d.into_iter().flat_map(move |d| {
+                let pixel = DVec2::new((i % width) as f64 + 0.5, (i / width) as f64 + 0.5);
+                let steps = camera.steps(pixel, d, 1.0).map(|s| s.as_vec3());
+                resample_taps(size, d.as_vec3(), steps).map(|t| t.as_dvec3())
+            })
+        })
 }
 
 /// A rectangle of a bordered face, in texels: columns `x0..x1`, rows `y0..y1`.

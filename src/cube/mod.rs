@@ -12,7 +12,8 @@ pub mod faces;
 use glam::{Vec2, Vec3};
 
 pub use faces::{
-    Region, bordered, bordered_focal, face_camera, face_regions, face_uv, sample_bordered,
+    MOST_TAPS, Region, bordered, bordered_focal, face_camera, face_regions, face_uv, resample,
+    resample_taps, resampled_directions, sample_bordered, texels_across,
 };
 
 use crate::error::{Error, Result};
@@ -31,7 +32,8 @@ use crate::trace::{GpuScene, TracePass};
 /// How much of each face [`CubeMap`] renders.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Coverage {
-    /// Only the part of each face the lens can reach ([`face_regions`]).
+    /// Only the part of each face the lens can reach ([`face_regions`] of the directions the
+    /// resampler reads, [`resampled_directions`]).
     Reachable,
     /// Every texel of every face the lens reaches (to compare).
     WholeFaces,
@@ -239,7 +241,7 @@ impl CubeMap {
             "the cube-map colour output",
             16 * camera.size.pixels() as u64,
         )?;
-        let mut regions = face_regions(camera.directions().into_iter().flatten(), size);
+        let mut regions = face_regions(resampled_directions(camera, size), size);
         if settings.coverage == Coverage::WholeFaces {
             for r in regions.iter_mut().flatten() {
                 *r = Region {
@@ -298,7 +300,8 @@ impl CubeMap {
                     storage_entry(3, false),
                 ],
             });
-            let constants = lens_constants(camera);
+            let [kind, formula] = lens_constants(camera);
+            let constants = [kind, formula, ("MOST_TAPS", f64::from(MOST_TAPS))];
             let sampler =
                 shader::compute_pipeline(device, "cube_sample", "main", &constants, &[&layout]);
             let buffer = |label: &str, bytes: u64, usage: wgpu::BufferUsages| {

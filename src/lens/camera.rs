@@ -327,6 +327,22 @@ impl LensCamera {
         (r.is_finite() && r <= self.lens.r_max()).then(|| self.direction_inside(n))
     }
 
+    /// The change to the direction `d` through image point `pixel` a `step` on along each
+    /// axis (x, then y), or from the direction a step back where the lens masks the one ahead
+    /// (zero where it masks both): the pixel's footprint as directions, in the camera's frame.
+    /// `wgsl/lens.wgsl`'s `lens_steps` is its twin.
+    pub fn steps(&self, pixel: DVec2, d: DVec3, step: f64) -> [DVec3; 2] {
+        [DVec2::X, DVec2::Y].map(|axis| {
+            let s = axis * step;
+            match self.unproject(pixel + s) {
+                Some(ahead) => ahead - d,
+                None => self
+                    .unproject(pixel - s)
+                    .map_or(DVec3::ZERO, |behind| d - behind),
+            }
+        })
+    }
+
     /// The direction at normalized coordinates already known to be inside the domain.
     fn direction_inside(&self, n: DVec2) -> DVec3 {
         let r = n.length();

@@ -374,16 +374,9 @@ impl<'a> Reference<'a> {
         if !self.features.textures {
             return [DVec3::ZERO; 2];
         }
-        [DVec2::X, DVec2::Y].map(|axis| {
-            let s = axis * step;
-            let change = match camera.unproject(p + s) {
-                Some(ahead) => ahead - d,
-                None => camera
-                    .unproject(p - s)
-                    .map_or(DVec3::ZERO, |behind| d - behind),
-            };
-            self.rotation * change
-        })
+        camera
+            .steps(p, d, step)
+            .map(|change| self.rotation * change)
     }
 
     /// The level of detail of the texture at `hit` of a primary ray along `dir` whose
