@@ -310,8 +310,13 @@ fn trace_samples(
     colour_out[index] = s.colour;
     add_rays(index, u32(round(s.colour.w * f32(count))));
     // Dammertz et al. (2010) estimate a pixel's error by how far the mean of half its samples
-    // lies from the mean of all: here in displayed colour, where the threshold is.
-    if estimate && largest(abs(shown(s.colour.rgb) - shown(s.half))) >= adaptive.threshold {
+    // lies from the mean of all: here in displayed colour, the largest over three halves (their
+    // interleaved half alone holds a sample either side of an edge along an axis at 2 × 2).
+    var worst = 0.0;
+    for (var h = 0u; h < 3u; h++) {
+        worst = max(worst, largest(abs(shown(s.colour.rgb) - shown(s.halves[h]))));
+    }
+    if estimate && worst >= adaptive.threshold {
         set_key(index, KEY_MORE);
     }
 }
@@ -405,10 +410,6 @@ fn masked_near(origin: vec2<u32>, l: vec2<u32>) -> bool {
         }
     }
     return false;
-}
-
-fn largest(v: vec3<f32>) -> f32 {
-    return max(v.x, max(v.y, v.z));
 }
 
 // How far linear interpolation between samples `a` and `b` may be off, in displayed colour,

@@ -15,3 +15,9 @@ fn shown(c: vec3<f32>) -> vec3<f32> {
     let v = clamp(c, vec3<f32>(0.0), vec3<f32>(1.0));
     return vec3<f32>(linear_to_srgb(v.r), linear_to_srgb(v.g), linear_to_srgb(v.b));
 }
+
+// A colour's largest channel: adaptive sampling's measure of a difference in displayed
+// colour against its threshold.
+fn largest(v: vec3<f32>) -> f32 {
+    return max(v.x, max(v.y, v.z));
+}

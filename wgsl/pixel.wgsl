@@ -22,21 +22,23 @@ override GLASS_CHANNELS: u32 = 1u;
 @group(0) @binding(5) var<storage, read_write> ids_out: array<u32>;
 
 // A pixel's samples: the mean radiance of those that have a ray (a box filter) with the
-// share that do in w, and the mean of the half of them on the strata of one colour of a
-// checkerboard (Dammertz et al.'s error estimate compares the two).
+// share that do in w, and the means of three halves of them (`SampleSums`: Dammertz et al.'s
+// error estimate compares a half's mean with the whole's).
 struct Sampled {
     colour: vec4<f32>,
-    half: vec3<f32>,
+    halves: array<vec3<f32>, 3>,
 }
 
 // Running sums over a pixel's samples, added in sample order (`add_sample`), wherever the
 // samples were traced: one invocation (`samples`) or several side by side
-// (`adaptive.wgsl`'s `trace_samples`) give the same bits.
+// (`adaptive.wgsl`'s `trace_samples`) give the same bits. Besides all of them, three halves
+// of the strata: those of one colour of a checkerboard, the first half of the rows, and the
+// first half of the columns.
 struct SampleSums {
     sum: vec3<f32>,
-    half_sum: vec3<f32>,
     covered: u32,
-    half_covered: u32,
+    half_sums: array<vec3<f32>, 3>,
+    half_covered: vec3<u32>,
 }
 
 // Sets `primary_spread` for the ray along camera-space direction `d` through image point `p`
@@ -69,20 +71,34 @@ fn add_sample(sums: ptr<function, SampleSums>, k: u32, side: u32, c: vec4<f32>) 
     }
     (*sums).sum += c.rgb;
     (*sums).covered += 1u;
-    if (k % side + k / side) % 2u == 0u {
-        (*sums).half_sum += c.rgb;
-        (*sums).half_covered += 1u;
+    let stratum = vec2<u32>(k % side, k / side);
+    let halves = vec3<bool>(
+        (stratum.x + stratum.y) % 2u == 0u,
+        2u * stratum.y < side,
+        2u * stratum.x < side,
+    );
+    for (var h = 0u; h < 3u; h++) {
+        if halves[h] {
+            (*sums).half_sums[h] += c.rgb;
+            (*sums).half_covered[h] += 1u;
+        }
     }
 }
 
-// What `count` samples summed in `sums` make.
+// What `count` samples summed in `sums` make (a half none of whose samples has a ray takes
+// the mean of all).
 fn sampled(sums: SampleSums, count: u32) -> Sampled {
+    var out = Sampled();
     if sums.covered == 0u {
-        return Sampled(vec4<f32>(0.0), vec3<f32>(0.0));
+        return out;
     }
     let mean = sums.sum / f32(sums.covered);
-    let half = select(mean, sums.half_sum / f32(max(sums.half_covered, 1u)), sums.half_covered > 0u);
-    return Sampled(vec4<f32>(mean, f32(sums.covered) / f32(count)), half);
+    out.colour = vec4<f32>(mean, f32(sums.covered) / f32(count));
+    for (var h = 0u; h < 3u; h++) {
+        let n = sums.half_covered[h];
+        out.halves[h] = select(mean, sums.half_sums[h] / f32(max(n, 1u)), n > 0u);
+    }
+    return out;
 }
 
 // The `side`² jittered stratified samples of pixel `pixel` (index `index`), in one invocation.

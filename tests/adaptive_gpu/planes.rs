@@ -1,5 +1,7 @@
 //! Adaptive sampling on planes made for the purpose: a smooth one traced at its block corners
-//! only and interpolated bicubically, and a straight edge refined only where it crosses.
+//! only and interpolated bicubically, a straight edge refined only where it crosses, and the
+//! estimating stage's pixels on an edge between its samples' columns and beside colours past
+//! the display's white.
 
 use super::*;
 
@@ -319,4 +321,90 @@ fn only_the_half_blocks_an_edge_crosses_are_traced() {
         in_crossed_blocks > 20,
         "{in_crossed_blocks} interpolated in crossed blocks"
     );
+}
+
+/// Two materials meet along a line through the centres of a column of pixels (the split
+/// plane seen straight down through a pinhole: x = 0 lies on the image's middle column), so
+/// each of those pixels' 2 × 2 estimating samples has its left column on one and its right on
+/// the other. The half of the strata of one colour of a checkerboard (Dammertz et al.'s
+/// interleaved half), like the top row, holds one sample of each: its mean is the pixel's,
+/// and alone it would leave the pixel at 4 samples with an error of a quarter of the step.
+/// The left column's half is one material: each such pixel takes every sample.
+#[test]
+fn an_edge_between_the_estimating_samples_columns_is_supersampled() {
+    let plane = lit_plane(
+        "columns",
+        20.0,
+        "position = [0.0, 0.0, 3.0]\nlook_at = [0.0, 0.0, 0.0]",
+        "position = [10.0, 6.0, 40.0]\nintensity = [1200.0, 1200.0, 1200.0]",
+        true,
+    );
+    let gpu = upload(&plane);
+    let (w, h) = (65u32, 49u32);
+    let cam = camera("rectilinear:f=1", w, h);
+    let (_, rays) = adaptive(&gpu, &cam, 16, 0.02, false);
+    let middle = w / 2;
+    for y in 0..h {
+        assert_eq!(
+            rays[(y * w + middle) as usize],
+            1 + 4 + 16,
+            "pixel ({middle}, {y})"
+        );
+    }
+}
+
+/// Displayed colour is clamped; the box filter is not. A plane lit far past white (radiance
+/// above 1 in every channel) ends against a black sky: along its edge a pixel whose colour
+/// bends and that has a neighbour brighter than the display shows takes every sample, however
+/// well its 2 × 2 estimating samples agree (four that all miss a sliver of the plane would
+/// leave it black, where its box average shows white). Judged from the one-ray image, whose
+/// pixels near the edge are the ones the adaptive frame traced there.
+#[test]
+fn a_pixel_beside_an_overexposed_one_takes_every_sample() {
+    let plane = lit_plane(
+        "overexposed",
+        1000.0,
+        "position = [0.0, -19.0, 1.5]\nlook_at = [6.0, 0.0, 1.0]",
+        "position = [10.0, 6.0, 400.0]\nintensity = [2.0e6, 2.0e6, 2.0e6]",
+        false,
+    );
+    let gpu = upload(&plane);
+    let (w, h) = (65u32, 49u32);
+    let cam = camera("rectilinear:f=1", w, h);
+    let one = uniform(&gpu, &cam, 1);
+    let over = |x: u32, y: u32| {
+        let c = one.colour[(y * w + x) as usize];
+        c[0].max(c[1]).max(c[2]) > 1.0
+    };
+    let plane_pixels = one.ids.iter().filter(|&&id| id != NO_HIT).count();
+    let lit = (0..h)
+        .flat_map(|y| (0..w).map(move |x| (x, y)))
+        .filter(|&(x, y)| over(x, y))
+        .count();
+    assert_eq!(lit, plane_pixels, "the whole plane is past white");
+    let (_, rays) = adaptive(&gpu, &cam, 16, 0.02, false);
+    let mut beside = 0;
+    for y in 0..h {
+        for x in 0..w {
+            let n = rays[(y * w + x) as usize];
+            // Pixels the estimating stage took (their centre's ray, then 2 × 2 samples).
+            if n < 1 + 4 {
+                continue;
+            }
+            let neighbours = [
+                (x.wrapping_sub(1), y),
+                (x + 1, y),
+                (x, y.wrapping_sub(1)),
+                (x, y + 1),
+            ];
+            if neighbours
+                .iter()
+                .any(|&(i, j)| i < w && j < h && over(i, j))
+            {
+                assert_eq!(n, 1 + 4 + 16, "pixel ({x}, {y})");
+                beside += 1;
+            }
+        }
+    }
+    assert!(beside > 40, "{beside} pixels beside the plane's edge");
 }
