@@ -72,7 +72,7 @@ pub(crate) struct StudyArgs {
     #[arg(
         long,
         value_delimiter = ',',
-        default_value = "1,4,16,auto:0.1:1,auto:0.1:4,auto:0.1,auto:0.02"
+        default_value = "1,4,16,auto:0.1:1,auto:0.1:4,auto:0.1,auto:0.02,auto:0.02:64"
     )]
     pub(crate) spp: Vec<Sampling>,
     /// Pixel filters to measure direct tracing with (comma-separated, as `render --filter`):
