@@ -139,7 +139,7 @@ height = 300
 plot = plot.resize((round(plot.width * height / plot.height), height), Image.LANCZOS)
 plot.save(f"{out}/tradeoff.png", optimize=True)
 # The verdict in rays: many-small through the Samyang, RT's rays against the traced cube's texels.
-rays = Image.open("results/lavapipe/rays/many-small/rays.samyang-7.5mm.png").convert("RGB")
+rays = Image.open("results/lavapipe/many-small/compare/rays.samyang-7.5mm.png").convert("RGB")
 rays = rays.resize((rays.width * 8 // 11, rays.height * 8 // 11), Image.LANCZOS)
 rays.save(f"{out}/rays.png", optimize=True)
 tiles = [Image.open(f"{out}/{n}.png").convert("RGB") for n in ("room", "gltf", "sibenik")]
