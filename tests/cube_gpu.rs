@@ -172,7 +172,8 @@ fn cube_error_falls_as_faces_grow() {
                 continue;
             };
             assert_eq!(c[3], 1.0, "pixel {i} has a ray");
-            let (x, y) = ((i % 128) as f64 + 0.5, (i / 128) as f64 + 0.5);
+            let width = cam.size.width as usize;
+            let (x, y) = ((i % width) as f64 + 0.5, (i / width) as f64 + 0.5);
             let steps = cam.steps(DVec2::new(x, y), d, 1.0).map(|s| s.as_vec3());
             let d = d.as_vec3();
             let (face, uv) = face_uv(d);

@@ -313,7 +313,7 @@ fn trace_samples(
     // lies from the mean of all: here in displayed colour, the largest over three halves (their
     // interleaved half alone holds a sample either side of an edge along an axis at 2 × 2).
     var worst = 0.0;
-    for (var h = 0u; h < 3u; h++) {
+    for (var h = 0u; estimate && h < 3u; h++) {
         worst = max(worst, largest(abs(shown(s.colour.rgb) - shown(s.halves[h]))));
     }
     if estimate && worst >= adaptive.threshold {
