@@ -31,7 +31,7 @@
 //    above 0, `trace_samples` first takes 2 × 2 stratified samples of each (`MODE_ESTIMATE`)
 //    and marks those whose half-sample mean differs from the mean by the threshold or more
 //    (Dammertz et al. 2010's error estimate); `more` lists those. The last list's pixels take
-//    the SAMPLES_PER_SIDE² jittered stratified samples that uniform supersampling takes, in
+//    the SAMPLES_PER_SIDE² samples that uniform supersampling takes (`sample_offset`), in
 //    its order (`trace_samples` again);
 // 5. with ground truth asked for, `untraced` lists the interpolated pixels and `trace_list`
 //    traces their centres' first hits, so ids, normals and ranges are never interpolated.

@@ -51,7 +51,7 @@ fn set_spread(at: Placement, p: vec2<f32>, d: vec3<f32>, step: f32) {
     }
 }
 
-// Sample `k` of the `side`² jittered stratified samples of pixel `pixel` (index `index`): its
+// Sample `k` of the `side`² samples (`sample_offset`) of pixel `pixel` (index `index`): its
 // radiance with w = 1, or all zero where the lens masks it.
 fn sample_radiance(pixel: vec2<u32>, index: u32, k: u32, side: u32) -> vec4<f32> {
     let p = vec2<f32>(pixel) + sample_offset(index, k, side);
@@ -101,7 +101,7 @@ fn sampled(sums: SampleSums, count: u32) -> Sampled {
     return out;
 }
 
-// The `side`² jittered stratified samples of pixel `pixel` (index `index`), in one invocation.
+// The `side`² samples of pixel `pixel` (index `index`), in one invocation.
 fn samples(pixel: vec2<u32>, index: u32, side: u32) -> Sampled {
     var sums = SampleSums();
     for (var k = 0u; k < side * side; k++) {

@@ -1,8 +1,8 @@
-// Where a pixel's samples go: an s × s grid of strata, one jittered sample in each, the jitter
-// from a hash of the pixel and the sample, so every render is the same (Mitchell 1987 and
-// Pharr, Jakob and Humphreys, "Physically Based Rendering", 4th ed., section 8.5: jittered
-// stratified sampling). The Rust twin is `fisheye_rt::trace::sampling`; the GPU and the f64
-// reference are compared over the same samples.
+// Where a pixel's samples go: side² of them on a rotated grid, one in each of the side × side
+// strata and one in each row and each column of the side² × side² cells that cut the pixel,
+// each at its cell's centre; which of 2·side such arrangements a pixel takes comes from a hash
+// of the pixel, so every render is the same. The Rust twin is `fisheye_rt::trace::sampling`
+// (it says why this pattern); the GPU and the f64 reference are compared over the same samples.
 
 // The pcg2d hash of Jarzynski and Olano ("Hash Functions for GPU Rendering", JCGT 9(3),
 // 2020): a PCG-style LCG step on each lane, mixed across lanes, twice.
@@ -17,14 +17,18 @@ fn pcg2d(seed: vec2<u32>) -> vec2<u32> {
     return v;
 }
 
-// Sample `k` of the `side` × `side` samples of pixel `index` (row-major): its offset from the
-// pixel's top-left corner, in [0, 1)². One sample sits at the centre.
+// Sample `k` of the `side` × `side` samples of pixel `index` (row-major by stratum): its
+// offset from the pixel's top-left corner, in (0, 1)². With one sample, the centre.
 fn sample_offset(index: u32, k: u32, side: u32) -> vec2<f32> {
-    if side == 1u {
-        return vec2<f32>(0.5);
+    let stratum = vec2<u32>(k % side, k / side);
+    let h = pcg2d(vec2<u32>(index, 0u));
+    // The lattice moved up h.y strata (wrapping around), and mirrored left to right where h.x
+    // is odd: the stratum's cell on one of its diagonals.
+    let shift = h.y % side;
+    var cell = vec2<u32>((stratum.y + side - stratum.x + shift) % side);
+    if (h.x & 1u) == 1u {
+        let r = (stratum.y + stratum.x + shift) % side;
+        cell = vec2<u32>(side - 1u - r, r);
     }
-    // 24 bits of each hash lane, exactly representable in f32.
-    let jitter = vec2<f32>(pcg2d(vec2<u32>(index, k)) >> vec2<u32>(8u)) * (1.0 / 16777216.0);
-    let stratum = vec2<f32>(f32(k % side), f32(k / side));
-    return (stratum + jitter) / f32(side);
+    return (vec2<f32>(stratum * side + cell) + 0.5) / f32(side * side);
 }

@@ -2,8 +2,8 @@
 // invocation per pixel, dispatched over the image in WORKGROUP_2D × WORKGROUP_2D tiles.
 // The same kernel serves every lens, pinhole included: only ray generation differs.
 //
-// With SAMPLES_PER_SIDE = s > 1 the colour is the mean radiance of s² jittered stratified
-// samples inside the pixel (a box filter), and w the share of them the lens covers; the
+// With SAMPLES_PER_SIDE = s > 1 the colour is the mean radiance of s² samples inside the
+// pixel (`sampling.wgsl`; a box filter), and w the share of them the lens covers; the
 // ground truth (geometry, id) stays the single ray through the pixel's centre. With GLASS the
 // colour is traced through a prescription's surfaces instead (`through_glass`), and the
 // ground truth is its fitted model's centre ray.

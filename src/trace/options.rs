@@ -26,7 +26,7 @@ pub struct RenderOptions {
     pub directions: DirectionSource,
     /// How rays find their hits.
     pub traversal: Traversal,
-    /// Rays per pixel (a square: jittered stratified samples, box-filtered; see
+    /// Rays per pixel (a square: samples on a rotated grid, box-filtered; see
     /// [`super::sampling`]). Ground-truth outputs stay the one ray through the pixel's centre.
     /// With `adaptive`, the most a pixel takes.
     pub spp: u32,
@@ -171,7 +171,7 @@ pub fn surface_constants(f: Features) -> [(&'static str, f64); 6] {
 /// How many rays a pixel's colour takes, as `--spp` and a setup's label write it.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Sampling {
-    /// `N`: every pixel `N` rays (a square: jittered stratified samples, box-filtered).
+    /// `N`: every pixel `N` rays (a square: samples on a rotated grid, box-filtered).
     Uniform(u32),
     /// `auto[:THRESHOLD[:MAX]]`: adaptive sampling ([`super::AdaptivePass`]) at the threshold
     /// ([`super::Adaptive::threshold`], 0.02 by default), at most `MAX` samples a pixel (16 by

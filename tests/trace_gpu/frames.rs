@@ -131,7 +131,7 @@ fn bvh_as_deep_as_the_stack_renders_and_deeper_is_refused() {
     );
 }
 
-/// Several rays per pixel: the GPU places and shades the same jittered stratified samples as
+/// Several rays per pixel: the GPU places and shades the same samples (`sample_offset`) as
 /// the f64 reference (the WGSL hash and its Rust twin agree), reruns are bit-identical, the
 /// colour's w is the share of the pixel the lens covers (between 0 and 1 only along the image
 /// circle's edge), and the ground truth stays the centre ray's.
@@ -165,7 +165,7 @@ fn supersampled_renders_match_the_reference() {
     }
 }
 
-/// Jittered stratified sampling converges faster than independent random samples would:
+/// The samples' rotated grid converges faster than independent random samples would:
 /// against a 256-ray reference, the error (MSE of the displayed values) falls with the rays
 /// per pixel N at least as N^-1.15 from 4 to 64 (stratification predicts N^-1.5 where edges
 /// dominate, Mitchell 1996; independent samples give N^-1).
