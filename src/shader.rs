@@ -17,7 +17,7 @@ use crate::split::SceneArrays;
 const SCENE_ARRAYS: &str = "scene_arrays";
 
 /// Every WGSL file of the project, by name (its file stem under `wgsl/`).
-pub const FILES: [(&str, &str); 36] = [
+pub const FILES: [(&str, &str); 37] = [
     ("math", include_str!("../wgsl/math.wgsl")),
     ("quaternion", include_str!("../wgsl/quaternion.wgsl")),
     ("calibrated", include_str!("../wgsl/calibrated.wgsl")),
@@ -32,6 +32,7 @@ pub const FILES: [(&str, &str); 36] = [
     ("frame", include_str!("../wgsl/frame.wgsl")),
     ("colour", include_str!("../wgsl/colour.wgsl")),
     ("adaptive", include_str!("../wgsl/adaptive.wgsl")),
+    ("interpolate", include_str!("../wgsl/interpolate.wgsl")),
     (
         "adaptive_lists",
         include_str!("../wgsl/adaptive_lists.wgsl"),

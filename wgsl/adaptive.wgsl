@@ -43,6 +43,7 @@
 // bit-identical.
 #import pixel
 #import colour
+#import interpolate
 
 // Mirrors `fisheye_rt::shared::AdaptiveParams`.
 struct AdaptiveParams {
@@ -412,24 +413,30 @@ fn masked_near(origin: vec2<u32>, l: vec2<u32>) -> bool {
     return false;
 }
 
-// How far linear interpolation between samples `a` and `b` may be off, in displayed colour,
-// judged from the samples beside them along the same line (`before` a, `after` b, where the
-// flags say they exist on the same surface): the larger second difference at either end,
-// which is zero along a linear change and the full step at a step (the error of linear
-// interpolation grows with the second derivative: |f - lerp| <= h² max|f''| / 8); with no
-// sample beside either end, the difference between the ends.
-fn bend(before: vec3<f32>, a: vec3<f32>, b: vec3<f32>, after: vec3<f32>, has: vec2<bool>) -> f32 {
-    if !any(has) {
-        return largest(abs(b - a));
+// Whether the eight lattice points beside the corners of the block from `l` to `l11`, one
+// beyond each corner along each of its edges' lines, see what the corner beside them sees
+// (material and instance, or sky: `key`) where they lie in the image. A silhouette that
+// passes between a corner and the next point beyond may curve into the block between
+// corners that agree; one that passes outside them all is a block or more away.
+fn ring_agrees(
+    origin: vec2<u32>, l: vec2<i32>, l11: vec2<i32>, a: Corner, b: Corner, c: Corner, d: Corner,
+) -> bool {
+    let last = vec2<i32>(level_lattice()) - 1;
+    let corners = array<vec2<i32>, 4>(l, vec2<i32>(l11.x, l.y), vec2<i32>(l.x, l11.y), l11);
+    let keys = vec4<u32>(a.key, b.key, c.key, d.key);
+    for (var i = 0u; i < 4u; i++) {
+        // Outward from corner i: left or right, then up or down.
+        let out = select(vec2<i32>(-1), vec2<i32>(1), vec2<bool>((i & 1u) == 1u, i >= 2u));
+        for (var axis = 0u; axis < 2u; axis++) {
+            var p = corners[i];
+            p[axis] += out[axis];
+            let inside = all(p >= vec2<i32>(0)) && all(p <= last);
+            if inside && tile_corner[tile_index(origin, p)].key != keys[i] {
+                return false;
+            }
+        }
     }
-    var worst = 0.0;
-    if has.x {
-        worst = largest(abs(before - 2.0 * a + b));
-    }
-    if has.y {
-        worst = max(worst, largest(abs(a - 2.0 * b + after)));
-    }
-    return worst;
+    return true;
 }
 
 // `bend` along the lattice edge from lattice point `a` to its neighbour `b`, from the tile of
@@ -487,26 +494,6 @@ fn spline_points(origin: vec2<u32>, l: vec2<u32>, l11: vec2<u32>, key: u32) -> u
         }
     }
     return points;
-}
-
-// The weights of the points at -1, 0, 1 and 2 for a point at `t` in [0, 1] on the Catmull-Rom
-// spline through them: Keys's cubic convolution with a = -1/2 ("Cubic convolution
-// interpolation for digital image processing", 1981), which reproduces quadratics, so its
-// error falls as h³ where linear interpolation's falls as h²; its slope is continuous across
-// the blocks' edges, where bilinear interpolation's kinks (which ꟻLIP sees as edges).
-fn catmull_rom(t: f32) -> vec4<f32> {
-    let t2 = t * t;
-    let t3 = t2 * t;
-    return 0.5 * vec4<f32>(-t3 + 2.0 * t2 - t, 3.0 * t3 - 5.0 * t2 + 2.0, -3.0 * t3 + 4.0 * t2 + t, t3 - t2);
-}
-
-// The spline with weights `w` through `a`, `b`, `c`, `d`, an end it may not pass through (`has`
-// false) replaced by the line through the middle two continued (2b - c, as Keys does past an
-// image's edge): with neither end, it is the linear interpolation between `b` and `c`.
-fn spline(w: vec4<f32>, a: vec3<f32>, b: vec3<f32>, c: vec3<f32>, d: vec3<f32>, has: vec2<bool>) -> vec3<f32> {
-    let before = select(2.0 * b - c, a, has.x);
-    let after = select(2.0 * c - b, d, has.y);
-    return w.x * before + w.y * b + w.z * c + w.w * after;
 }
 
 // `spline` down column `x` of the 4 × 4 points (`spline_points`: `points`), from tile entries
@@ -606,6 +593,9 @@ fn classify(
                 refine = !(same_surface(a, b) && same_surface(a, c) && same_surface(b, d)
                     && same_surface(c, d) && same_surface(a, d) && same_surface(b, c))
                     || (edge_near && !block_mask_is(first, end, true));
+            }
+            if LEVEL == 0u && !refine {
+                refine = !ring_agrees(origin, vec2<i32>(l), vec2<i32>(l11), a, b, c, d);
             }
         }
         if LEVEL == 0u {

@@ -1,7 +1,8 @@
 //! Adaptive sampling on planes made for the purpose: a smooth one traced at its block corners
-//! only and interpolated bicubically, a straight edge refined only where it crosses, and the
-//! estimating stage's pixels on an edge between its samples' columns and beside colours past
-//! the display's white.
+//! only and interpolated bicubically, a straight edge refined only where it crosses, wedges
+//! whose tips reach into blocks between corners that see sky, and the estimating stage's
+//! pixels on an edge between its samples' columns and beside colours past the display's
+//! white.
 
 use super::*;
 
@@ -10,26 +11,33 @@ use super::*;
 /// `camera` (its position and look-at point, TOML), through the scene loader. With `split`,
 /// its halves x < 0 and x > 0 are of two materials (diffuse 0.8 and 0.5).
 fn lit_plane(tag: &str, half: f64, camera: &str, light: &str, split: bool) -> Scene {
-    let dir = std::env::temp_dir().join(format!("fisheye-{tag}-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
     let far = half.min(20.0);
-    let obj = if split {
-        std::fs::write(
-            dir.join("plane.mtl"),
-            "newmtl light\nKd 0.8 0.8 0.8\nnewmtl dark\nKd 0.5 0.5 0.5\n",
-        )
-        .unwrap();
-        format!(
+    let (obj, mtl) = if split {
+        let obj = format!(
             "mtllib plane.mtl\nv -{half} -{half} 0\nv 0 -{half} 0\nv 0 {far} 0\nv -{half} {far} 0\n\
              v {half} -{half} 0\nv {half} {far} 0\nusemtl light\nf 1 2 3\nf 1 3 4\n\
              usemtl dark\nf 2 5 6\nf 2 6 3\n"
-        )
+        );
+        let mtl = "newmtl light\nKd 0.8 0.8 0.8\nnewmtl dark\nKd 0.5 0.5 0.5\n";
+        (obj, Some(mtl))
     } else {
-        format!(
+        let obj = format!(
             "v -{half} -{half} 0\nv {half} -{half} 0\nv {half} {far} 0\nv -{half} {far} 0\n\
              f 1 2 3\nf 1 3 4\n"
-        )
+        );
+        (obj, None)
     };
+    lit_mesh(tag, &obj, mtl, camera, light)
+}
+
+/// The mesh `obj` (OBJ text; its materials `mtl`, as `plane.mtl`) under one point light, black
+/// ambient and sky, seen from `camera`, through the scene loader (as [`lit_plane`]).
+fn lit_mesh(tag: &str, obj: &str, mtl: Option<&str>, camera: &str, light: &str) -> Scene {
+    let dir = std::env::temp_dir().join(format!("fisheye-{tag}-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    if let Some(mtl) = mtl {
+        std::fs::write(dir.join("plane.mtl"), mtl).unwrap();
+    }
     std::fs::write(dir.join("plane.obj"), obj).unwrap();
     std::fs::write(
         dir.join("plane.toml"),
@@ -39,11 +47,11 @@ fn lit_plane(tag: &str, half: f64, camera: &str, light: &str, split: bool) -> Sc
         ),
     )
     .unwrap();
-    let plane = fisheye_rt::scene::load(dir.join("plane.toml").to_str().unwrap())
+    let scene = fisheye_rt::scene::load(dir.join("plane.toml").to_str().unwrap())
         .unwrap()
         .scene;
     std::fs::remove_dir_all(&dir).unwrap();
-    plane
+    scene
 }
 
 /// A plane lit by a distant point light fills a pinhole's view: no edges, colour changing smoothly.
@@ -108,9 +116,10 @@ fn a_smooth_scene_is_traced_at_block_corners_only() {
     );
 }
 
-/// The same plane under a nearer light, whose falloff bends the colour within a block, its
-/// halves of two materials, at threshold 1 (every block whose corners see one material
-/// interpolated, no colour test): each such block takes the bicubic through its 4 × 4 lattice
+/// A plane under a nearer light, whose falloff bends the colour within a block, its halves
+/// either side of a line at an angle of two materials, at threshold 1 (no colour test: every
+/// block whose corners, and the lattice points beside them along its edges, see one material
+/// is interpolated): each such block takes the bicubic through its 4 × 4 lattice
 /// points (Catmull-Rom splines down the columns, then across; kept within its corners'
 /// colours), where a point of its ring sees the other material, lies outside the image or not
 /// a whole spacing on (the width, 67, puts the last lattice column 2 pixels from the one
@@ -120,21 +129,24 @@ fn a_smooth_scene_is_traced_at_block_corners_only() {
 /// image than the bilinear through the same corners would be.
 #[test]
 fn smooth_blocks_are_interpolated_bicubically() {
-    let plane = lit_plane(
+    // The square z = 0 from -20 to 20, its halves either side of the diagonal y = x of two
+    // materials, so that the line between them crosses the image at an angle.
+    let plane = lit_mesh(
         "bicubic",
-        20.0,
+        "mtllib plane.mtl\nv -20 -20 0\nv 20 -20 0\nv 20 20 0\nv -20 20 0\n\
+         usemtl light\nf 1 3 4\nusemtl dark\nf 1 2 3\n",
+        Some("newmtl light\nKd 0.8 0.8 0.8\nnewmtl dark\nKd 0.5 0.5 0.5\n"),
         "position = [0.3, 0.0, 3.0]\nlook_at = [0.3, 0.0, 0.0]",
         "position = [1.0, 0.5, 1.5]\nintensity = [6.0, 6.0, 6.0]",
-        true,
     );
     let gpu = upload(&plane);
     let (w, h) = (67usize, 49usize);
     let cam = camera("rectilinear:f=1", w as u32, h as u32);
     let one = uniform(&gpu, &cam, 1);
     let (out, rays) = adaptive(&gpu, &cam, 1, 1.0, false);
-    // The first two triangles are the light half's.
-    let light = |x: usize, y: usize| one.ids[y * w + x] < 2;
-    assert!(one.ids.iter().all(|&id| id < 4), "the plane fills the view");
+    // The first triangle is the light half.
+    let light = |x: usize, y: usize| one.ids[y * w + x] == 0;
+    assert!(one.ids.iter().all(|&id| id < 2), "the plane fills the view");
     let block = ADAPTIVE_BLOCK as usize;
     // Catmull-Rom weights of the points at -1, 0, 1, 2 at t in [0, 1] (Keys 1981, a = -1/2).
     let weights = |t: f64| {
@@ -177,7 +189,24 @@ fn smooth_blocks_are_interpolated_bicubically() {
             let (x1, y1) = (columns[2].unwrap(), rows[2].unwrap());
             let corners = [(x0, y0), (x1, y0), (x0, y1), (x1, y1)];
             let material = light(x0, y0);
-            if corners.iter().any(|&(x, y)| light(x, y) != material) {
+            // The lattice points one beyond each corner along the block's edges (the image's
+            // last row and column are on the lattice).
+            let before = |v: usize| v.checked_sub(block);
+            let after = |v: usize, n: usize| (v < n - 1).then(|| (v + block).min(n - 1));
+            let beside = [
+                (before(x0), Some(y0)),
+                (Some(x0), before(y0)),
+                (after(x1, w), Some(y0)),
+                (Some(x1), before(y0)),
+                (before(x0), Some(y1)),
+                (Some(x0), after(y1, h)),
+                (after(x1, w), Some(y1)),
+                (Some(x1), after(y1, h)),
+            ];
+            let differs = |&(x, y): &(Option<usize>, Option<usize>)| {
+                x.zip(y).is_some_and(|(x, y)| light(x, y) != material)
+            };
+            if corners.iter().any(|&(x, y)| light(x, y) != material) || beside.iter().any(differs) {
                 continue; // refined: its pixels are the half-blocks' (level 1)
             }
             // Ring point (a, b) of the 4 × 4, where the spline may pass through it.
@@ -407,4 +436,74 @@ fn a_pixel_beside_an_overexposed_one_takes_every_sample() {
         }
     }
     assert!(beside > 40, "{beside} pixels beside the plane's edge");
+}
+
+/// Thin wedges against the sky, their tips pointing left at several heights and depths: where
+/// a tip reaches into a 4 × 4 block between its corners, all four of which see sky, while a
+/// lattice point one spacing beyond a corner along the block's edge sees the wedge (the tip
+/// passes between them), the block is not interpolated from its corners (which would paint
+/// the tip over with sky) but refined: its centre and the midpoints of its edges are traced.
+/// Judged from the one-ray image's hits.
+#[test]
+fn a_silhouette_beside_a_blocks_corners_refines_it() {
+    // Wedge k: tip at x = -4 + 0.37 k, widening to 1.6 high at x = 6, at height 2.3 k - 7.
+    let mut obj = String::new();
+    for k in 0..7 {
+        let (tip, y) = (-4.0 + 0.37 * f64::from(k), 2.3 * f64::from(k) - 7.0);
+        obj += &format!("v {tip} 0 {y}\nv 6 0 {}\nv 6 0 {}\n", y - 0.8, y + 0.8);
+        let v = 3 * k + 1;
+        obj += &format!("f {v} {} {}\n", v + 1, v + 2);
+    }
+    let wedges = lit_mesh(
+        "wedges",
+        &obj,
+        None,
+        "position = [0.0, -10.0, 0.0]\nlook_at = [0.0, 0.0, 0.0]",
+        "position = [0.0, -10.0, 0.0]\nintensity = [100.0, 100.0, 100.0]",
+    );
+    let gpu = upload(&wedges);
+    let (w, h) = (65u32, 49u32);
+    let cam = camera("rectilinear:f=1", w, h);
+    let one = uniform(&gpu, &cam, 1);
+    let (_, rays) = adaptive(&gpu, &cam, 1, 0.02, false);
+    let hit = |x: i64, y: i64| {
+        (0..i64::from(w)).contains(&x)
+            && (0..i64::from(h)).contains(&y)
+            && one.ids[(y * i64::from(w) + x) as usize] != NO_HIT
+    };
+    let b = i64::from(ADAPTIVE_BLOCK);
+    let mut tips = 0;
+    for by in 0..(i64::from(h) - 1) / b {
+        for bx in 0..(i64::from(w) - 1) / b {
+            let (x0, y0, x1, y1) = (bx * b, by * b, bx * b + b, by * b + b);
+            let corners = [(x0, y0), (x1, y0), (x0, y1), (x1, y1)];
+            if corners.iter().any(|&(x, y)| hit(x, y)) {
+                continue;
+            }
+            let ring = [
+                (x0 - b, y0),
+                (x0, y0 - b),
+                (x1 + b, y0),
+                (x1, y0 - b),
+                (x0 - b, y1),
+                (x0, y1 + b),
+                (x1 + b, y1),
+                (x1, y1 + b),
+            ];
+            let inside = (y0..y1).any(|y| (x0..x1).any(|x| hit(x, y)));
+            if !ring.iter().any(|&(x, y)| hit(x, y)) {
+                continue;
+            }
+            let traced = |x: i64, y: i64| rays[(y * i64::from(w) + x) as usize] > 0;
+            let half = b / 2;
+            for (x, y) in [(x0 + half, y0 + half), (x0 + half, y0), (x0, y0 + half)] {
+                assert!(traced(x, y), "block at ({x0}, {y0}): ({x}, {y}) untraced");
+            }
+            tips += usize::from(inside);
+        }
+    }
+    assert!(
+        tips >= 2,
+        "{tips} blocks with a tip inside between corners that miss"
+    );
 }
