@@ -8,14 +8,15 @@
 //    no list;
 // 2. `classify` looks at each block's four corners (Whitted 1980 subdivided a pixel whose
 //    corners disagree): where they agree (the same surface, normals and tangent planes, and
-//    displayed colour along each edge that bends by less than the threshold, see `bend`) and
-//    the lens covers every pixel, the block's other pixels are interpolated between the
-//    corners in linear radiance, bicubically (Catmull-Rom splines through the corners and the
-//    ring of lattice points beyond them, a point of the ring on another surface replaced by a
-//    line: `spline_points`, `catmull_rom`), so no interpolation crosses a change of surface or
-//    a depth step. `midpoints` (in `adaptive_lists.wgsl`) lists the half-blocks' corners in
-//    the other blocks, the midpoints of their edges and their centres, and `trace_list`
-//    traces them;
+//    displayed colour along each edge that bends by less than the threshold, see `bend`), the
+//    lattice points beyond them along its edges see what they see (`ring_agrees`: no
+//    silhouette curves in between) and the lens covers every pixel, the block's other pixels
+//    are interpolated between the corners in linear radiance, bicubically (Catmull-Rom
+//    splines through the corners and the ring of lattice points beyond them, a point of the
+//    ring on another surface replaced by a line: `spline_points`, `catmull_rom`), so no
+//    interpolation crosses a change of surface or a depth step. `midpoints` (in
+//    `adaptive_lists.wgsl`) lists the half-blocks' corners in the other blocks, the midpoints
+//    of their edges and their centres, and `trace_list` traces them;
 // 3. `classify` at level 1 does the same for the half-blocks of those blocks (interpolating
 //    bilinearly), and the pixels of the half-blocks whose corners disagree are listed and
 //    traced: rays subdivide where the image changes, as Painter and Sloan (1989) and Thomas,
