@@ -54,6 +54,32 @@ fn lit_mesh(tag: &str, obj: &str, mtl: Option<&str>, camera: &str, light: &str) 
     scene
 }
 
+/// The lattice points one beyond each corner of the block from `(x0, y0)` to `(x1, y1)` along
+/// its edges' lines, where they lie in an image of `(w, h)` pixels (whose last row and column
+/// are on the lattice): those `ring_agrees` in `wgsl/adaptive.wgsl` compares with the corners.
+fn beside_corners(
+    (x0, y0): (usize, usize),
+    (x1, y1): (usize, usize),
+    (w, h): (usize, usize),
+) -> Vec<(usize, usize)> {
+    let block = ADAPTIVE_BLOCK as usize;
+    let before = |v: usize| v.checked_sub(block);
+    let after = |v: usize, n: usize| (v < n - 1).then(|| (v + block).min(n - 1));
+    [
+        (before(x0), Some(y0)),
+        (Some(x0), before(y0)),
+        (after(x1, w), Some(y0)),
+        (Some(x1), before(y0)),
+        (before(x0), Some(y1)),
+        (Some(x0), after(y1, h)),
+        (after(x1, w), Some(y1)),
+        (Some(x1), after(y1, h)),
+    ]
+    .into_iter()
+    .filter_map(|(x, y)| x.zip(y))
+    .collect()
+}
+
 /// A plane lit by a distant point light fills a pinhole's view: no edges, colour changing smoothly.
 /// Only the lattice of block corners is traced, and bilinear interpolation between them stays
 /// within a quarter of the threshold of the one-ray image in displayed colour: the blocks are
@@ -189,24 +215,9 @@ fn smooth_blocks_are_interpolated_bicubically() {
             let (x1, y1) = (columns[2].unwrap(), rows[2].unwrap());
             let corners = [(x0, y0), (x1, y0), (x0, y1), (x1, y1)];
             let material = light(x0, y0);
-            // The lattice points one beyond each corner along the block's edges (the image's
-            // last row and column are on the lattice).
-            let before = |v: usize| v.checked_sub(block);
-            let after = |v: usize, n: usize| (v < n - 1).then(|| (v + block).min(n - 1));
-            let beside = [
-                (before(x0), Some(y0)),
-                (Some(x0), before(y0)),
-                (after(x1, w), Some(y0)),
-                (Some(x1), before(y0)),
-                (before(x0), Some(y1)),
-                (Some(x0), after(y1, h)),
-                (after(x1, w), Some(y1)),
-                (Some(x1), after(y1, h)),
-            ];
-            let differs = |&(x, y): &(Option<usize>, Option<usize>)| {
-                x.zip(y).is_some_and(|(x, y)| light(x, y) != material)
-            };
-            if corners.iter().any(|&(x, y)| light(x, y) != material) || beside.iter().any(differs) {
+            let beside = beside_corners((x0, y0), (x1, y1), (w, h));
+            let differs = |&(x, y): &(usize, usize)| light(x, y) != material;
+            if corners.iter().any(differs) || beside.iter().any(differs) {
                 continue; // refined: its pixels are the half-blocks' (level 1)
             }
             // Ring point (a, b) of the 4 × 4, where the spline may pass through it.
@@ -466,39 +477,27 @@ fn a_silhouette_beside_a_blocks_corners_refines_it() {
     let cam = camera("rectilinear:f=1", w, h);
     let one = uniform(&gpu, &cam, 1);
     let (_, rays) = adaptive(&gpu, &cam, 1, 0.02, false);
-    let hit = |x: i64, y: i64| {
-        (0..i64::from(w)).contains(&x)
-            && (0..i64::from(h)).contains(&y)
-            && one.ids[(y * i64::from(w) + x) as usize] != NO_HIT
-    };
-    let b = i64::from(ADAPTIVE_BLOCK);
+    let (w, h) = (w as usize, h as usize);
+    let hit = |&(x, y): &(usize, usize)| one.ids[y * w + x] != NO_HIT;
+    let b = ADAPTIVE_BLOCK as usize;
     let mut tips = 0;
-    for by in 0..(i64::from(h) - 1) / b {
-        for bx in 0..(i64::from(w) - 1) / b {
-            let (x0, y0, x1, y1) = (bx * b, by * b, bx * b + b, by * b + b);
+    // Whole blocks only (65 × 49 puts the last lattice row and column a block on).
+    for y0 in (0..h - 1).step_by(b) {
+        for x0 in (0..w - 1).step_by(b) {
+            let (x1, y1) = (x0 + b, y0 + b);
             let corners = [(x0, y0), (x1, y0), (x0, y1), (x1, y1)];
-            if corners.iter().any(|&(x, y)| hit(x, y)) {
+            let beside = beside_corners((x0, y0), (x1, y1), (w, h));
+            if corners.iter().any(hit) || !beside.iter().any(hit) {
                 continue;
             }
-            let ring = [
-                (x0 - b, y0),
-                (x0, y0 - b),
-                (x1 + b, y0),
-                (x1, y0 - b),
-                (x0 - b, y1),
-                (x0, y1 + b),
-                (x1 + b, y1),
-                (x1, y1 + b),
-            ];
-            let inside = (y0..y1).any(|y| (x0..x1).any(|x| hit(x, y)));
-            if !ring.iter().any(|&(x, y)| hit(x, y)) {
-                continue;
-            }
-            let traced = |x: i64, y: i64| rays[(y * i64::from(w) + x) as usize] > 0;
             let half = b / 2;
             for (x, y) in [(x0 + half, y0 + half), (x0 + half, y0), (x0, y0 + half)] {
-                assert!(traced(x, y), "block at ({x0}, {y0}): ({x}, {y}) untraced");
+                assert!(
+                    rays[y * w + x] > 0,
+                    "block at ({x0}, {y0}): ({x}, {y}) untraced"
+                );
             }
+            let inside = (y0..y1).any(|y| (x0..x1).any(|x| hit(&(x, y))));
             tips += usize::from(inside);
         }
     }
