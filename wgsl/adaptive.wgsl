@@ -265,11 +265,11 @@ override SAMPLE_LANES: u32 = 1u;
 var<workgroup> lane_radiance: array<vec4<f32>, WORKGROUP_1D>;
 
 // Traces the listed pixels' samples, LIST_MODE's MODE_SAMPLES (SAMPLES_PER_SIDE² each) or
-// MODE_ESTIMATE (ADAPTIVE_ESTIMATE_SIDE²), SAMPLE_LANES invocations a pixel: lane j traces
-// samples j, j + SAMPLE_LANES, ..., and the pixel's first lane adds them to its sums in sample
-// order, as `samples` does in one invocation, so the colour is the same bit for bit. (With one
-// invocation a pixel, a few listed pixels left a large GPU waiting on a few long invocations:
-// on an H200, supersampling a few thousand pixels took 3 to 5 ms.)
+// MODE_ESTIMATE (ADAPTIVE_ESTIMATE_SIDE²), SAMPLE_LANES invocations a pixel (the layout
+// `fisheye_rt::trace::SampleLanes` picks for the device): lane j traces samples j,
+// j + SAMPLE_LANES, ..., and the pixel's first lane adds them to its sums in sample order, as
+// `samples` does in one invocation, so the colour is the same bit for bit. With one lane, each
+// invocation calls `samples` for its pixel, with no barriers.
 @compute @workgroup_size(WORKGROUP_1D)
 fn trace_samples(
     @builtin(workgroup_id) group: vec3<u32>,
@@ -289,26 +289,34 @@ fn trace_samples(
         index = atomicLoad(&work[ADAPTIVE_HEADER + i]);
     }
     let pixel = vec2<u32>(index % lens.width, index / lens.width);
-    var sums = SampleSums();
-    // Every invocation runs every round and its barriers, listed or not.
-    for (var first = 0u; first < count; first += SAMPLE_LANES) {
-        var c = vec4<f32>(0.0);
-        if listed && first + lane < count {
-            c = sample_radiance(pixel, index, first + lane, side);
+    var s: Sampled;
+    if SAMPLE_LANES == 1u {
+        if !listed {
+            return;
         }
-        lane_radiance[local] = c;
-        workgroupBarrier();
-        if listed && lane == 0u {
-            for (var j = 0u; j < min(SAMPLE_LANES, count - first); j++) {
-                add_sample(&sums, first + j, side, lane_radiance[local + j]);
+        s = samples(pixel, index, side);
+    } else {
+        var sums = SampleSums();
+        // Every invocation runs every round and its barriers, listed or not.
+        for (var first = 0u; first < count; first += SAMPLE_LANES) {
+            var c = vec4<f32>(0.0);
+            if listed && first + lane < count {
+                c = sample_radiance(pixel, index, first + lane, side);
             }
+            lane_radiance[local] = c;
+            workgroupBarrier();
+            if listed && lane == 0u {
+                for (var j = 0u; j < min(SAMPLE_LANES, count - first); j++) {
+                    add_sample(&sums, first + j, side, lane_radiance[local + j]);
+                }
+            }
+            workgroupBarrier();
         }
-        workgroupBarrier();
+        if !listed || lane != 0u {
+            return;
+        }
+        s = sampled(sums, count);
     }
-    if !listed || lane != 0u {
-        return;
-    }
-    let s = sampled(sums, count);
     colour_out[index] = s.colour;
     add_rays(index, u32(round(s.colour.w * f32(count))));
     // Dammertz et al. (2010) estimate a pixel's error by how far the mean of half its samples

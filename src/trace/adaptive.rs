@@ -5,7 +5,7 @@
 //! GPU, with no read-back between them. `wgsl/adaptive.wgsl` says how each pass decides.
 
 use super::pass::{TracePass, check_storage_buffers, shared_entries};
-use super::{Adaptive, GpuScene, RenderOutput};
+use super::{Adaptive, GpuScene, RenderOutput, SampleLanes};
 use crate::error::{Error, Result};
 use crate::gpu::{GpuContext, bind_group_at, storage_entry, uniform_entry};
 use crate::lens::LensCamera;
@@ -97,9 +97,12 @@ fn listed_at(stage: Stage) -> usize {
 }
 
 /// How many invocations of `trace_samples` (wgsl/adaptive.wgsl) trace each pixel listed at
-/// `stage` side by side: one for each of its samples, at most a workgroup's.
-fn sample_lanes(stage: Stage, samples_per_side: u32) -> u32 {
-    samples_at(stage, samples_per_side).min(WORKGROUP_1D)
+/// `stage` side by side: one for each of its samples, at most a workgroup's, or one.
+fn sample_lanes(stage: Stage, samples_per_side: u32, lanes: SampleLanes) -> u32 {
+    match lanes {
+        SampleLanes::PerSample => samples_at(stage, samples_per_side).min(WORKGROUP_1D),
+        SampleLanes::PerPixel => 1,
+    }
 }
 
 /// Timestamp writes for the stages of one frame, each but the first in two compute passes:
@@ -145,8 +148,9 @@ pub struct AdaptivePass {
 
 impl AdaptivePass {
     /// Creates the kernels and buffers for `camera` on `scene`, with at most `spp` samples a
-    /// pixel (a square, as uniform sampling takes them). Refuses an image whose outputs do not
-    /// fit one storage binding, and a device with too few storage buffers per stage.
+    /// pixel (a square, as uniform sampling takes them), its samples spread over invocations
+    /// as suits the device ([`SampleLanes::for_device`]). Refuses an image whose outputs do
+    /// not fit one storage binding, and a device with too few storage buffers per stage.
     pub fn new(
         ctx: &GpuContext,
         camera: &LensCamera,
@@ -154,6 +158,20 @@ impl AdaptivePass {
         source: DirectionSource,
         spp: u32,
         options: Adaptive,
+    ) -> Result<Self> {
+        let lanes = SampleLanes::for_device(&ctx.device);
+        Self::with_lanes(ctx, camera, scene, source, spp, options, lanes)
+    }
+
+    /// As [`AdaptivePass::new`], with the samples spread over invocations as `lanes` says.
+    pub fn with_lanes(
+        ctx: &GpuContext,
+        camera: &LensCamera,
+        scene: &GpuScene,
+        source: DirectionSource,
+        spp: u32,
+        options: Adaptive,
+        lanes: SampleLanes,
     ) -> Result<Self> {
         if !(options.threshold >= 0.0 && options.threshold.is_finite()) {
             return Err(Error::Option(format!(
@@ -290,8 +308,16 @@ impl AdaptivePass {
             let trace_lists = [
                 trace_centres.clone(),
                 trace_centres,
-                kernel("trace_samples", 3, sample_lanes(Stage::Estimate, side)),
-                kernel("trace_samples", 1, sample_lanes(Stage::Supersample, side)),
+                kernel(
+                    "trace_samples",
+                    3,
+                    sample_lanes(Stage::Estimate, side, lanes),
+                ),
+                kernel(
+                    "trace_samples",
+                    1,
+                    sample_lanes(Stage::Supersample, side, lanes),
+                ),
                 kernel("trace_list", 2, 1),
             ];
             let args_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
@@ -299,7 +325,7 @@ impl AdaptivePass {
                 entries: &[storage_entry(0, false), storage_entry(1, false)],
             });
             let args_kernel = |slice: u32, stage: Stage| {
-                let per_group = WORKGROUP_1D / sample_lanes(stage, side);
+                let per_group = WORKGROUP_1D / sample_lanes(stage, side, lanes);
                 let constants = [
                     ("SLICE", f64::from(slice)),
                     ("PER_GROUP", f64::from(per_group)),

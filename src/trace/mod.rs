@@ -33,7 +33,8 @@ pub use gpu_scene::{GpuScene, SceneBytes, gpu_lights, shading_vertices};
 pub use mip::{mip_level_count, mip_levels};
 pub use motion::{Motion, moving_directions};
 pub use options::{
-    Adaptive, PixelFilter, RenderOptions, Sampling, Traversal, surface_constants, surface_id,
+    Adaptive, PixelFilter, RenderOptions, SampleLanes, Sampling, Traversal, surface_constants,
+    surface_id,
 };
 pub use output::{Channel, RenderOutput, Values, write_exr, write_npy};
 pub use pass::TracePass;

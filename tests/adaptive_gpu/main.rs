@@ -14,8 +14,8 @@ use fisheye_rt::lens::gpu::DirectionSource;
 use fisheye_rt::scene::Scene;
 use fisheye_rt::shared::ADAPTIVE_BLOCK;
 use fisheye_rt::trace::{
-    Adaptive, AdaptivePass, GpuScene, NO_HIT, RenderOptions, RenderOutput, Stage, TracePass,
-    linear_to_srgb,
+    Adaptive, AdaptivePass, GpuScene, NO_HIT, RenderOptions, RenderOutput, SampleLanes, Stage,
+    TracePass, linear_to_srgb,
 };
 
 fn uniform(gpu: &GpuScene, cam: &LensCamera, spp: u32) -> RenderOutput {
@@ -47,11 +47,24 @@ fn adaptive_stages(
     threshold: f32,
     ground_truth: bool,
 ) -> (RenderOutput, Vec<u32>, Vec<(Stage, u64)>) {
+    let lanes = SampleLanes::for_device(&ctx().device);
+    adaptive_laid_out(gpu, cam, (spp, threshold, ground_truth), lanes)
+}
+
+/// As [`adaptive_stages`] (at `spp`, `threshold`, with or without the ground truth), each
+/// pixel's samples spread over invocations as `lanes` says.
+fn adaptive_laid_out(
+    gpu: &GpuScene,
+    cam: &LensCamera,
+    (spp, threshold, ground_truth): (u32, f32, bool),
+    lanes: SampleLanes,
+) -> (RenderOutput, Vec<u32>, Vec<(Stage, u64)>) {
     let options = Adaptive {
         threshold,
         ground_truth,
     };
-    let pass = AdaptivePass::new(ctx(), cam, gpu, DirectionSource::Computed, spp, options).unwrap();
+    let source = DirectionSource::Computed;
+    let pass = AdaptivePass::with_lanes(ctx(), cam, gpu, source, spp, options, lanes).unwrap();
     let out = pass.trace(ctx(), gpu, "adaptive").unwrap();
     let stages = pass.read_stage_rays(ctx()).unwrap();
     (out, pass.read_rays(ctx()).unwrap(), stages)
@@ -62,23 +75,29 @@ fn upload(scene: &Scene) -> GpuScene {
 }
 
 /// At threshold 0 every block is refined and every pixel supersampled with the very samples
-/// uniform sampling takes, summed in the same order: the same bits. Supersampling traces a
-/// pixel's samples side by side, one invocation each up to a workgroup's 64: 16 samples fill
-/// a workgroup with 4 pixels, 9 leave one invocation of 64 idle, 256 take 4 rounds of 64.
+/// uniform sampling takes, summed in the same order: the same bits, in either layout of the
+/// samples over invocations. Side by side (`SampleLanes::PerSample`), one invocation each up
+/// to a workgroup's 64: 16 samples fill a workgroup with 4 pixels, 9 leave one invocation of
+/// 64 idle, 256 take 4 rounds of 64; or an invocation a pixel (`PerPixel`).
 #[test]
 fn threshold_zero_is_uniform_sampling_exactly() {
     let room = scene("builtin:default");
     let gpu = upload(&room);
     let cam = camera("canon-8-15mm@8mm", 61, 46);
-    for spp in [16, 9, 256] {
-        threshold_zero_at(&gpu, &cam, spp);
+    for lanes in [SampleLanes::PerSample, SampleLanes::PerPixel] {
+        for spp in [16, 9, 256] {
+            threshold_zero_at(&gpu, &cam, spp, lanes);
+        }
     }
 }
 
-fn threshold_zero_at(gpu: &GpuScene, cam: &LensCamera, spp: u32) {
+fn threshold_zero_at(gpu: &GpuScene, cam: &LensCamera, spp: u32, lanes: SampleLanes) {
     let reference = uniform(gpu, cam, spp);
-    let (out, rays, stages) = adaptive_stages(gpu, cam, spp, 0.0, true);
-    assert_eq!(out.colour, reference.colour, "colour at {spp} samples");
+    let (out, rays, stages) = adaptive_laid_out(gpu, cam, (spp, 0.0, true), lanes);
+    assert_eq!(
+        out.colour, reference.colour,
+        "colour at {spp} samples, {lanes:?}"
+    );
     // Every lattice point; every other pixel but those of blocks wholly outside the lens
     // (filled as masked), so at least every one the lens covers; every pixel's 16 samples
     // (counted as rays where the lens masks them, though they cost a lens evaluation
@@ -299,14 +318,27 @@ fn error_falls_as_the_threshold_falls() {
 
 /// Above threshold 0, a pixel the estimating stage samples 2 × 2 and leaves is uniform
 /// sampling's 4-ray pixel, and one it goes on to supersample is the 16-ray pixel, bit for bit
-/// (the same samples, added in the same order, though traced side by side): both kinds occur.
+/// (the same samples, added in the same order, whether traced side by side or an invocation
+/// a pixel): both kinds occur.
 #[test]
 fn estimated_and_supersampled_pixels_are_uniform_samplings() {
     let room = scene("builtin:default");
     let gpu = upload(&room);
     let cam = camera("canon-8-15mm@8mm", 80, 60);
     let (four, sixteen) = (uniform(&gpu, &cam, 4), uniform(&gpu, &cam, 16));
-    let (out, rays) = adaptive(&gpu, &cam, 16, 0.05, false);
+    for lanes in [SampleLanes::PerSample, SampleLanes::PerPixel] {
+        let (out, rays, _) = adaptive_laid_out(&gpu, &cam, (16, 0.05, false), lanes);
+        estimated_and_supersampled_match(&out, &rays, (&four, &sixteen));
+    }
+}
+
+/// The checks of [`estimated_and_supersampled_pixels_are_uniform_samplings`] on one frame
+/// (`out`, each pixel's `rays`) against uniform sampling's 4- and 16-ray frames.
+fn estimated_and_supersampled_match(
+    out: &RenderOutput,
+    rays: &[u32],
+    (four, sixteen): (&RenderOutput, &RenderOutput),
+) {
     let (mut estimated, mut supersampled) = (0, 0);
     for (i, &n) in rays.iter().enumerate() {
         // Pixels the lens covers whole: their centre's ray, then 4, then 16 samples.
