@@ -10,14 +10,14 @@
 
 use std::fmt::Write;
 
-use crate::shared::{wgsl_constants, wgsl_faces, wgsl_float_constants};
+use crate::shared::{wgsl_constants, wgsl_faces, wgsl_float_constants, wgsl_nested_samples};
 use crate::split::SceneArrays;
 
 /// The name `#import` gives the generated module of the scene's arrays.
 const SCENE_ARRAYS: &str = "scene_arrays";
 
 /// Every WGSL file of the project, by name (its file stem under `wgsl/`).
-pub const FILES: [(&str, &str); 37] = [
+pub const FILES: [(&str, &str); 38] = [
     ("math", include_str!("../wgsl/math.wgsl")),
     ("quaternion", include_str!("../wgsl/quaternion.wgsl")),
     ("calibrated", include_str!("../wgsl/calibrated.wgsl")),
@@ -36,6 +36,10 @@ pub const FILES: [(&str, &str); 37] = [
     (
         "adaptive_lists",
         include_str!("../wgsl/adaptive_lists.wgsl"),
+    ),
+    (
+        "adaptive_samples",
+        include_str!("../wgsl/adaptive_samples.wgsl"),
     ),
     ("adaptive_rq", include_str!("../wgsl/adaptive_rq.wgsl")),
     ("adaptive_args", include_str!("../wgsl/adaptive_args.wgsl")),
@@ -156,6 +160,7 @@ pub fn compose_for(entry: &str, arrays: &SceneArrays, swaps: &[(&str, &str)]) ->
         writeln!(out, "const {name}: f32 = {value:?};").unwrap();
     }
     out.push_str(&wgsl_faces());
+    out.push_str(&wgsl_nested_samples());
     out.push_str(&c.body);
     out
 }

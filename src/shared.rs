@@ -51,6 +51,34 @@ pub const ADAPTIVE_END: u32 = 2;
 /// The most samples per pixel side (`RenderOptions::spp` is a square of at most this).
 pub const MAX_SAMPLES_PER_SIDE: u32 = 16;
 
+/// The samples per side whose pattern is nested (`trace::sampling`): its first 2 × 2 samples
+/// are the 2 × 2 pattern, so adaptive sampling's estimate is the start of its supersampling.
+pub const NESTED_SIDE: u32 = 4;
+/// The nested pattern's coordinates count 48ths of a pixel.
+pub const NESTED_UNITS: u32 = 48;
+/// The nested pattern in one of its arrangements, in 48ths of a pixel from its top-left
+/// corner: first the 2 × 2 rotated grid (the centres of four of its 4 × 4 cells), then one
+/// sample in each other stratum of the 4 × 4, two thirds of the way across and down a cell of
+/// the 16 × 16 (see `trace::sampling` for how they were chosen).
+pub const NESTED_SAMPLES: [[u32; 2]; 16] = [
+    [6, 6],
+    [42, 18],
+    [18, 42],
+    [30, 30],
+    [11, 14],
+    [5, 35],
+    [2, 47],
+    [17, 5],
+    [23, 23],
+    [14, 29],
+    [35, 2],
+    [26, 17],
+    [29, 41],
+    [38, 11],
+    [47, 26],
+    [41, 38],
+];
+
 /// The deepest Whitted recursion a kernel can run (its ray stack has one more entry).
 pub const MAX_DEPTH_LIMIT: u32 = 8;
 /// A shadow ray passes at most this many partially transparent surfaces; behind more, the
@@ -296,6 +324,19 @@ pub const MIN_WEIGHT: f32 = 1e-3;
 /// Rendering System", arXiv:1705.01263).
 pub const GRAZING_COSINE: f32 = 1e-3;
 
+/// The WGSL declaration of [`NESTED_SAMPLES`], prepended to every module.
+pub fn wgsl_nested_samples() -> String {
+    let points: Vec<String> = NESTED_SAMPLES
+        .iter()
+        .map(|[x, y]| format!("vec2<u32>({x}u, {y}u)"))
+        .collect();
+    format!(
+        "const NESTED_SAMPLES = array<vec2<u32>, {}>({});\n",
+        NESTED_SAMPLES.len(),
+        points.join(", ")
+    )
+}
+
 /// The f32 constants every WGSL module sees, as `const NAME: f32` lines.
 pub fn wgsl_float_constants() -> [(&'static str, f32); 2] {
     [
@@ -329,6 +370,8 @@ pub fn wgsl_constants() -> Vec<(String, u32)> {
         ("ADAPTIVE_ESTIMATE_SIDE", ADAPTIVE_ESTIMATE_SIDE),
         ("ADAPTIVE_FIRST", ADAPTIVE_FIRST),
         ("ADAPTIVE_END", ADAPTIVE_END),
+        ("NESTED_SIDE", NESTED_SIDE),
+        ("NESTED_UNITS", NESTED_UNITS),
         ("SURFACE_DIFFUSE", SURFACE_DIFFUSE),
         ("SURFACE_MIRROR", SURFACE_MIRROR),
         ("SURFACE_GLASS", SURFACE_GLASS),

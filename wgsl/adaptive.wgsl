@@ -29,11 +29,12 @@
 //    one-ray pixel is its box filter's value where colour changes linearly across it, and the
 //    bend estimates how far off it is (Mitchell 1987 drove supersampling by such local
 //    contrast). Where SAMPLES_PER_SIDE > 2 and the threshold is
-//    above 0, `trace_samples` first takes 2 × 2 stratified samples of each (`MODE_ESTIMATE`)
-//    and marks those whose half-sample mean differs from the mean by the threshold or more
-//    (Dammertz et al. 2010's error estimate); `more` lists those. The last list's pixels take
-//    the SAMPLES_PER_SIDE² samples that uniform supersampling takes (`sample_offset`), in
-//    its order (`trace_samples` again);
+//    above 0, `trace_samples` (in `adaptive_samples.wgsl`) first takes 2 × 2 stratified
+//    samples of each (`MODE_ESTIMATE`) and marks those whose half-sample mean differs from
+//    the mean by the threshold or more (Dammertz et al. 2010's error estimate); `more` lists
+//    those. The last list's pixels take the SAMPLES_PER_SIDE² samples that uniform
+//    supersampling takes (`sample_offset`), in its order (`trace_samples` again), going on
+//    from the estimate's where those are the first of them (the nested 4 × 4 pattern);
 // 5. with ground truth asked for, `untraced` lists the interpolated pixels and `trace_list`
 //    traces their centres' first hits, so ids, normals and ranges are never interpolated.
 //
@@ -256,79 +257,6 @@ fn trace_list(
     }
     let index = atomicLoad(&work[ADAPTIVE_HEADER + i]);
     trace_centre(index, vec2<u32>(index % lens.width, index / lens.width), LIST_MODE);
-}
-
-// Invocations that trace one listed pixel's samples side by side in `trace_samples`: as many
-// as it takes samples, at most a workgroup's (WORKGROUP_1D / SAMPLE_LANES pixels a workgroup).
-override SAMPLE_LANES: u32 = 1u;
-// Each invocation's last sample, for its pixel's first lane to add up.
-var<workgroup> lane_radiance: array<vec4<f32>, WORKGROUP_1D>;
-
-// Traces the listed pixels' samples, LIST_MODE's MODE_SAMPLES (SAMPLES_PER_SIDE² each) or
-// MODE_ESTIMATE (ADAPTIVE_ESTIMATE_SIDE²), SAMPLE_LANES invocations a pixel (the layout
-// `fisheye_rt::trace::SampleLanes` picks for the device): lane j traces samples j,
-// j + SAMPLE_LANES, ..., and the pixel's first lane adds them to its sums in sample order, as
-// `samples` does in one invocation, so the colour is the same bit for bit. With one lane, each
-// invocation calls `samples` for its pixel, with no barriers.
-@compute @workgroup_size(WORKGROUP_1D)
-fn trace_samples(
-    @builtin(workgroup_id) group: vec3<u32>,
-    @builtin(num_workgroups) groups: vec3<u32>,
-    @builtin(local_invocation_index) local: u32,
-) {
-    let estimate = LIST_MODE == MODE_ESTIMATE;
-    let side = select(SAMPLES_PER_SIDE, ADAPTIVE_ESTIMATE_SIDE, estimate);
-    let count = side * side;
-    let per_group = WORKGROUP_1D / SAMPLE_LANES;
-    let lane = local % SAMPLE_LANES;
-    let slot = local / SAMPLE_LANES;
-    let i = atomicLoad(&work[ADAPTIVE_FIRST]) + (group.y * groups.x + group.x) * per_group + slot;
-    let listed = slot < per_group && i < atomicLoad(&work[ADAPTIVE_END]);
-    var index = 0u;
-    if listed {
-        index = atomicLoad(&work[ADAPTIVE_HEADER + i]);
-    }
-    let pixel = vec2<u32>(index % lens.width, index / lens.width);
-    var s: Sampled;
-    if SAMPLE_LANES == 1u {
-        if !listed {
-            return;
-        }
-        s = samples(pixel, index, side);
-    } else {
-        var sums = SampleSums();
-        // Every invocation runs every round and its barriers, listed or not.
-        for (var first = 0u; first < count; first += SAMPLE_LANES) {
-            var c = vec4<f32>(0.0);
-            if listed && first + lane < count {
-                c = sample_radiance(pixel, index, first + lane, side);
-            }
-            lane_radiance[local] = c;
-            workgroupBarrier();
-            if listed && lane == 0u {
-                for (var j = 0u; j < min(SAMPLE_LANES, count - first); j++) {
-                    add_sample(&sums, first + j, side, lane_radiance[local + j]);
-                }
-            }
-            workgroupBarrier();
-        }
-        if !listed || lane != 0u {
-            return;
-        }
-        s = sampled(sums, count);
-    }
-    colour_out[index] = s.colour;
-    add_rays(index, u32(round(s.colour.w * f32(count))));
-    // Dammertz et al. (2010) estimate a pixel's error by how far the mean of half its samples
-    // lies from the mean of all: here in displayed colour, the largest over three halves (their
-    // interleaved half alone holds a sample either side of an edge along an axis at 2 × 2).
-    var worst = 0.0;
-    for (var h = 0u; estimate && h < 3u; h++) {
-        worst = max(worst, largest(abs(shown(s.colour.rgb) - shown(s.halves[h]))));
-    }
-    if estimate && worst >= adaptive.threshold {
-        set_key(index, KEY_MORE);
-    }
 }
 
 // What a block's corner saw: its key, and its hit's normal and position (relative to the

@@ -101,12 +101,27 @@ fn sampled(sums: SampleSums, count: u32) -> Sampled {
     return out;
 }
 
+// The sums of `count` samples whose mean and share with a ray `sampled` made `colour`: exact
+// where 1, 2 or 4 of them have a ray (a power of two), without their halves.
+fn sums_of(colour: vec4<f32>, count: u32) -> SampleSums {
+    var sums = SampleSums();
+    sums.covered = u32(round(colour.w * f32(count)));
+    sums.sum = colour.rgb * f32(sums.covered);
+    return sums;
+}
+
+// Adds samples `first` to `side`² − 1 of pixel `pixel` (index `index`) to `sums`, in order,
+// in one invocation.
+fn add_samples(sums: ptr<function, SampleSums>, first: u32, pixel: vec2<u32>, index: u32, side: u32) {
+    for (var k = first; k < side * side; k++) {
+        add_sample(sums, k, side, sample_radiance(pixel, index, k, side));
+    }
+}
+
 // The `side`² samples of pixel `pixel` (index `index`), in one invocation.
 fn samples(pixel: vec2<u32>, index: u32, side: u32) -> Sampled {
     var sums = SampleSums();
-    for (var k = 0u; k < side * side; k++) {
-        add_sample(&sums, k, side, sample_radiance(pixel, index, k, side));
-    }
+    add_samples(&sums, 0u, pixel, index, side);
     return sampled(sums, side * side);
 }
 

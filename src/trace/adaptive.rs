@@ -14,8 +14,8 @@ use crate::scene::Camera;
 use crate::shader;
 use crate::shared::{
     ADAPTIVE_BLOCK, ADAPTIVE_COUNT, ADAPTIVE_ESTIMATE_SIDE, ADAPTIVE_HEADER,
-    ADAPTIVE_STORAGE_BUFFERS, ADAPTIVE_STRIP, AdaptiveParams, TRACE_STORAGE_BUFFERS, WORKGROUP_1D,
-    WORKGROUP_2D,
+    ADAPTIVE_STORAGE_BUFFERS, ADAPTIVE_STRIP, AdaptiveParams, NESTED_SIDE, TRACE_STORAGE_BUFFERS,
+    WORKGROUP_1D, WORKGROUP_2D,
 };
 
 /// Two corners' shading normals further apart than this (about 25°) are not one smooth
@@ -73,12 +73,25 @@ pub fn stages_for(samples_per_side: u32, options: Adaptive) -> Vec<Stage> {
     stages
 }
 
+/// The samples supersampling takes over from the estimating stage, with `samples_per_side`²
+/// at most: the estimate's 2 × 2 where the estimate runs and the pattern is the nested one
+/// (whose first samples are the 2 × 2 pattern's, `sampling::sample_offset`), else none.
+fn reused_samples(samples_per_side: u32, options: Adaptive) -> u32 {
+    let estimates = stages_for(samples_per_side, options).contains(&Stage::Estimate);
+    if estimates && samples_per_side == NESTED_SIDE {
+        ADAPTIVE_ESTIMATE_SIDE.pow(2)
+    } else {
+        0
+    }
+}
+
 /// The rays each pixel listed at `stage` takes, with `samples_per_side`² samples at most: 1 at
-/// the stages that trace centres (`trace_list`), 2 × 2 estimating, all of them supersampling.
-fn samples_at(stage: Stage, samples_per_side: u32) -> u32 {
+/// the stages that trace centres (`trace_list`), 2 × 2 estimating, all of them but those
+/// reused from the estimate ([`reused_samples`]) supersampling.
+fn samples_at(stage: Stage, samples_per_side: u32, options: Adaptive) -> u32 {
     match stage {
         Stage::Estimate => ADAPTIVE_ESTIMATE_SIDE.pow(2),
-        Stage::Supersample => samples_per_side.pow(2),
+        Stage::Supersample => samples_per_side.pow(2) - reused_samples(samples_per_side, options),
         Stage::Coarse | Stage::Midpoints | Stage::Refine | Stage::Truth => 1,
     }
 }
@@ -98,9 +111,9 @@ fn listed_at(stage: Stage) -> usize {
 
 /// How many invocations of `trace_samples` (wgsl/adaptive.wgsl) trace each pixel listed at
 /// `stage` side by side: one for each of its samples, at most a workgroup's, or one.
-fn sample_lanes(stage: Stage, samples_per_side: u32, lanes: SampleLanes) -> u32 {
+fn sample_lanes(stage: Stage, samples_per_side: u32, options: Adaptive, lanes: SampleLanes) -> u32 {
     match lanes {
-        SampleLanes::PerSample => samples_at(stage, samples_per_side).min(WORKGROUP_1D),
+        SampleLanes::PerSample => samples_at(stage, samples_per_side, options).min(WORKGROUP_1D),
         SampleLanes::PerPixel => 1,
     }
 }
@@ -269,63 +282,63 @@ impl AdaptivePass {
                 }
                 None => "adaptive",
             };
-            // The listers but `classify` are in wgsl/adaptive_lists.wgsl, which imports
-            // wgsl/adaptive.wgsl; with ray queries it is composed as adaptive_rq.wgsl composes
-            // that.
-            let mut lister_swaps = source.swaps().to_vec();
+            // The listers but `classify` are in wgsl/adaptive_lists.wgsl and the sample tracer
+            // in wgsl/adaptive_samples.wgsl, which import wgsl/adaptive.wgsl; with ray queries
+            // they are composed as adaptive_rq.wgsl composes that.
+            let mut import_swaps = source.swaps().to_vec();
             if scene.ray_query.is_some() {
-                lister_swaps.push(("bvh", "bvh_rq"));
+                import_swaps.push(("bvh", "bvh_rq"));
             }
             let side = trace.samples_per_side();
             let in_file = |(file, swaps): (&str, &[(&str, &str)]),
                            entry: &str,
-                           mode: u32,
-                           lanes: u32,
-                           level: u32| {
+                           overrides: &[(&'static str, u32)]| {
                 let mut constants = trace.constants().to_vec();
-                constants.push(("LIST_MODE", f64::from(mode)));
-                constants.push(("SAMPLE_LANES", f64::from(lanes)));
-                constants.push(("LEVEL", f64::from(level)));
+                constants.extend(overrides.iter().map(|&(name, v)| (name, f64::from(v))));
                 let composed = (&scene.arrays, swaps);
                 shader::scene_pipeline(device, file, composed, entry, &constants, &layouts)
             };
-            let leveled = |entry: &str, mode: u32, lanes: u32, level: u32| {
-                in_file((file, source.swaps()), entry, mode, lanes, level)
+            let kernel = |entry: &str, mode: u32, level: u32| {
+                let overrides = [("LIST_MODE", mode), ("LEVEL", level)];
+                in_file((file, source.swaps()), entry, &overrides)
             };
-            let kernel = |entry: &str, mode: u32, lanes: u32| leveled(entry, mode, lanes, 0);
-            let lister = |entry: &str| in_file(("adaptive_lists", &lister_swaps), entry, 0, 1, 0);
+            let lister = |entry: &str| in_file(("adaptive_lists", &import_swaps), entry, &[]);
+            let sampler = |mode: u32, stage: Stage| {
+                let overrides = [
+                    ("LIST_MODE", mode),
+                    ("SAMPLE_LANES", sample_lanes(stage, side, options, lanes)),
+                    ("REUSED", reused_samples(side, options)),
+                ];
+                in_file(
+                    ("adaptive_samples", &import_swaps),
+                    "trace_samples",
+                    &overrides,
+                )
+            };
             let builders = [
-                kernel("classify", 0, 1),
+                kernel("classify", 0, 0),
                 lister("midpoints"),
-                leveled("classify", 0, 1, 1),
+                kernel("classify", 0, 1),
                 lister("select_pixels"),
                 lister("more"),
                 lister("untraced"),
             ];
             // The modes of wgsl/adaptive.wgsl: centres, samples, first hits, estimates.
-            let lattice = kernel("trace_lattice", 0, 1);
-            let trace_centres = kernel("trace_list", 0, 1);
+            let lattice = kernel("trace_lattice", 0, 0);
+            let trace_centres = kernel("trace_list", 0, 0);
             let trace_lists = [
                 trace_centres.clone(),
                 trace_centres,
-                kernel(
-                    "trace_samples",
-                    3,
-                    sample_lanes(Stage::Estimate, side, lanes),
-                ),
-                kernel(
-                    "trace_samples",
-                    1,
-                    sample_lanes(Stage::Supersample, side, lanes),
-                ),
-                kernel("trace_list", 2, 1),
+                sampler(3, Stage::Estimate),
+                sampler(1, Stage::Supersample),
+                kernel("trace_list", 2, 0),
             ];
             let args_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
                 label: Some("fisheye.adaptive.args"),
                 entries: &[storage_entry(0, false), storage_entry(1, false)],
             });
             let args_kernel = |slice: u32, stage: Stage| {
-                let per_group = WORKGROUP_1D / sample_lanes(stage, side, lanes);
+                let per_group = WORKGROUP_1D / sample_lanes(stage, side, options, lanes);
                 let constants = [
                     ("SLICE", f64::from(slice)),
                     ("PER_GROUP", f64::from(per_group)),
@@ -605,7 +618,7 @@ impl AdaptivePass {
                 };
                 (
                     stage,
-                    u64::from(pixels) * u64::from(samples_at(stage, side)),
+                    u64::from(pixels) * u64::from(samples_at(stage, side, self.options)),
                 )
             })
             .collect())
@@ -625,7 +638,8 @@ impl AdaptivePass {
     /// The rays each pixel's colour took in the last frame, row-major (the spp map): 0 for a
     /// pixel interpolated between its block's or half-block's corners or masked, 1 for its
     /// centre alone, and one more for each sample that the lens covers of a pixel's 2 × 2
-    /// estimating samples and of its full supersampling.
+    /// estimating samples and of those its supersampling takes beyond any it reuses (so at
+    /// most 1 + 16 with 16 samples, 1 + 4 + 64 with 64).
     pub fn read_rays(&self, ctx: &GpuContext) -> Result<Vec<u32>> {
         let pixels = self.trace.size().pixels() as u64;
         let first = 4 * (u64::from(ADAPTIVE_HEADER) + pixels);
