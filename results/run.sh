@@ -24,7 +24,7 @@ cd "$(dirname "$0")/.."
 out=${1:?usage: bash results/run.sh OUT_DIR}
 size=${SIZE:-256x192}
 cubes=${CUBES:-128,256,480}
-spp=${SPP:-1,4,16,auto:1:1,auto:0.3:1,auto:0.1:1,auto:0.1:4,auto:0.1,auto:0.02,auto:0.02:64}
+spp=${SPP:-1,4,16,auto:1:1,auto:0.3:1,auto:0.1:1,auto:0.1:4,auto:0.1,auto:0.02,auto:0.01,auto:0.02:64}
 filters=${FILTERS:-box,tent}
 reference_spp=${REFERENCE_SPP:-256}
 bench_cubes=${BENCH_CUBES:-128,256}
