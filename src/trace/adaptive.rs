@@ -109,8 +109,8 @@ fn listed_at(stage: Stage) -> usize {
     stage as usize - 1
 }
 
-/// How many invocations of `trace_samples` (wgsl/adaptive.wgsl) trace each pixel listed at
-/// `stage` side by side: one for each of its samples, at most a workgroup's, or one.
+/// How many invocations of `trace_samples` (wgsl/adaptive_samples.wgsl) trace each pixel
+/// listed at `stage` side by side: one for each of its samples, at most a workgroup's, or one.
 fn sample_lanes(stage: Stage, samples_per_side: u32, options: Adaptive, lanes: SampleLanes) -> u32 {
     match lanes {
         SampleLanes::PerSample => samples_at(stage, samples_per_side, options).min(WORKGROUP_1D),
