@@ -47,6 +47,10 @@ pub const ADAPTIVE_ESTIMATE_SIDE: u32 = 2;
 pub const ADAPTIVE_FIRST: u32 = 1;
 /// Where the work buffer holds the end (exclusive) of the entries `trace_list` traces.
 pub const ADAPTIVE_END: u32 = 2;
+/// What a pixel's state in the work buffer keeps, in place of what its centre saw, when it
+/// demands every sample: its 2 × 2 estimating samples disagreed, or a neighbour is brighter
+/// than the display shows (`wgsl/adaptive.wgsl`'s other keys sit above it).
+pub const ADAPTIVE_KEY_MORE: u32 = 0xffff_fffc;
 
 /// The most samples per pixel side (`RenderOptions::spp` is a square of at most this).
 pub const MAX_SAMPLES_PER_SIDE: u32 = 16;
@@ -370,6 +374,7 @@ pub fn wgsl_constants() -> Vec<(String, u32)> {
         ("ADAPTIVE_ESTIMATE_SIDE", ADAPTIVE_ESTIMATE_SIDE),
         ("ADAPTIVE_FIRST", ADAPTIVE_FIRST),
         ("ADAPTIVE_END", ADAPTIVE_END),
+        ("ADAPTIVE_KEY_MORE", ADAPTIVE_KEY_MORE),
         ("NESTED_SIDE", NESTED_SIDE),
         ("NESTED_UNITS", NESTED_UNITS),
         ("SURFACE_DIFFUSE", SURFACE_DIFFUSE),

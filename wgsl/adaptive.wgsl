@@ -32,7 +32,8 @@
 //    above 0, `trace_samples` (in `adaptive_samples.wgsl`) first takes 2 × 2 stratified
 //    samples of each (`MODE_ESTIMATE`) and marks those whose half-sample mean differs from
 //    the mean by the threshold or more (Dammertz et al. 2010's error estimate); `more` lists
-//    those. The last list's pixels take the SAMPLES_PER_SIDE² samples that uniform
+//    those, and the estimated pixels beside them across a change of surface. The last list's
+//    pixels take the SAMPLES_PER_SIDE² samples that uniform
 //    supersampling takes (`sample_offset`), in its order (`trace_samples` again), going on
 //    from the estimate's where those are the first of them (the nested 4 × 4 pattern);
 // 5. with ground truth asked for, `untraced` lists the interpolated pixels and `trace_list`
@@ -94,8 +95,9 @@ override LEVEL: u32 = 0u;
 const KEY_UNTRACED: u32 = 0xffffffffu;
 const KEY_MASKED: u32 = 0xfffffffeu;
 const KEY_SKY: u32 = 0xfffffffdu;
-// A pixel whose first samples still disagree (`MODE_ESTIMATE`): it takes them all.
-const KEY_MORE: u32 = 0xfffffffcu;
+// A pixel whose first samples still disagree (`MODE_ESTIMATE`) takes them all: its key is then
+// ADAPTIVE_KEY_MORE (`fisheye_rt::shared`, which `AdaptivePass::read_demanding` reads), below
+// these three and above every `surface_key`.
 
 var<workgroup> group_count: atomic<u32>;
 var<workgroup> group_base: u32;
@@ -301,7 +303,7 @@ fn load_tile(origin: vec2<u32>, local: u32) {
         let key = key_at(i);
         let g = geometry_out[i];
         var position = vec3<f32>(0.0);
-        if key < KEY_MORE {
+        if key < ADAPTIVE_KEY_MORE {
             let ray = centre_ray(p, primary_ray(p).xyz);
             position = ray.origin + ray.dir * g.w;
         }

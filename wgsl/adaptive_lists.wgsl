@@ -196,7 +196,7 @@ fn select_pixels(
         picks[k] = all(p < size()) && bends(origin, p);
         // Its neighbours' keys read alike before and after (traced): no race to the image.
         if picks[k] && estimates && beside_overexposed(origin, p) {
-            set_key(index_of(p), KEY_MORE);
+            set_key(index_of(p), ADAPTIVE_KEY_MORE);
         }
     }
     list_strip(id, picks, local);
@@ -212,9 +212,60 @@ fn keyed(id: vec3<u32>, key: u32) -> array<bool, ADAPTIVE_STRIP> {
     return picks;
 }
 
+// Whether pixel `p` took the 2 × 2 estimating samples: its colour is theirs, so supersampling
+// can go on from them (a pixel traced at its centre alone took one ray).
+fn estimated(p: vec2<u32>) -> bool {
+    return atomicLoad(&work[state_slot(index_of(p))]) > 1u;
+}
+
+// Pixel `p`'s centre as a corner of `same_surface`'s, its key left out: its ray's hit (normal
+// and range) and where that is.
+fn centre_corner(p: vec2<u32>) -> Corner {
+    let g = geometry_out[index_of(p)];
+    let ray = centre_ray(p, primary_ray(p).xyz);
+    return Corner(0u, g, ray.origin + ray.dir * g.w);
+}
+
+// Whether traced pixel `p`'s neighbour `offset` away (one pixel along an axis) is in the
+// image, demands every sample, and its centre sees another surface than `p`'s: one sees the
+// sky and the other not, or their normals or a depth step tell them apart (`same_surface`;
+// the material cannot be compared, the neighbour's key no longer says it).
+fn demanding_across(p: vec2<u32>, offset: vec2<i32>) -> bool {
+    let q = vec2<i32>(p) + offset;
+    let inside = all(q >= vec2<i32>(0)) && all(q < vec2<i32>(size()));
+    if !inside || key_at(index_of(vec2<u32>(q))) != ADAPTIVE_KEY_MORE {
+        return false;
+    }
+    let a = centre_corner(p);
+    let b = centre_corner(vec2<u32>(q));
+    if a.geometry.w == 0.0 || b.geometry.w == 0.0 {
+        return (a.geometry.w == 0.0) != (b.geometry.w == 0.0);
+    }
+    return !same_surface(a, b);
+}
+
+// Lists the pixels to supersample: those that demand every sample (ADAPTIVE_KEY_MORE), and
+// each other estimated pixel beside one of them (left, right, above or below) across a change
+// of surface.
+//
+// Two samples a half say little: an edge that crosses a pixel can miss both halves' samples
+// alike, and where it crosses one pixel it runs on into the next. So an estimated pixel whose
+// neighbour demands more and sees another surface takes every sample too, as Cycles'
+// adaptive sampling dilates its unconverged pixels into their neighbours
+// (`film_adaptive_sampling_filter_x` and `_y`). Only across a change of surface: within one,
+// the neighbour's demand is the detail of its own texture or lighting, which the pixel's own
+// estimate judged (dilating there too cost Šibenik many rays for little).
 @compute @workgroup_size(WORKGROUP_2D, WORKGROUP_2D)
 fn more(@builtin(global_invocation_id) id: vec3<u32>, @builtin(local_invocation_index) local: u32) {
-    list_strip(id, keyed(id, KEY_MORE), local);
+    var picks = keyed(id, ADAPTIVE_KEY_MORE);
+    for (var k = 0u; k < ADAPTIVE_STRIP; k++) {
+        let p = strip_pixel(id, k);
+        if !picks[k] && all(p < size()) && estimated(p) {
+            picks[k] = demanding_across(p, vec2<i32>(-1, 0)) || demanding_across(p, vec2<i32>(1, 0))
+                || demanding_across(p, vec2<i32>(0, -1)) || demanding_across(p, vec2<i32>(0, 1));
+        }
+    }
+    list_strip(id, picks, local);
 }
 
 @compute @workgroup_size(WORKGROUP_2D, WORKGROUP_2D)

@@ -81,6 +81,6 @@ fn trace_samples(
         worst = max(worst, largest(abs(shown(s.colour.rgb) - shown(s.halves[h]))));
     }
     if estimate && worst >= adaptive.threshold {
-        set_key(index, KEY_MORE);
+        set_key(index, ADAPTIVE_KEY_MORE);
     }
 }

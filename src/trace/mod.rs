@@ -22,7 +22,7 @@ mod tent;
 
 use glam::DVec3;
 
-pub use adaptive::{ALL_STAGES, AdaptivePass, AdaptiveSpans, Stage, spp_picture, stages_for};
+pub use adaptive::{ALL_STAGES, AdaptivePass, AdaptiveSpans, Stage, stages_for};
 pub use display::{
     ColourFile, Display, KEY, MASKED_RGB, Tone, auto_exposure, check_writable,
     check_writable_folder, colour_image, colour_image_with, linear_to_srgb, refuse_non_regular,
@@ -36,7 +36,7 @@ pub use options::{
     Adaptive, PixelFilter, RenderOptions, SampleLanes, Sampling, Traversal, surface_constants,
     surface_id,
 };
-pub use output::{Channel, RenderOutput, Values, write_exr, write_npy};
+pub use output::{Channel, RenderOutput, Values, spp_picture, write_exr, write_npy};
 pub use pass::TracePass;
 pub use ray_query::RayQueryScene;
 pub use tent::Tent;

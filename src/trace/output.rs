@@ -255,3 +255,48 @@ pub fn write_exr(path: &Path, size: ImageSize, name: &str, values: Values) -> Re
             })
     })
 }
+
+/// Colours of the spp map's ramp from no ray to the most, at even steps: viridis's ends and
+/// quarter points (van der Walt and Smith's matplotlib colour map, chosen for being
+/// perceptually uniform and readable with colour-blindness).
+const RAMP: [[f32; 3]; 5] = [
+    [0.267, 0.005, 0.329],
+    [0.229, 0.322, 0.546],
+    [0.128, 0.567, 0.551],
+    [0.369, 0.789, 0.383],
+    [0.993, 0.906, 0.144],
+];
+
+/// A picture of the rays each pixel took (`rays`, row-major, as
+/// [`AdaptivePass::read_rays`](super::AdaptivePass::read_rays) gives them): dark violet for
+/// none (interpolated), then along viridis to yellow at `most`, on a logarithmic scale
+/// (log(1 + rays)); transparent where `colour`'s mask says the lens covers nothing.
+pub fn spp_picture(
+    size: crate::lens::ImageSize,
+    rays: &[u32],
+    colour: &[[f32; 4]],
+    most: u32,
+) -> image::RgbaImage {
+    let top = f64::from(most.max(1)).ln_1p();
+    let mut picture = image::RgbaImage::new(size.width, size.height);
+    for ((pixel, &n), c) in picture.pixels_mut().zip(rays).zip(colour) {
+        if c[3] <= 0.0 {
+            continue;
+        }
+        let x = (f64::from(n).ln_1p() / top).clamp(0.0, 1.0) * (RAMP.len() - 1) as f64;
+        let (i, f) = ((x.floor() as usize).min(RAMP.len() - 2), x - x.floor());
+        let f = if x >= (RAMP.len() - 1) as f64 {
+            1.0
+        } else {
+            f as f32
+        };
+        let rgb: [f32; 3] = std::array::from_fn(|k| RAMP[i][k] + (RAMP[i + 1][k] - RAMP[i][k]) * f);
+        *pixel = image::Rgba([
+            (rgb[0] * 255.0).round() as u8,
+            (rgb[1] * 255.0).round() as u8,
+            (rgb[2] * 255.0).round() as u8,
+            255,
+        ]);
+    }
+    picture
+}

@@ -362,6 +362,83 @@ fn estimated_and_supersampled_match(
     );
 }
 
+/// Supersampling takes the pixels that demand every sample (`AdaptivePass::read_demanding`)
+/// and estimated pixels beside them across a change of surface, and no others: on the pixels
+/// the lens covers whole, where an estimated pixel took 1 + 4 rays and a supersampled one
+/// 1 + 16, each supersampled pixel demands or has a demanding neighbour (left, right, above or
+/// below); an estimated pixel with a demanding neighbour that sees the sky where it sees a
+/// surface, or the other way round, is supersampled; and one whose demanding neighbours all
+/// hit its own flat triangle (the same id and normal: one plane) is left at its 4. Pixels
+/// supersampled for a silhouette beside them occur, and pixels left beside a demanding one.
+#[test]
+fn estimated_pixels_beside_demanding_ones_across_an_edge_are_supersampled() {
+    let gpu = upload(&scene("builtin:many-small"));
+    let (w, h) = (96usize, 72usize);
+    let cam = camera("canon-8-15mm@8mm", w as u32, h as u32);
+    let whole = uniform(&gpu, &cam, 16);
+    let options = Adaptive {
+        threshold: 0.05,
+        ground_truth: false,
+    };
+    let pass =
+        AdaptivePass::new(ctx(), &cam, &gpu, DirectionSource::Computed, 16, options).unwrap();
+    let out = pass.trace(ctx(), &gpu, "adaptive").unwrap();
+    let (rays, demanding) = (
+        pass.read_rays(ctx()).unwrap(),
+        pass.read_demanding(ctx()).unwrap(),
+    );
+    let (mut across_sky, mut left) = (0, 0);
+    for y in 0..h {
+        for x in 0..w {
+            let i = y * w + x;
+            if whole.colour[i][3] != 1.0 || rays[i] < 1 + 4 {
+                continue;
+            }
+            let supersampled = match rays[i] {
+                5 => false,
+                17 => true,
+                n => panic!("pixel ({x}, {y}) took {n} rays"),
+            };
+            if demanding[i] {
+                assert!(supersampled, "pixel ({x}, {y}) demands but took 4");
+                continue;
+            }
+            let beside: Vec<usize> = [(-1i64, 0i64), (1, 0), (0, -1), (0, 1)]
+                .iter()
+                .map(|&(dx, dy)| (x as i64 + dx, y as i64 + dy))
+                .filter(|&(a, b)| (0..w as i64).contains(&a) && (0..h as i64).contains(&b))
+                .map(|(a, b)| b as usize * w + a as usize)
+                .filter(|&j| demanding[j])
+                .collect();
+            let sky = |j: usize| out.ids[j] == NO_HIT;
+            if beside.iter().any(|&j| sky(j) != sky(i)) {
+                assert!(supersampled, "pixel ({x}, {y}) beside a silhouette took 4");
+                across_sky += 1;
+            } else if !beside.is_empty()
+                && !sky(i)
+                && beside.iter().all(|&j| {
+                    out.ids[j] == out.ids[i] && out.geometry[j][..3] == out.geometry[i][..3]
+                })
+            {
+                assert!(
+                    !supersampled,
+                    "pixel ({x}, {y}) supersampled within its triangle"
+                );
+                left += 1;
+            } else if beside.is_empty() {
+                assert!(
+                    !supersampled,
+                    "pixel ({x}, {y}) supersampled with no demanding neighbour"
+                );
+            }
+        }
+    }
+    assert!(
+        across_sky > 0 && left > 0,
+        "{across_sky} across the sky, {left} left at 4"
+    );
+}
+
 /// What adaptive sampling cannot do is refused with what to do instead: a negative or
 /// non-finite threshold, and an image whose outputs exceed one storage binding (uniform
 /// sampling traces those in bands).
