@@ -3,7 +3,7 @@
 # (the built-in many-small and few-detailed, and the shared Sibenik, Cornell box, bunny and
 # Buddha), through a 180° equidistant fisheye (canon-8-15mm@8mm) and the Samyang equisolid
 # preset (bench adds the pinhole baseline); direct RT over rays per pixel (SPP: uniform
-# counts, and adaptive sampling at thresholds and most rays, auto:THRESHOLD[:MAX]), each
+# counts, and adaptive sampling at thresholds, most rays and least, auto:THRESHOLD[:MAX[:LEAST]]), each
 # with the box filter and, where pixels take one ray, the tent (FILTERS), against
 # the cube maps over face sizes (CUBES); then the thesis's face sizes (512, 1024, 1920) at
 # 1024x768.
@@ -24,11 +24,11 @@ cd "$(dirname "$0")/.."
 out=${1:?usage: bash results/run.sh OUT_DIR}
 size=${SIZE:-256x192}
 cubes=${CUBES:-128,256,480}
-spp=${SPP:-1,4,16,auto:1:1,auto:0.3:1,auto:0.1:1,auto:0.1:4,auto:0.1,auto:0.02,auto:0.01,auto:0.02:64}
+spp=${SPP:-1,4,16,auto:1:1,auto:0.3:1,auto:0.1:1,auto:0.1:4,auto:0.1,auto:0.02,auto:0.01,auto:0.02:64,auto:0.1:4:1,auto:0.1:16:1,auto:0.02:16:1}
 filters=${FILTERS:-box,tent}
 reference_spp=${REFERENCE_SPP:-256}
 bench_cubes=${BENCH_CUBES:-128,256}
-bench_spp=${BENCH_SPP:-1,16,auto:0.1:1,auto:0.1}
+bench_spp=${BENCH_SPP:-1,16,auto:0.1:1,auto:0.1,auto:0.1:16:1}
 frames=${FRAMES:-8}
 compare_frames=${COMPARE_FRAMES:-7}
 bin=${FISHEYE:-target/release/fisheye}

@@ -340,6 +340,7 @@ fn progressive_frames_sharpen_while_still_and_restart_on_a_move() {
         adaptive: adaptive.then_some(Adaptive {
             threshold: Adaptive::DEFAULT_THRESHOLD,
             ground_truth: false,
+            every_pixel: false,
         }),
         ..RenderOptions::default()
     };
@@ -407,6 +408,7 @@ fn every_kernel_runs_within_the_storage_buffers_it_names() {
         adaptive: Some(Adaptive {
             threshold: Adaptive::DEFAULT_THRESHOLD,
             ground_truth: true,
+            every_pixel: false,
         }),
         ..RenderOptions::default()
     };

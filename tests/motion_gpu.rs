@@ -287,6 +287,7 @@ fn adaptive_sampling_at_threshold_zero_is_uniform_sampling_in_motion() {
         adaptive: Some(Adaptive {
             threshold: 0.0,
             ground_truth: true,
+            every_pixel: false,
         }),
         ..uniform
     };

@@ -34,6 +34,7 @@ fn sampled(spp: u32, threshold: Option<f32>, filter: PixelFilter) -> RenderOptio
         adaptive: threshold.map(|threshold| Adaptive {
             threshold,
             ground_truth: true,
+            every_pixel: false,
         }),
         filter,
         ..RenderOptions::default()

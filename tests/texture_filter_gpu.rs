@@ -107,6 +107,7 @@ fn minified_textures_are_filtered_to_their_mean_by_every_method() {
         adaptive: Some(Adaptive {
             threshold: 0.02,
             ground_truth: true,
+            every_pixel: false,
         }),
         ..RenderOptions::default()
     };

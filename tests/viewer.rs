@@ -119,6 +119,7 @@ fn the_viewer_shows_the_scene_under_xvfb() {
         adaptive: Some(Adaptive {
             threshold: Adaptive::DEFAULT_THRESHOLD,
             ground_truth: false,
+            every_pixel: false,
         }),
         ..options
     };

@@ -5,7 +5,7 @@
 //
 // 1. `trace_lattice` traces one shaded ray through each lattice pixel's centre (a first pass
 //    below one ray per pixel: 1/ADAPTIVE_BLOCK² of them), an invocation a lattice point, with
-//    no list;
+//    no list (or through every pixel's, EVERY_PIXEL, and the frame goes on at step 4);
 // 2. `classify` looks at each block's four corners (Whitted 1980 subdivided a pixel whose
 //    corners disagree): where they agree (the same surface, normals and tangent planes, and
 //    displayed colour along each edge that bends by less than the threshold, see `bend`), the
@@ -235,14 +235,20 @@ fn trace_centre(index: u32, pixel: vec2<u32>, mode: u32) {
     set_state(index, 1u, surface_key(traced));
 }
 
-// The coarse stage: a shaded ray through each lattice pixel's centre, an invocation a lattice
-// point, in the lattice's rows (no list to make or read: the lattice is known).
+// Whether the coarse stage traces every pixel's centre (`fisheye_rt::trace::Adaptive::
+// every_pixel`, `--spp auto:T:MAX:1`) instead of the lattice's: then no pixel is
+// interpolated, and the frame goes on at step 4.
+override EVERY_PIXEL: u32 = 0u;
+
+// The coarse stage: a shaded ray through each lattice pixel's centre (or each pixel's), an
+// invocation a point, in rows (no list to make or read: the points are known).
 @compute @workgroup_size(WORKGROUP_2D, WORKGROUP_2D)
 fn trace_lattice(@builtin(global_invocation_id) id: vec3<u32>) {
-    if any(id.xy >= adaptive.lattice) {
+    let every = EVERY_PIXEL == 1u;
+    if any(id.xy >= select(adaptive.lattice, size(), every)) {
         return;
     }
-    let pixel = lattice_pixel(id.xy);
+    let pixel = select(lattice_pixel(id.xy), id.xy, every);
     trace_centre(index_of(pixel), pixel, MODE_CENTRE);
 }
 

@@ -312,7 +312,7 @@ const OUTPUTS: [&str; 7] = [
     "mask",
 ];
 
-/// `render`'s `spp`: a count of rays per pixel, or `"auto[:THRESHOLD[:MAX]]"`.
+/// `render`'s `spp`: a count of rays per pixel, or `"auto[:THRESHOLD[:MAX[:LEAST]]]"`.
 #[derive(FromPyObject)]
 enum Spp {
     Count(u32),
@@ -390,7 +390,7 @@ impl Renderer {
 
     /// Renders the scene through `lens` from `pose` (a 4×4 `T_scene_camera`, OpenCV camera
     /// frame, e.g. from `look_at`; the scene's own camera if None) with `spp` rays per pixel
-    /// (a square, 1 to 256, or "auto[:THRESHOLD[:MAX]]" for adaptive sampling, as
+    /// (a square, 1 to 256, or "auto[:THRESHOLD[:MAX[:LEAST]]]" for adaptive sampling, as
     /// `fisheye render --spp` takes it), and returns a dict of arrays, one per name in `outputs`:
     /// "colour" (H×W×4 float32: linear RGB, alpha the lens's coverage), "srgb" (H×W×4 uint8,
     /// through `exposure` stops and the `tone` curve "aces" or "clamp", as `fisheye render`

@@ -327,7 +327,7 @@ def test_bad_input_raises_with_the_librarys_message(tmp_path):
         (lambda: renderer.render(lens, spp=3), ValueError, "3"),
         (lambda: renderer.render(lens, spp=0), ValueError, "0"),
         (lambda: renderer.render(lens, spp="auto:x"), ValueError, "threshold"),
-        (lambda: renderer.render(lens, spp="most"), ValueError, "auto[:THRESHOLD[:MAX]]"),
+        (lambda: renderer.render(lens, spp="most"), ValueError, "auto[:THRESHOLD[:MAX[:LEAST]]]"),
         (lambda: renderer.render(lens, pose=np.eye(3)), ValueError, "4×4"),
         (lambda: renderer.render(lens, pose=shear), ValueError, "rotation"),
         (lambda: renderer.render(lens, tone="filmic"), ValueError, "tone"),

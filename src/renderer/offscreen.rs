@@ -16,8 +16,8 @@ use crate::lens::gpu::DirectionSource;
 use crate::raster::RasterMethod;
 use crate::scene::{Camera, Scene};
 use crate::trace::{
-    ALL_STAGES, Adaptive, AdaptiveSpans, GpuScene, PixelFilter, RenderOptions, RenderOutput,
-    Sampling, Stage, Traversal, stages_for,
+    ALL_STAGES, AdaptiveSpans, GpuScene, PixelFilter, RenderOptions, RenderOutput, Sampling, Stage,
+    Traversal, stages_for,
 };
 
 impl Method {
@@ -121,15 +121,12 @@ impl Setup {
     /// [`crate::trace::stages_for`] lists them).
     /// A filtered direct setup's filter is a pass of its own, last.
     pub fn passes(&self, ground_truth: bool) -> Vec<Pass> {
-        let mut passes = match self.threshold() {
+        let adaptive = self.sampling.options(ground_truth).1;
+        let mut passes = match adaptive.filter(|_| self.method.cube().is_none()) {
             None => self.method.passes().to_vec(),
-            Some(threshold) => {
+            Some(options) => {
                 let spp = self.sampling.max_spp();
                 let side = crate::trace::sampling::samples_per_side(spp).unwrap_or(1);
-                let options = Adaptive {
-                    threshold,
-                    ground_truth,
-                };
                 stages_for(side, options)
                     .into_iter()
                     .flat_map(|stage| Pass::listing(stage).into_iter().chain([Pass::of(stage)]))

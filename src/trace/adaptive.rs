@@ -1,6 +1,7 @@
 //! Adaptive sampling ([`AdaptivePass`]): a first pass of one ray per
-//! [`ADAPTIVE_BLOCK`]² pixels, then rays only where neighbouring samples disagree (the blocks'
-//! midpoints, then each pixel of the half-blocks that still disagree), up to the uniform
+//! [`ADAPTIVE_BLOCK`]² pixels (or one through every pixel: [`Adaptive::every_pixel`]), then
+//! rays only where neighbouring samples disagree (the blocks' midpoints, then each pixel of
+//! the half-blocks that still disagree), up to the uniform
 //! supersampling of [`super::sampling`] where colours still differ; every pass on the
 //! GPU, with no read-back between them. `wgsl/adaptive.wgsl` says how each pass decides.
 
@@ -28,7 +29,7 @@ const PLANE_DISTANCE: f32 = 0.01;
 /// A part of an adaptive frame, each its own compute pass (and its own timestamps).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Stage {
-    /// One ray per block corner.
+    /// One ray per block corner, or per pixel ([`Adaptive::every_pixel`]).
     Coarse,
     /// The blocks whose corners disagree: a ray through each of their edges' midpoints and
     /// their centres (the corners of their half-blocks); the other blocks interpolated.
@@ -56,18 +57,22 @@ pub const ALL_STAGES: [Stage; 6] = [
     Stage::Truth,
 ];
 
-/// The stages a frame runs with `samples_per_side`² samples at most, in order: supersampling
-/// only with more than one sample a pixel, estimating first with more than 4 and a threshold
-/// above 0, the ground truth's only when asked for.
+/// The stages a frame runs with `samples_per_side`² samples at most, in order: the midpoints
+/// and refining only after a coarse stage of block corners, supersampling only with more
+/// than one sample a pixel, estimating first with more than 4 and a threshold above 0, the
+/// ground truth's only when asked for and some pixels may be interpolated.
 pub fn stages_for(samples_per_side: u32, options: Adaptive) -> Vec<Stage> {
-    let mut stages = vec![Stage::Coarse, Stage::Midpoints, Stage::Refine];
+    let mut stages = vec![Stage::Coarse];
+    if !options.every_pixel {
+        stages.extend([Stage::Midpoints, Stage::Refine]);
+    }
     if samples_per_side > 2 && options.threshold > 0.0 {
         stages.push(Stage::Estimate);
     }
     if samples_per_side > 1 {
         stages.push(Stage::Supersample);
     }
-    if options.ground_truth {
+    if options.ground_truth && !options.every_pixel {
         stages.push(Stage::Truth);
     }
     stages
@@ -324,7 +329,11 @@ impl AdaptivePass {
                 lister("untraced"),
             ];
             // The modes of wgsl/adaptive.wgsl: centres, samples, first hits, estimates.
-            let lattice = kernel("trace_lattice", 0, 0);
+            let lattice = in_file(
+                (file, source.swaps()),
+                "trace_lattice",
+                &[("EVERY_PIXEL", u32::from(options.every_pixel))],
+            );
             let trace_centres = kernel("trace_list", 0, 0);
             let trace_lists = [
                 trace_centres.clone(),
@@ -454,8 +463,18 @@ impl AdaptivePass {
         writes: Option<wgpu::ComputePassTimestampWrites<'_>>,
     ) {
         let label = "fisheye.adaptive.coarse";
-        let size = self.params.lattice;
+        let size = self.coarse_points();
         self.dispatch_2d(encoder, scene, label, &[&self.lattice], size, writes);
+    }
+
+    /// The points the coarse stage traces, across and down: the lattice, or every pixel.
+    fn coarse_points(&self) -> [u32; 2] {
+        let size = self.trace.size();
+        if self.options.every_pixel {
+            [size.width, size.height]
+        } else {
+            self.params.lattice
+        }
     }
 
     /// Records a compute pass timed by `writes` that runs `kernels` one after another with
@@ -486,7 +505,8 @@ impl AdaptivePass {
     /// Records step `step` of a progressive frame, which shows a picture at once and sharpens
     /// it step by step, ending with the frame [`AdaptivePass::encode`] makes, bit for bit:
     /// - step 0 is the frame below one ray per pixel: the coarse and refining stages (and the
-    ///   ground truth's, where asked for), as `--spp auto:T:1` makes it;
+    ///   ground truth's, where asked for), as `--spp auto:T:1` makes it (with
+    ///   [`Adaptive::every_pixel`], a ray through every pixel);
     /// - step 1 runs the estimating stage, where there is one, and lists the pixels to
     ///   supersample;
     /// - each later step supersamples the next part of that list: as many pixels as take one
@@ -611,7 +631,7 @@ impl AdaptivePass {
             .stages()
             .into_iter()
             .map(|stage| {
-                let [w, h] = self.params.lattice;
+                let [w, h] = self.coarse_points();
                 let pixels = match stage {
                     Stage::Coarse => w * h,
                     _ => listed[stage as usize],

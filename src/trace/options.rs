@@ -109,6 +109,14 @@ pub struct Adaptive {
     /// first hit traced, so the ground-truth outputs (range, normal, id) are exact everywhere.
     /// Without it those pixels' geometry is zero and their id `NO_HIT`.
     pub ground_truth: bool,
+    /// Whether the first pass traces every pixel's centre (at least one ray a pixel,
+    /// `auto:T:MAX:1`) instead of one pixel a block of `ADAPTIVE_BLOCK`² (1/16 of a ray a
+    /// pixel, interpolated where the image is smooth, then refined level by level). Fewer
+    /// passes that depend on each other, for more rays where the image is smooth: on a large
+    /// GPU a pass of a few thousand rays costs about one ray's latency however few it
+    /// traces, and there the passes set an adaptive frame's time; on a CPU it depends on
+    /// the scene (the book's "Adaptive sampling" measures both).
+    pub every_pixel: bool,
 }
 
 impl Adaptive {
@@ -170,9 +178,14 @@ impl RenderOptions {
     /// The sampling `spp` and `adaptive` make, as `--spp` names it.
     pub fn sampling(&self) -> Sampling {
         match self.adaptive {
-            Some(Adaptive { threshold, .. }) => Sampling::Adaptive {
+            Some(Adaptive {
+                threshold,
+                every_pixel,
+                ..
+            }) => Sampling::Adaptive {
                 threshold,
                 max_spp: self.spp,
+                every_pixel,
             },
             None => Sampling::Uniform(self.spp),
         }
@@ -198,14 +211,17 @@ pub fn surface_constants(f: Features) -> [(&'static str, f64); 6] {
 pub enum Sampling {
     /// `N`: every pixel `N` rays (a square: samples on a rotated grid, box-filtered).
     Uniform(u32),
-    /// `auto[:THRESHOLD[:MAX]]`: adaptive sampling ([`super::AdaptivePass`]) at the threshold
-    /// ([`super::Adaptive::threshold`], 0.02 by default), at most `MAX` samples a pixel (16 by
-    /// default).
+    /// `auto[:THRESHOLD[:MAX[:LEAST]]]`: adaptive sampling ([`super::AdaptivePass`]) at the
+    /// threshold ([`super::Adaptive::threshold`], 0.02 by default), at most `MAX` samples a
+    /// pixel (16 by default), starting from one ray a 4 × 4 block (`LEAST` 1/16, the default)
+    /// or from one through every pixel (`LEAST` 1: [`super::Adaptive::every_pixel`]).
     Adaptive {
         /// Displayed-colour difference at which samples disagree.
         threshold: f32,
         /// The most samples a pixel takes (a square).
         max_spp: u32,
+        /// Whether every pixel takes at least its centre's ray.
+        every_pixel: bool,
     },
 }
 
@@ -214,12 +230,14 @@ impl Sampling {
     /// default.
     pub const DEFAULT_MAX_SPP: u32 = 16;
 
-    /// Reads `N` or `auto[:THRESHOLD[:MAX]]`; errors say what is wrong and what is accepted.
+    /// Reads `N` or `auto[:THRESHOLD[:MAX[:LEAST]]]`; errors say what is wrong and what is
+    /// accepted.
     pub fn parse(text: &str) -> crate::error::Result<Self> {
         let bad = |why: String| {
             crate::error::Error::Option(format!(
                 "{text:?}: {why}; rays per pixel are N (a square: 1, 4, 9, 16, ...) or \
-                 auto[:THRESHOLD[:MAX]] (adaptive, e.g. auto, auto:0.05, auto:0.01:64)"
+                 auto[:THRESHOLD[:MAX[:LEAST]]] (adaptive, e.g. auto, auto:0.05, auto:0.01:64, \
+                 auto:0.02:16:1)"
             ))
         };
         let check = |spp: u32| super::sampling::samples_per_side(spp).map(|_| spp);
@@ -249,10 +267,24 @@ impl Sampling {
                     .map_err(|_| bad(format!("the most rays {m:?} is not a number")))?,
             )?,
         };
+        let every_pixel = match parts.next() {
+            None | Some("1/16") => false,
+            Some("1") => true,
+            Some(least) => {
+                return Err(bad(format!(
+                    "the least rays a pixel {least:?} is 1/16 (one ray a 4 × 4 block first, \
+                     the default) or 1 (every pixel's centre first)"
+                )));
+            }
+        };
         if parts.next().is_some() {
             return Err(bad("too many parts".into()));
         }
-        Ok(Sampling::Adaptive { threshold, max_spp })
+        Ok(Sampling::Adaptive {
+            threshold,
+            max_spp,
+            every_pixel,
+        })
     }
 
     /// Reads a sampling and its pixel filter as `compare` labels a setup's, and the viewer and
@@ -284,14 +316,22 @@ impl Sampling {
 
     /// The render options' `spp` and `adaptive` for this sampling.
     pub fn options(&self, ground_truth: bool) -> (u32, Option<Adaptive>) {
-        let adaptive = self.threshold().map(|threshold| Adaptive {
-            threshold,
-            ground_truth,
-        });
+        let adaptive = match *self {
+            Sampling::Uniform(_) => None,
+            Sampling::Adaptive {
+                threshold,
+                every_pixel,
+                ..
+            } => Some(Adaptive {
+                threshold,
+                ground_truth,
+                every_pixel,
+            }),
+        };
         (self.max_spp(), adaptive)
     }
 
-    /// As a setup's label writes it: `16spp`, `auto:0.02`, `auto:0.01:64`.
+    /// As a setup's label writes it: `16spp`, `auto:0.02`, `auto:0.01:64`, `auto:0.02:16:1`.
     pub fn label(&self) -> String {
         match *self {
             Sampling::Uniform(spp) => format!("{spp}spp"),
@@ -301,14 +341,21 @@ impl Sampling {
 }
 
 impl std::fmt::Display for Sampling {
-    /// As `--spp` takes it: `16`, `auto:0.02`, `auto:0.01:64`.
+    /// As `--spp` takes it: `16`, `auto:0.02`, `auto:0.01:64`, `auto:0.02:16:1`.
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         match *self {
             Sampling::Uniform(spp) => write!(f, "{spp}"),
-            Sampling::Adaptive { threshold, max_spp } if max_spp == Self::DEFAULT_MAX_SPP => {
-                write!(f, "auto:{threshold}")
-            }
-            Sampling::Adaptive { threshold, max_spp } => write!(f, "auto:{threshold}:{max_spp}"),
+            Sampling::Adaptive {
+                threshold,
+                max_spp,
+                every_pixel: true,
+            } => write!(f, "auto:{threshold}:{max_spp}:1"),
+            Sampling::Adaptive {
+                threshold, max_spp, ..
+            } if max_spp == Self::DEFAULT_MAX_SPP => write!(f, "auto:{threshold}"),
+            Sampling::Adaptive {
+                threshold, max_spp, ..
+            } => write!(f, "auto:{threshold}:{max_spp}"),
         }
     }
 }
@@ -334,6 +381,7 @@ mod tests {
                 Sampling::Adaptive {
                     threshold: 0.02,
                     max_spp: 16,
+                    every_pixel: false,
                 },
             ),
             (
@@ -341,6 +389,7 @@ mod tests {
                 Sampling::Adaptive {
                     threshold: 0.05,
                     max_spp: 16,
+                    every_pixel: false,
                 },
             ),
             (
@@ -348,6 +397,15 @@ mod tests {
                 Sampling::Adaptive {
                     threshold: 0.0,
                     max_spp: 64,
+                    every_pixel: false,
+                },
+            ),
+            (
+                "auto:0.1:4:1",
+                Sampling::Adaptive {
+                    threshold: 0.1,
+                    max_spp: 4,
+                    every_pixel: true,
                 },
             ),
         ] {
@@ -388,6 +446,14 @@ mod tests {
         assert!(applies("1") && applies("auto:0.1:1") && applies("auto:0:1"));
         assert!(!applies("4") && !applies("16") && !applies("auto") && !applies("auto:0.1:4"));
         assert_eq!(Sampling::parse("auto").unwrap().label(), "auto:0.02");
+        assert_eq!(
+            Sampling::parse("auto:0.02:16:1").unwrap().label(),
+            "auto:0.02:16:1"
+        );
+        assert_eq!(
+            Sampling::parse("auto:0.02:16:1/16").unwrap(),
+            Sampling::parse("auto").unwrap()
+        );
         for bad in [
             "",
             "8",
@@ -395,7 +461,8 @@ mod tests {
             "auto:-1",
             "auto:x",
             "auto:0.1:8",
-            "auto:0.1:4:1",
+            "auto:0.1:4:2",
+            "auto:0.1:4:1:1",
             "autox",
         ] {
             let message = Sampling::parse(bad).unwrap_err().to_string();

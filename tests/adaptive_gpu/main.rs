@@ -62,7 +62,20 @@ fn adaptive_laid_out(
     let options = Adaptive {
         threshold,
         ground_truth,
+        every_pixel: false,
     };
+    adaptive_with(gpu, cam, spp, options, lanes)
+}
+
+/// An adaptive frame with `options` and at most `spp` samples a pixel, each pixel's samples
+/// spread over invocations as `lanes` says: as [`adaptive_stages`] returns it.
+fn adaptive_with(
+    gpu: &GpuScene,
+    cam: &LensCamera,
+    spp: u32,
+    options: Adaptive,
+    lanes: SampleLanes,
+) -> (RenderOutput, Vec<u32>, Vec<(Stage, u64)>) {
     let source = DirectionSource::Computed;
     let pass = AdaptivePass::with_lanes(ctx(), cam, gpu, source, spp, options, lanes).unwrap();
     let out = pass.trace(ctx(), gpu, "adaptive").unwrap();
@@ -362,6 +375,64 @@ fn estimated_and_supersampled_match(
     );
 }
 
+/// Starting from every pixel's centre (`auto:T:MAX:1`) the frame is coarse, estimating and
+/// supersampling stages alone, the first a ray through every pixel; each pixel is then
+/// uniform sampling's at its own rays, bit for bit: one ray (its centre), 1 + 4 (the
+/// estimate's 2 × 2) or 1 + 16, and each of the three occurs; no pixel is interpolated, so
+/// the ground truth is uniform sampling's with no stage of its own; at threshold 0 the frame
+/// is 16 uniform rays'; and a rerun gives the same bits.
+#[test]
+fn every_pixel_first_gives_uniform_sampling_at_each_pixels_rays() {
+    let room = scene("scenes/cornell-box.toml");
+    let gpu = upload(&room);
+    let (w, h) = (80u32, 60u32);
+    let cam = camera("canon-8-15mm@8mm", w, h);
+    let (one, four, sixteen) = (
+        uniform(&gpu, &cam, 1),
+        uniform(&gpu, &cam, 4),
+        uniform(&gpu, &cam, 16),
+    );
+    let lanes = SampleLanes::for_device(&ctx().device);
+    let every = |threshold| Adaptive {
+        threshold,
+        ground_truth: true,
+        every_pixel: true,
+    };
+    let (out, rays, stages) = adaptive_with(&gpu, &cam, 16, every(0.05), lanes);
+    let names: Vec<Stage> = stages.iter().map(|&(stage, _)| stage).collect();
+    assert_eq!(
+        names,
+        [Stage::Coarse, Stage::Estimate, Stage::Supersample],
+        "{stages:?}"
+    );
+    assert_eq!(stages[0].1, u64::from(w * h), "a ray through every pixel");
+    let mut seen = [0; 3];
+    for (i, &n) in rays.iter().enumerate() {
+        // Every pixel whose centre the lens covers (pixels on the lens's edge whose centre
+        // it masks may take the estimate's samples it covers).
+        assert!(n >= 1 || !one.valid(i), "pixel {i}: {n} rays");
+        // Pixels the lens covers whole (the others' samples are partly masked).
+        if out.colour[i][3] != 1.0 {
+            continue;
+        }
+        let (wanted, kind) = match n {
+            1 => (&one, 0),
+            5 => (&four, 1),
+            17 => (&sixteen, 2),
+            _ => panic!("pixel {i}: {n} rays"),
+        };
+        assert_eq!(out.colour[i], wanted.colour[i], "pixel {i}, {n} rays");
+        seen[kind] += 1;
+    }
+    assert!(seen.iter().all(|&k| k > 0), "1, 5 and 17 rays: {seen:?}");
+    assert_eq!(out.geometry, one.geometry, "geometry");
+    assert_eq!(out.ids, one.ids, "ids");
+    let (again, rays_again, _) = adaptive_with(&gpu, &cam, 16, every(0.05), lanes);
+    assert_eq!((again.colour, rays_again), (out.colour, rays), "rerun");
+    let (exact, _, _) = adaptive_with(&gpu, &cam, 16, every(0.0), lanes);
+    assert_eq!(exact.colour, sixteen.colour, "threshold 0");
+}
+
 /// Supersampling takes the pixels that demand every sample (`AdaptivePass::read_demanding`)
 /// and estimated pixels beside them across a change of surface, and no others: on the pixels
 /// the lens covers whole, where an estimated pixel took 1 + 4 rays and a supersampled one
@@ -379,6 +450,7 @@ fn estimated_pixels_beside_demanding_ones_across_an_edge_are_supersampled() {
     let options = Adaptive {
         threshold: 0.05,
         ground_truth: false,
+        every_pixel: false,
     };
     let pass =
         AdaptivePass::new(ctx(), &cam, &gpu, DirectionSource::Computed, 16, options).unwrap();
@@ -449,6 +521,7 @@ fn adaptive_sampling_refuses_what_it_cannot_do() {
         let options = Adaptive {
             threshold,
             ground_truth: false,
+            every_pixel: false,
         };
         let source = DirectionSource::Computed;
         match AdaptivePass::new(ctx(), cam, &gpu, source, 1, options) {
@@ -482,6 +555,7 @@ fn progressive_steps_sharpen_into_the_adaptive_frame() {
     let options = Adaptive {
         threshold,
         ground_truth: true,
+        every_pixel: false,
     };
     let pass =
         AdaptivePass::new(ctx(), &cam, &gpu, DirectionSource::Computed, spp, options).unwrap();

@@ -338,7 +338,7 @@ fn adaptive_render_writes_its_spp_map() {
     let message = String::from_utf8_lossy(&refused.stderr);
     assert!(!refused.status.success());
     assert!(
-        message.contains("auto[:THRESHOLD[:MAX]]") && !message.contains("panicked"),
+        message.contains("auto[:THRESHOLD[:MAX[:LEAST]]]") && !message.contains("panicked"),
         "{message}"
     );
     std::fs::remove_dir_all(dir).unwrap();

@@ -67,12 +67,13 @@ pub(crate) struct StudyArgs {
     #[arg(long, value_delimiter = ',', default_value = "512,1024,1920")]
     pub(crate) cube_size: Vec<u32>,
     /// Rays per pixel to measure direct tracing at (comma-separated): squares N for uniform
-    /// sampling, auto:THRESHOLD or auto:THRESHOLD:MAX for adaptive sampling (as `render --spp`). Direct RT is
-    /// a family over these as the cube maps are over face sizes.
+    /// sampling, auto:THRESHOLD, auto:THRESHOLD:MAX or auto:THRESHOLD:MAX:LEAST for adaptive
+    /// sampling (as `render --spp`). Direct RT is a family over these as the cube maps are
+    /// over face sizes.
     #[arg(
         long,
         value_delimiter = ',',
-        default_value = "1,4,16,auto:0.1:1,auto:0.1:4,auto:0.1,auto:0.02,auto:0.02:64"
+        default_value = "1,4,16,auto:0.1:1,auto:0.1:4,auto:0.1,auto:0.02,auto:0.02:64,auto:0.1:4:1"
     )]
     pub(crate) spp: Vec<Sampling>,
     /// Pixel filters to measure direct tracing with (comma-separated, as `render --filter`):

@@ -115,7 +115,8 @@ pub(crate) struct RenderArgs {
     #[arg(long, default_value = "identity", allow_hyphen_values = true)]
     t_scene_world: String,
     /// Rays per pixel, as `render --spp` takes them: N (a square, 1 to 256, box-filtered) or
-    /// auto, auto:THRESHOLD or auto:THRESHOLD:MAX (adaptive sampling); ground truth is the
+    /// auto, auto:THRESHOLD, auto:THRESHOLD:MAX or auto:THRESHOLD:MAX:LEAST (adaptive
+    /// sampling); ground truth is the
     /// centre ray's.
     #[arg(long, default_value = "16")]
     spp: Sampling,

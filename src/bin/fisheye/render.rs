@@ -66,11 +66,13 @@ pub(crate) struct RenderArgs {
     /// Rays per pixel (direct methods): N, a square from 1 to 256, for N rays in every pixel
     /// (on a rotated grid: one in each row and column of N × N cells), their mean its colour
     /// (a box filter) and alpha the share of the pixel the lens covers; or auto,
-    /// auto:THRESHOLD or auto:THRESHOLD:MAX for adaptive sampling: one ray per 4×4 pixels
-    /// first, then rays where neighbours see different surfaces or their displayed colours
-    /// bend by THRESHOLD or more (default 0.02 of full scale), then 2×2 samples where a
-    /// pixel's colour still bends, and all MAX (default 16) where those disagree; the rest
-    /// interpolated. Ground-truth arrays stay the one ray
+    /// auto:THRESHOLD, auto:THRESHOLD:MAX or auto:THRESHOLD:MAX:LEAST for adaptive sampling:
+    /// one ray per 4×4 pixels first, then rays where neighbours see different surfaces or
+    /// their displayed colours bend by THRESHOLD or more (default 0.02 of full scale), then
+    /// 2×2 samples where a pixel's colour still bends, and all MAX (default 16) where those
+    /// disagree; the rest interpolated. LEAST 1 traces every pixel's centre first instead
+    /// (fewer passes for more rays: faster where a pass costs a ray's latency, as on a large
+    /// GPU; LEAST 1/16 is the default). Ground-truth arrays stay the one ray
     /// through each pixel's centre. The default, 16, chosen by measurement: on the default
     /// scene it gives 52 dB against 64 rays, where adaptive sampling stops near 49 dB (see
     /// the book's "Adaptive sampling").
