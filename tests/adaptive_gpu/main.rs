@@ -380,7 +380,8 @@ fn estimated_and_supersampled_match(
 /// uniform sampling's at its own rays, bit for bit: one ray (its centre), 1 + 4 (the
 /// estimate's 2 × 2) or 1 + 16, and each of the three occurs; no pixel is interpolated, so
 /// the ground truth is uniform sampling's with no stage of its own; at threshold 0 the frame
-/// is 16 uniform rays'; and a rerun gives the same bits.
+/// is 16 uniform rays'; a rerun gives the same bits; and progressive steps begin at uniform
+/// sampling's one-ray frame and end in the whole frame.
 #[test]
 fn every_pixel_first_gives_uniform_sampling_at_each_pixels_rays() {
     let room = scene("scenes/cornell-box.toml");
@@ -428,9 +429,22 @@ fn every_pixel_first_gives_uniform_sampling_at_each_pixels_rays() {
     assert_eq!(out.geometry, one.geometry, "geometry");
     assert_eq!(out.ids, one.ids, "ids");
     let (again, rays_again, _) = adaptive_with(&gpu, &cam, 16, every(0.05), lanes);
-    assert_eq!((again.colour, rays_again), (out.colour, rays), "rerun");
+    assert_eq!((&again.colour, &rays_again), (&out.colour, &rays), "rerun");
     let (exact, _, _) = adaptive_with(&gpu, &cam, 16, every(0.0), lanes);
     assert_eq!(exact.colour, sixteen.colour, "threshold 0");
+    // Progressively: the first step is uniform sampling's one-ray frame, and the steps end in
+    // the whole frame (16 samples a pixel at most: step 1 and at most 16 slices).
+    let source = DirectionSource::Computed;
+    let pass = AdaptivePass::with_lanes(ctx(), &cam, &gpu, source, 16, every(0.05), lanes).unwrap();
+    let step = |k: u32| {
+        let mut encoder = ctx().device.create_command_encoder(&Default::default());
+        pass.encode_step(&mut encoder, &gpu, k);
+        ctx().queue.submit([encoder.finish()]);
+        pass.trace_pass().read(ctx()).unwrap()
+    };
+    assert_eq!(step(0).colour, one.colour, "step 0");
+    let last = (1..=17).map(step).last().unwrap();
+    assert_eq!(last.colour, out.colour, "the steps' end");
 }
 
 /// Supersampling takes the pixels that demand every sample (`AdaptivePass::read_demanding`)
