@@ -275,6 +275,13 @@ struct Corner {
     position: vec3<f32>,
 }
 
+// Where pixel `p`'s centre ray, whose hit is `geometry` (normal and range), meets the surface
+// (relative to the scene's origin).
+fn centre_hit(p: vec2<u32>, geometry: vec4<f32>) -> vec3<f32> {
+    let ray = centre_ray(p, primary_ray(p).xyz);
+    return ray.origin + ray.dir * geometry.w;
+}
+
 // What `classify` reads of the lattice points around its workgroup's blocks, loaded once into
 // workgroup memory by `load_tile`: the WORKGROUP_2D² blocks' corners and the ring beyond them
 // (whose colours `edge_bend` and keys `masked_near` look at), TILE² points in rows. Each
@@ -310,8 +317,7 @@ fn load_tile(origin: vec2<u32>, local: u32) {
         let g = geometry_out[i];
         var position = vec3<f32>(0.0);
         if key < ADAPTIVE_KEY_MORE {
-            let ray = centre_ray(p, primary_ray(p).xyz);
-            position = ray.origin + ray.dir * g.w;
+            position = centre_hit(p, g);
         }
         tile_corner[t] = Corner(key, g, position);
         let c = colour_out[i];

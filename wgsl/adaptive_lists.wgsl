@@ -222,8 +222,7 @@ fn estimated(p: vec2<u32>) -> bool {
 // and range) and where that is.
 fn centre_corner(p: vec2<u32>) -> Corner {
     let g = geometry_out[index_of(p)];
-    let ray = centre_ray(p, primary_ray(p).xyz);
-    return Corner(0u, g, ray.origin + ray.dir * g.w);
+    return Corner(0u, g, centre_hit(p, g));
 }
 
 // Whether traced pixel `p`'s neighbour `offset` away (one pixel along an axis) is in the
