@@ -96,7 +96,14 @@ fn adaptive_frames_time_listing_and_tracing_apart_and_count_their_rays() {
         rays.iter().skip(1).step_by(2).all(|&n| n == 0),
         "listing traces nothing: {rays:?}"
     );
-    let lattice = u64::from(47u32.div_ceil(4) + 1) * u64::from(35u32.div_ceil(4) + 1);
+    // The block corners the lens covers: every 4th pixel along each axis and the last (the
+    // 180° circle masks the image's corners, and the coarse stage traces nothing there).
+    let corners = |n: u32| (0..n).filter(move |&i| i % 4 == 0 || i == n - 1);
+    let lattice = corners(36)
+        .flat_map(|y| corners(48).map(move |x| (x, y)))
+        .filter(|&(x, y)| cam.pixel_direction(x, y).is_some())
+        .count() as u64;
+    assert!(lattice < 13 * 10, "{lattice} of 130 corners covered");
     assert_eq!(rays[0], lattice);
     let map: u64 = renderer
         .rays_per_pixel(ctx())
@@ -110,6 +117,17 @@ fn adaptive_frames_time_listing_and_tracing_apart_and_count_their_rays() {
         counted >= map && map > lattice,
         "{counted} counted, {map} in the map"
     );
+    // Starting from every pixel, the first stage traces the centres the lens covers: those
+    // of a uniform frame of one ray a pixel.
+    let every = Setup::sampled(Method::Rt, Sampling::parse("auto:0.05:4:1").unwrap());
+    let scenes = SceneSet::new(ctx(), &scene, &RenderOptions::default(), &[every]).unwrap();
+    let renderer = Offscreen::new(ctx(), &cam, &scenes, every, 256).unwrap();
+    renderer.warm_up(ctx(), &scenes, &scene.camera).unwrap();
+    let time = renderer.frame(ctx(), &scenes, &scene.camera).unwrap();
+    let once = render(ctx(), &scene, &cam, &RenderOptions::default()).unwrap();
+    let rays = time.passes_rays.expect("a traced frame");
+    assert_eq!(rays[0], once.counts().0 as u64);
+    assert!(rays[0] < 48 * 36);
 }
 
 /// A study of `setups` on one lens, the built-in scene `name`.

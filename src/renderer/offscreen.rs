@@ -346,6 +346,9 @@ pub struct Offscreen {
     /// The rays of a uniformly sampled frame: the pixels the lens gives a ray, times spp (0
     /// for other paths, which count their own or none).
     uniform_rays: u64,
+    /// The rays of an adaptive frame's coarse stage: the lattice points (or pixels) the lens
+    /// gives a ray (0 for other paths).
+    coarse_rays: u64,
 }
 
 /// How long one frame took.
@@ -356,9 +359,11 @@ pub struct FrameTime {
     /// GPU milliseconds per pass, in [`Offscreen::passes`] order; `None` without timestamp
     /// queries.
     pub passes_ms: Option<Vec<f64>>,
-    /// Rays each pass traced, in the same order, for direct tracing (see
-    /// [`crate::trace::AdaptivePass::read_stage_rays`]; a uniform frame's are the pixels the
-    /// lens gives a ray times spp); `None` through a cube map.
+    /// Rays each pass traced, in the same order, for direct tracing: a uniform frame's are
+    /// the pixels the lens gives a ray times spp, an adaptive coarse stage's the lattice
+    /// points (or pixels) it gives one, and a later stage's its pixels listed times their
+    /// samples ([`crate::trace::AdaptivePass::read_stage_rays`], which counts the few the
+    /// lens masks at its rim too); `None` through a cube map.
     pub passes_rays: Option<Vec<u64>>,
 }
 
@@ -415,18 +420,28 @@ impl Offscreen {
         let path = Path::new(ctx, camera, scene, rays, cube.as_ref())?;
         let passes = setup.passes(ground_truth);
         let queries = Queries::new(ctx, passes.len() as u32);
-        // Only a uniformly traced frame's rays are counted from the lens (an f64 evaluation
-        // a pixel, once).
-        let covered = match &path {
-            Path::Direct(_) => camera.directions().iter().filter(|d| d.is_some()).count(),
-            _ => 0,
-        } as u64;
+        // A uniformly traced frame's rays and an adaptive frame's coarse stage's are counted
+        // from the lens (an f64 evaluation a pixel, once): the centres it covers. The coarse
+        // stage's invocations at masked lattice points trace nothing.
+        let (uniform_rays, coarse_rays) = match &path {
+            Path::Direct(_) => {
+                let covered = camera.directions().iter().filter(|d| d.is_some()).count();
+                (covered as u64 * u64::from(spp), 0)
+            }
+            Path::Adaptive(pass) => {
+                let covered = pass.coarse_pixels();
+                let covered = covered.filter(|&[x, y]| camera.pixel_direction(x, y).is_some());
+                (0, covered.count() as u64)
+            }
+            Path::Cube(_) => (0, 0),
+        };
         Ok(Self {
             path,
             setup,
             passes,
             queries,
-            uniform_rays: covered * u64::from(spp),
+            uniform_rays,
+            coarse_rays,
         })
     }
 
@@ -493,6 +508,11 @@ impl Offscreen {
                 pass.read_stage_rays(ctx)?
                     .into_iter()
                     .flat_map(|(stage, rays)| {
+                        let rays = if stage == Stage::Coarse {
+                            self.coarse_rays
+                        } else {
+                            rays
+                        };
                         Pass::listing(stage).map(|_| 0).into_iter().chain([rays])
                     })
                     .collect(),
