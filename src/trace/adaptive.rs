@@ -467,17 +467,12 @@ impl AdaptivePass {
         self.dispatch_2d(encoder, scene, label, &[&self.lattice], size, writes);
     }
 
-    /// The pixels whose centres the coarse stage traces, row by row: the lattice's (every
-    /// `ADAPTIVE_BLOCK`-th pixel along each axis and the last, as `lattice_pixel` in
-    /// `wgsl/adaptive.wgsl` places them), or every pixel.
+    /// The pixels whose centres the coarse stage traces, row by row: the lattice's (where
+    /// `lattice_pixel` in `wgsl/adaptive.wgsl` puts them), or every pixel.
     pub fn coarse_pixels(&self) -> impl Iterator<Item = [u32; 2]> {
-        let size = self.trace.size();
-        let spacing = if self.options.every_pixel {
-            1
-        } else {
-            ADAPTIVE_BLOCK
-        };
-        let [w, h] = self.coarse_points();
+        let (size, [w, h]) = (self.trace.size(), self.coarse_points());
+        let every = self.options.every_pixel;
+        let spacing = if every { 1 } else { ADAPTIVE_BLOCK };
         let at = move |i: u32, n: u32| (i * spacing).min(n - 1);
         (0..h).flat_map(move |y| (0..w).map(move |x| [at(x, size.width), at(y, size.height)]))
     }
