@@ -476,6 +476,16 @@ fn count(n: f64) -> String {
     }
 }
 
+/// A frame's time over its rays or texels, in ns (what one costs, bookkeeping and resampling
+/// included); a dash for a frame that takes none.
+fn per_sample_ns(ms: f64, samples: f64) -> String {
+    if samples > 0.0 {
+        sig(ms * 1e6 / samples)
+    } else {
+        "—".into()
+    }
+}
+
 /// How many times fewer rays RT traces than the cube texels (`ratio` = texels / rays).
 fn rays_ratio(ratio: f64) -> String {
     if ratio >= 1.0 {
@@ -509,17 +519,18 @@ impl CompareReport {
             WARM_UP.as_millis()
         );
         md.push_str(
-            "| lens | setup | ms / frame | rays or texels | MSE | PSNR (dB) | ꟻLIP | mask agreement | Pareto (MSE) | Pareto (ꟻLIP) |\n|---|---|---:|---:|---:|---:|---:|---:|:-:|:-:|\n",
+            "| lens | setup | ms / frame | rays or texels | ns / ray or texel | MSE | PSNR (dB) | ꟻLIP | mask agreement | Pareto (MSE) | Pareto (ꟻLIP) |\n|---|---|---:|---:|---:|---:|---:|---:|---:|:-:|:-:|\n",
         );
         let dot = |on: bool| if on { "●" } else { "" };
         for e in &self.entries {
             let _ = writeln!(
                 md,
-                "| {} | {} | {} | {} | {:.2e} | {:.1} | {:.4} | {:.4} | {} | {} |",
+                "| {} | {} | {} | {} | {} | {:.2e} | {:.1} | {:.4} | {:.4} | {} | {} |",
                 e.lens,
                 e.setup,
                 sig(e.ms()),
                 count(e.samples),
+                per_sample_ns(e.ms(), e.samples),
                 e.error.mse,
                 e.error.psnr_db,
                 e.flip,

@@ -169,10 +169,16 @@ fn the_markdown_states_every_level() {
     };
     let md = report.markdown();
     assert!(
-        md.contains("| lens | rt@4spp | 40.0 | 4.00 k | 1.00e-3 |"),
+        md.contains("| lens | rt@4spp | 40.0 | 4.00 k | 10000 | 1.00e-3 |"),
         "{md}"
     );
     assert!(md.contains("- lens, MSE (least: 2.00x slower): at cube-rt@64's MSE 8.00e-3 (5.00 ms) RT needs 10.0 ms: 2.00x slower; at cube-rt@128's MSE 2.00e-3 (40.0 ms) RT needs 20.0 ms: 2.00x faster"), "{md}");
     assert!(md.contains("only RT reaches below the cube maps' best, down to 2.50e-4 (rt@16spp)"));
+    // What a texel costs: 40 ms over 128² of them; a frame of no samples has no cost a sample.
+    assert!(
+        md.contains("| lens | cube-rt@128 | 40.0 | 16.4 k | 2441 | 2.00e-3 |"),
+        "{md}"
+    );
+    assert_eq!(per_sample_ns(1.0, 0.0), "—");
     assert!(md.contains("- lens, MSE (least: 4.10x fewer): at cube-rt@64's MSE 8.00e-3 (4.10 k texels) RT needs 1.00 k rays: 4.10x fewer; at cube-rt@128's MSE 2.00e-3 (16.4 k texels) RT needs 2.00 k rays: 8.19x fewer"), "{md}");
 }
