@@ -11,6 +11,12 @@ override SAMPLE_LANES: u32 = 1u;
 override REUSED: u32 = 0u;
 // Each invocation's last sample, for its pixel's first lane to add up.
 var<workgroup> lane_radiance: array<vec4<f32>, WORKGROUP_1D>;
+// How much of the difference between an estimated pixel's centre ray and its 2 × 2 samples'
+// mean counts against the threshold: the centre is a fifth sample, and one sample lies
+// about twice as far from a mean of four as a half of two does (for independent samples of
+// spread σ, √(1 + 1/4)·σ against σ/2), so a half of its difference weighs about as much as
+// a half's. Used only to decide; the colour stays the four samples' mean.
+const CENTRE_SHARE: f32 = 0.5;
 
 // Traces the listed pixels' samples, LIST_MODE's MODE_SAMPLES (SAMPLES_PER_SIDE² each) or
 // MODE_ESTIMATE (ADAPTIVE_ESTIMATE_SIDE²), SAMPLE_LANES invocations a pixel (the layout
@@ -40,6 +46,12 @@ fn trace_samples(
     let pixel = vec2<u32>(index % lens.width, index / lens.width);
     // Supersampling goes on from the estimate's samples where it reuses them.
     let reused = select(0u, REUSED, LIST_MODE == MODE_SAMPLES);
+    // An estimated pixel's colour is still its centre ray's (every listed pixel was traced
+    // there).
+    var centre = vec4<f32>(0.0);
+    if listed && estimate {
+        centre = colour_out[index];
+    }
     var sums = SampleSums();
     if listed && reused > 0u {
         sums = sums_of(colour_out[index], reused);
@@ -76,9 +88,15 @@ fn trace_samples(
     // Dammertz et al. (2010) estimate a pixel's error by how far the mean of half its samples
     // lies from the mean of all: here in displayed colour, the largest over three halves (their
     // interleaved half alone holds a sample either side of an edge along an axis at 2 × 2).
+    // Beside them the centre ray the pixel already has, which sees what passes between the
+    // 2 × 2 samples (a detail narrower than a quarter pixel at its centre): CENTRE_SHARE of
+    // its difference from their mean.
     var worst = 0.0;
     for (var h = 0u; estimate && h < 3u; h++) {
         worst = max(worst, largest(abs(shown(s.colour.rgb) - shown(s.halves[h]))));
+    }
+    if estimate && centre.w > 0.0 {
+        worst = max(worst, CENTRE_SHARE * largest(abs(shown(s.colour.rgb) - shown(centre.rgb))));
     }
     if estimate && worst >= adaptive.threshold {
         set_key(index, ADAPTIVE_KEY_MORE);

@@ -1,8 +1,8 @@
 //! Adaptive sampling on planes made for the purpose: a smooth one traced at its block corners
 //! only and interpolated bicubically, a straight edge refined only where it crosses, wedges
 //! whose tips reach into blocks between corners that see sky, and the estimating stage's
-//! pixels on an edge between its samples' columns and beside colours past the display's
-//! white.
+//! pixels on an edge between its samples' columns, on a detail between its samples and beside
+//! colours past the display's white.
 
 use super::*;
 
@@ -384,6 +384,48 @@ fn an_edge_between_the_estimating_samples_columns_is_supersampled() {
     let cam = camera("rectilinear:f=1", w, h);
     let (_, rays) = adaptive(&gpu, &cam, 16, 0.02, false);
     let middle = w / 2;
+    for y in 0..h {
+        assert_eq!(
+            rays[(y * w + middle) as usize],
+            1 + 16,
+            "pixel ({middle}, {y})"
+        );
+    }
+}
+
+/// A dark strip a few hundredths of a pixel wide lies on a lit plane along the centres of a
+/// column of pixels (seen straight down through a pinhole, as above): each of those pixels'
+/// centre rays sees it, and their 2 × 2 estimating samples, an eighth and three eighths of a
+/// pixel either side of the centre, all miss it, so their halves agree. The centre ray, which
+/// the estimate weighs beside them, differs from their mean: each such pixel takes every
+/// sample (with the halves alone it would stop at 4, the strip missed).
+#[test]
+fn a_detail_between_the_estimating_samples_is_supersampled() {
+    let obj = "mtllib plane.mtl\nv -20 -20 0\nv 20 -20 0\nv 20 20 0\nv -20 20 0\n\
+               v -0.002 -20 0.001\nv 0.002 -20 0.001\nv 0.002 20 0.001\nv -0.002 20 0.001\n\
+               usemtl plane\nf 1 2 3\nf 1 3 4\nusemtl strip\nf 5 6 7\nf 5 7 8\n";
+    let mtl = "newmtl plane\nKd 0.8 0.8 0.8\nnewmtl strip\nKd 0.05 0.05 0.05\n";
+    let plane = lit_mesh(
+        "strip",
+        obj,
+        Some(mtl),
+        "position = [0.0, 0.0, 3.0]\nlook_at = [0.0, 0.0, 0.0]",
+        "position = [10.0, 6.0, 40.0]\nintensity = [1200.0, 1200.0, 1200.0]",
+    );
+    let gpu = upload(&plane);
+    let (w, h) = (65u32, 49u32);
+    let cam = camera("rectilinear:f=1", w, h);
+    let one = uniform(&gpu, &cam, 1);
+    let strip = |x: u32, y: u32| one.ids[(y * w + x) as usize] >= 2;
+    let middle = w / 2;
+    for y in 0..h {
+        assert!(
+            strip(middle, y),
+            "the centre of ({middle}, {y}) sees the strip"
+        );
+        assert!(!strip(middle - 1, y) && !strip(middle + 1, y));
+    }
+    let (_, rays) = adaptive(&gpu, &cam, 16, 0.02, false);
     for y in 0..h {
         assert_eq!(
             rays[(y * w + middle) as usize],
