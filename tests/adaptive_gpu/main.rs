@@ -440,14 +440,12 @@ fn every_pixel_first_gives_uniform_sampling_at_each_pixels_rays() {
         let mut encoder = ctx().device.create_command_encoder(&Default::default());
         pass.encode_step(&mut encoder, &gpu, k);
         ctx().queue.submit([encoder.finish()]);
-        pass.trace_pass().read(ctx()).unwrap()
     };
-    assert_eq!(step(0).colour, one.colour, "step 0");
-    let mut last = step(1);
-    for k in 2..=17 {
-        last = step(k);
-    }
-    assert_eq!(last.colour, out.colour, "the steps' end");
+    let image = || pass.trace_pass().read(ctx()).unwrap().colour;
+    step(0);
+    assert_eq!(image(), one.colour, "step 0");
+    (1..=17).for_each(step);
+    assert_eq!(image(), out.colour, "the steps' end");
 }
 
 /// Supersampling takes the pixels that demand every sample (`AdaptivePass::read_demanding`)

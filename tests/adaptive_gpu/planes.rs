@@ -125,6 +125,22 @@ fn a_smooth_scene_is_traced_at_block_corners_only() {
         rays.iter().filter(|&&n| n == 0).count(),
         rays.len() - corners
     );
+    // The traced pixels are those `AdaptivePass::coarse_pixels` names (by which `bench`
+    // counts the coarse stage's rays): its Rust lattice is the kernel's.
+    let options = Adaptive {
+        threshold,
+        ground_truth: false,
+        every_pixel: false,
+    };
+    let source = DirectionSource::Computed;
+    let lanes = SampleLanes::PerPixel;
+    let pass = AdaptivePass::with_lanes(ctx(), &cam, &gpu, source, 16, options, lanes).unwrap();
+    let named: Vec<usize> = pass
+        .coarse_pixels()
+        .map(|[x, y]| (y * w + x) as usize)
+        .collect();
+    let traced: Vec<usize> = (0..rays.len()).filter(|&i| rays[i] == 1).collect();
+    assert_eq!(named, traced);
     let shown = |c: f32| linear_to_srgb(c.clamp(0.0, 1.0));
     let worst = one
         .colour
