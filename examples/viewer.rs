@@ -243,8 +243,6 @@ impl State {
         let (sampling, filter) =
             Sampling::parse_filtered(SPP[self.spp]).map_err(|e| e.to_string())?;
         let (spp, adaptive) = sampling.options(false);
-        // The glass is traced by uniform sampling, at the choice's most rays a pixel.
-        let adaptive = adaptive.filter(|_| camera.glass.is_none());
         let options = RenderOptions {
             traversal: method.traversal(),
             spp,

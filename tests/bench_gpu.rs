@@ -408,7 +408,8 @@ fn banded_frames_are_timed_whole() {
 }
 
 /// A prescription's glass is timed and compared beside its fitted model (`rays=fit`): the
-/// glass runs the uniform direct setups, its cube-map setup is skipped and listed saying why,
+/// glass runs the direct setups, uniform and adaptive, its cube-map setup is skipped and
+/// listed saying why,
 /// and the fitted model runs every setup, so a frame through the glass and one through its
 /// model stand in the same reports.
 #[test]
@@ -433,7 +434,7 @@ fn a_prescriptions_glass_is_timed_beside_its_fitted_model() {
     let all = Setup::all(
         &[Method::Rt, cube],
         &[16],
-        &[Sampling::Uniform(4)],
+        &[Sampling::Uniform(4), Sampling::parse("auto:0.1").unwrap()],
         &[PixelFilter::Box],
     );
     let scenes = SceneSet::new(ctx(), &scene, &RenderOptions::default(), &all).unwrap();
@@ -449,7 +450,9 @@ fn a_prescriptions_glass_is_timed_beside_its_fitted_model() {
         ran,
         [
             pair("glass", "rt@4spp"),
+            pair("glass", "rt@auto:0.1"),
             pair("fit", "rt@4spp"),
+            pair("fit", "rt@auto:0.1"),
             pair("fit", "cube-rt@16")
         ]
     );
@@ -478,7 +481,9 @@ fn a_prescriptions_glass_is_timed_beside_its_fitted_model() {
         ran,
         [
             pair("glass", "rt@4spp"),
+            pair("glass", "rt@auto:0.1"),
             pair("fit", "rt@4spp"),
+            pair("fit", "rt@auto:0.1"),
             pair("fit", "cube-rt@16")
         ]
     );

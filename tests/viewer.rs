@@ -140,18 +140,19 @@ fn the_viewer_shows_the_scene_under_xvfb() {
     let window = screenshot(&[&args[..], &["--method", "cube-rt"]].concat(), 4);
     assert_shows("cube-rt", &window, &colour_image(size, &colour));
 
-    // Through a prescription's glass, which the viewer traces uniformly: the default `auto`
-    // at its most rays a pixel (16) everywhere.
+    // Through a prescription's glass, adaptively as through any lens: a still camera's
+    // frames sharpen into the whole adaptive frame.
     let spec = format!(
         "prescription:{}/lenses/fisheye-10mm.dat",
         env!("CARGO_MANIFEST_DIR")
     );
     let glass = fisheye_rt::lens::glass::camera_for(&spec, size).unwrap();
-    let sixteen = RenderOptions { spp: 16, ..options };
-    let traced = render(&ctx, &scene, &glass, &sixteen).unwrap().to_image();
+    let traced = render(&ctx, &scene, &glass, &adaptive(16))
+        .unwrap()
+        .to_image();
     let window = screenshot(
         &["builtin:default", "--lens", &spec, "--size", "160x120"],
-        2,
+        20,
     );
-    assert_shows("rt through glass", &window, &traced);
+    assert_shows("rt through glass, adaptive, still", &window, &traced);
 }

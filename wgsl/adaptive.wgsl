@@ -210,7 +210,8 @@ fn is_lattice(p: vec2<u32>) -> bool {
 }
 
 // Traces the centre of pixel `index` (at `pixel`) as `mode` says: shaded (MODE_CENTRE), or
-// its first hit alone (MODE_TRUTH).
+// its first hit alone (MODE_TRUTH). Through a prescription's glass, MODE_CENTRE's colour is
+// the pixel's one film sample's (`glass_radiance`).
 fn trace_centre(index: u32, pixel: vec2<u32>, mode: u32) {
     let ray = primary_ray(pixel);
     if ray.w == 0.0 {
@@ -228,8 +229,17 @@ fn trace_centre(index: u32, pixel: vec2<u32>, mode: u32) {
         ids_out[index] = hit.triangle;
         return;
     }
-    let traced = shade_centre(pixel, ray.xyz);
-    colour_out[index] = vec4<f32>(traced.colour, 1.0);
+    var traced: Traced;
+    if GLASS {
+        // The ray of the pixel's one film sample through the glass makes the colour, as
+        // uniform sampling's at one ray a pixel; the fitted model's centre ray, the ground
+        // truth and what the pixel's neighbours compare.
+        traced = first_hit(centre_ray(pixel, ray.xyz));
+        colour_out[index] = vec4<f32>(glass_radiance(pixel, index, 0u, 1u), 1.0);
+    } else {
+        traced = shade_centre(pixel, ray.xyz);
+        colour_out[index] = vec4<f32>(traced.colour, 1.0);
+    }
     geometry_out[index] = geometry_of(traced);
     ids_out[index] = traced.triangle;
     set_state(index, 1u, surface_key(traced));

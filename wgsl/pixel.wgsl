@@ -52,8 +52,16 @@ fn set_spread(at: Placement, p: vec2<f32>, d: vec3<f32>, step: f32) {
 }
 
 // Sample `k` of the `side`² samples (`sample_offset`) of pixel `pixel` (index `index`): its
-// radiance with w = 1, or all zero where the lens masks it.
+// radiance with w = 1, or all zero where the lens masks it. Through a prescription's glass,
+// the film sample's ray through its point of the exit pupil (`glass_radiance`), in a pixel
+// that the fitted model's centre ray, which gives the mask and the ground truth, does not mask.
 fn sample_radiance(pixel: vec2<u32>, index: u32, k: u32, side: u32) -> vec4<f32> {
+    if GLASS {
+        if primary_ray(pixel).w == 0.0 {
+            return vec4<f32>(0.0);
+        }
+        return vec4<f32>(glass_radiance(pixel, index, k, side), 1.0);
+    }
     let p = vec2<f32>(pixel) + sample_offset(index, k, side);
     let d = lens_unproject(lens, p);
     if d.w == 0.0 {
@@ -62,6 +70,30 @@ fn sample_radiance(pixel: vec2<u32>, index: u32, k: u32, side: u32) -> vec4<f32>
     let at = camera_at(sample_time(pixel, index, k, side * side));
     set_spread(at, p, d.xyz, 1.0 / f32(side));
     return vec4<f32>(shade(placed_ray(at, vec3<f32>(0.0), d.xyz)).colour, 1.0);
+}
+
+// Film sample `k` of pixel `pixel`'s `side`² (`sample_offset`, toward `pupil_offset`'s point
+// of the exit pupil) through the glass: its ray's radiance times its weight, zero where the
+// glass blocks it, so that the mean over a pixel's samples darkens with vignetting and
+// spreads an out-of-focus point as the glass does. Where the glass disperses, red, green and
+// blue are traced apart, each giving its channel.
+fn glass_radiance(pixel: vec2<u32>, index: u32, k: u32, side: u32) -> vec3<f32> {
+    let centre = 0.5 * vec2<f32>(f32(lens.width), f32(lens.height));
+    let p = vec2<f32>(pixel) + sample_offset(index, k, side) - centre;
+    let u = pupil_offset(index, k, side);
+    let at = camera_at(sample_time(pixel, index, k, side * side));
+    var radiance = vec3<f32>(0.0);
+    for (var c = 0u; c < GLASS_CHANNELS; c++) {
+        // One channel of three, or green's indices for all.
+        let s = glass_sample(p, u, select(1u, c, GLASS_CHANNELS == 3u));
+        if s.weight > 0.0 {
+            let ray = placed_ray(at, s.origin, s.direction);
+            // Channel c's part alone, or every channel without dispersion.
+            let part = (vec3<u32>(0u, 1u, 2u) == vec3<u32>(c)) | vec3<bool>(GLASS_CHANNELS == 1u);
+            radiance += select(vec3<f32>(0.0), s.weight * shade(ray).colour, part);
+        }
+    }
+    return radiance;
 }
 
 // Adds sample `k` of `side`², `sample_radiance`'s `c`, to `sums`.
@@ -125,36 +157,10 @@ fn samples(pixel: vec2<u32>, index: u32, side: u32) -> Sampled {
     return sampled(sums, side * side);
 }
 
-// The pixel's SAMPLES_PER_SIDE² samples: their mean radiance, and the share with a ray (w).
+// The pixel's SAMPLES_PER_SIDE² samples: their mean radiance, and the share with a ray (w);
+// through the glass, its image irradiance (the mean of its samples' weighted radiance).
 fn supersampled(pixel: vec2<u32>, index: u32) -> vec4<f32> {
     return samples(pixel, index, SAMPLES_PER_SIDE).colour;
-}
-
-// Pixel `pixel`'s image irradiance through the glass: the mean over its SAMPLES_PER_SIDE²
-// film samples of their rays' radiance times their weights (zero where blocked), so that
-// vignetting darkens and an out-of-focus point spreads as the glass makes them. Where the
-// glass disperses, each sample traces red, green and blue apart, each giving its channel.
-fn through_glass(pixel: vec2<u32>, index: u32) -> vec3<f32> {
-    let side = SAMPLES_PER_SIDE;
-    let centre = 0.5 * vec2<f32>(f32(lens.width), f32(lens.height));
-    var sum = vec3<f32>(0.0);
-    for (var k = 0u; k < side * side; k++) {
-        let p = vec2<f32>(pixel) + sample_offset(index, k, side) - centre;
-        let u = pupil_offset(index, k, side);
-        let at = camera_at(sample_time(pixel, index, k, side * side));
-        for (var c = 0u; c < GLASS_CHANNELS; c++) {
-            // One channel of three, or green's indices for all.
-            let s = glass_sample(p, u, select(1u, c, GLASS_CHANNELS == 3u));
-            if s.weight > 0.0 {
-                let ray = placed_ray(at, s.origin, s.direction);
-                let radiance = s.weight * shade(ray).colour;
-                // Channel c's part alone, or every channel without dispersion.
-                let part = (vec3<u32>(0u, 1u, 2u) == vec3<u32>(c)) | vec3<bool>(GLASS_CHANNELS == 1u);
-                sum += select(vec3<f32>(0.0), radiance, part);
-            }
-        }
-    }
-    return sum / f32(side * side);
 }
 
 // Shades pixel `pixel`'s centre ray (`centre_ray`), along camera-space direction `d`.

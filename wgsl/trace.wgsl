@@ -5,7 +5,7 @@
 // With SAMPLES_PER_SIDE = s > 1 the colour is the mean radiance of s² samples inside the
 // pixel (`sampling.wgsl`; a box filter), and w the share of them the lens covers; the
 // ground truth (geometry, id) stays the single ray through the pixel's centre. With GLASS the
-// colour is traced through a prescription's surfaces instead (`through_glass`), and the
+// colour is traced through a prescription's surfaces instead (`glass_radiance`), and the
 // ground truth is its fitted model's centre ray.
 #import pixel
 
@@ -30,12 +30,9 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     }
     let centre = centre_ray(pixel, ray.xyz);
     var traced: Traced;
-    if GLASS {
-        // The glass makes the colour; the fitted model's centre ray, the ground truth.
-        traced = first_hit(centre);
-        colour_out[stored] = vec4<f32>(through_glass(pixel, index), 1.0);
-    } else if SAMPLES_PER_SIDE > 1u {
-        // The samples make the colour; the centre gives the ground truth, its hit alone.
+    if GLASS || SAMPLES_PER_SIDE > 1u {
+        // The samples make the colour (through the glass, where there is one); the centre
+        // (the glass's fitted model's) gives the ground truth, its hit alone.
         traced = first_hit(centre);
         colour_out[stored] = supersampled(pixel, index);
     } else {

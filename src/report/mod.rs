@@ -77,15 +77,13 @@ impl Study<'_> {
     }
 
     /// Why `lens` cannot run `setup`, where it cannot: a prescription's glass is traced by
-    /// uniform direct sampling only (a cube map resamples by direction; adaptive sampling does
-    /// not trace the glass yet), so its other setups are skipped and listed, and `rays=fit`
-    /// measures its fitted model there.
+    /// direct sampling only (a cube map resamples by direction), so its cube setups are
+    /// skipped and listed, and `rays=fit` measures its fitted model there.
     fn cannot(lens: &LensRun, setup: &Setup) -> Option<String> {
-        let uniform_direct = setup.method.cube().is_none() && setup.threshold().is_none();
-        (lens.camera.glass.is_some() && !uniform_direct).then(|| {
+        (lens.camera.glass.is_some() && setup.method.cube().is_some()).then(|| {
             format!(
-                "{} {}: the glass is traced by uniform direct sampling only (rays=fit in the \
-                 spec measures its fitted model)",
+                "{} {}: the glass is traced by direct sampling only (rays=fit in the spec \
+                 measures its fitted model)",
                 lens.name,
                 setup.label()
             )

@@ -5,6 +5,7 @@
 
 #[path = "../common/mod.rs"]
 mod common;
+mod glass;
 mod planes;
 
 use common::{camera, ctx, scene};
