@@ -72,15 +72,15 @@ if [ "${SOAK:-1}" = 1 ]; then
     rm -f "$out/soak/bench.json"   # 20,000 frames' times; the medians are in bench.md
 fi
 # Real glass against its fitted model: the shipped prescriptions traced per ray and as their
-# chief rays' Kannala-Brandt fits (rays=fit), direct RT at 1 and 16 rays a pixel (GLASS=0
-# leaves it out).
+# chief rays' Kannala-Brandt fits (rays=fit), direct RT at 1 and 16 rays a pixel and adaptively
+# (`auto`, the default threshold; GLASS=0 leaves it out).
 if [ "${GLASS:-1}" = 1 ]; then
     glass=()
     for lens in fisheye-10mm dgauss-50mm; do
         glass+=(--lens "prescription:lenses/$lens.dat" --lens "prescription:lenses/$lens.dat,rays=fit")
     done
     "$bin" bench builtin:default "${glass[@]}" --no-pinhole --size "$size" --method rt \
-        --spp 1,16 --frames "$frames" --warmup 2 -o "$out/glass"
+        --spp 1,16,auto --frames "$frames" --warmup 2 -o "$out/glass"
 fi
 # The thesis's face sizes at its kind of image size (THESIS=0 leaves it out), against a
 # 64-ray reference (a 256-ray one at 1024x768 takes minutes a lens on a CPU).

@@ -20,7 +20,15 @@ struct GlassParams {
     // Per radial bin: the ellipse on the rear vertex's plane that holds the exit pupil seen
     // from a film point on the +x axis (centre x, centre y, semi-axes x and y; 0: none).
     pupil: array<vec4<f32>, PUPIL_BINS>,
+    // Per bin, at its inner edge on the film (2 × bin) and its outer edge (2 × bin + 1): the
+    // share of its ellipse whose rays get through, per channel (red, green, blue).
+    shares: array<vec4<f32>, 2u * PUPIL_BINS>,
 }
+
+// The most points of the ellipse a sample draws before it counts as stopped (a point whose
+// ray the glass stops is drawn again): where a share p of the ellipse gets through, all of
+// them stop with chance (1 - p)^GLASS_TRIES, under 3e-4 for p ≥ 0.4.
+const GLASS_TRIES: u32 = 16u;
 
 @group(0) @binding(6) var<uniform> glass: GlassParams;
 
@@ -119,14 +127,19 @@ struct GlassSample {
 }
 
 // The ray of the film point `offset` pixels from the image's centre (x right, y down) toward
-// the point `u` ∈ [0, 1)² of its radial bin's exit-pupil ellipse, in `channel`.
+// the point `u` ∈ [0, 1)² of its radial bin's exit-pupil ellipse, in `channel`. Where the
+// glass stops it, points drawn from a hash of `u` are tried instead (up to GLASS_TRIES in all),
+// and the ray that gets through carries the share of the ellipse that does (`glass.shares`):
+// rejection sampling of the pupil, whose expected weight is that of the ellipse's points with
+// those stopped counting 0, without their noise.
 fn glass_sample(offset: vec2<f32>, u: vec2<f32>, channel: u32) -> GlassSample {
     let none = GlassSample(vec3<f32>(0.0), vec3<f32>(0.0, 0.0, 1.0), 0.0);
     // The image on the film is inverted: the lens frame is the camera's turned half a turn
     // about y (x and z negated), and the film point of a pixel below the centre is above it.
     let xy = vec2<f32>(offset.x, -offset.y) * glass.film.z;
     let r = length(xy);
-    let bin = u32(r / glass.film.w * f32(glass.counts.y));
+    let place = r / glass.film.w * f32(glass.counts.y);
+    let bin = u32(place);
     if bin >= glass.counts.y {
         return none;
     }
@@ -134,26 +147,33 @@ fn glass_sample(offset: vec2<f32>, u: vec2<f32>, channel: u32) -> GlassSample {
     if e.z <= 0.0 {
         return none;
     }
+    let share = mix(glass.shares[2u * bin][channel], glass.shares[2u * bin + 1u][channel], fract(place));
     // The bin's ellipse is for a film point on the +x axis: turn it to this one's.
-    let q = e.xy + e.zw * concentric_disc(u);
     let c = select(vec2<f32>(1.0, 0.0), xy / r, r > 0.0);
-    let target_point = vec3<f32>(q.x * c.x - q.y * c.y, q.x * c.y + q.y * c.x, glass.film.y);
     let film = vec3<f32>(xy, glass.film.x);
-    let d = normalize(target_point - film);
-    let out = glass_trace(film, d, channel);
-    if !out.passed {
-        return none;
+    var v = u;
+    for (var attempt = 0u; attempt < GLASS_TRIES; attempt++) {
+        let q = e.xy + e.zw * concentric_disc(v);
+        let target_point = vec3<f32>(q.x * c.x - q.y * c.y, q.x * c.y + q.y * c.x, glass.film.y);
+        let d = normalize(target_point - film);
+        let out = glass_trace(film, d, channel);
+        if out.passed {
+            // cos⁴θ · A / z² over the centre's mean, times the share of A that gets through:
+            // the sample's share of the irradiance.
+            let z = glass.film.x - glass.film.y;
+            let cos2 = d.z * d.z;
+            let weight = cos2 * cos2 * PI * e.z * e.w / (z * z) * share * glass.scale[channel];
+            let m = glass.scale.w;
+            return GlassSample(
+                vec3<f32>(-out.origin.x, out.origin.y, -out.origin.z) * m,
+                vec3<f32>(-out.direction.x, out.direction.y, -out.direction.z),
+                weight,
+            );
+        }
+        let h = pcg2d(bitcast<vec2<u32>>(v) ^ vec2<u32>(attempt, channel));
+        v = vec2<f32>(h >> vec2<u32>(8u)) * (1.0 / 16777216.0);
     }
-    // cos⁴θ · A / z² over the centre's mean: the sample's share of the irradiance.
-    let z = glass.film.x - glass.film.y;
-    let cos2 = d.z * d.z;
-    let weight = cos2 * cos2 * PI * e.z * e.w / (z * z) * glass.scale[channel];
-    let m = glass.scale.w;
-    return GlassSample(
-        vec3<f32>(-out.origin.x, out.origin.y, -out.origin.z) * m,
-        vec3<f32>(-out.direction.x, out.direction.y, -out.direction.z),
-        weight,
-    );
+    return none;
 }
 
 // The point of the unit disc at `u` ∈ [0, 1)² by Shirley and Chiu's concentric map ("A

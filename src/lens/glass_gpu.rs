@@ -10,6 +10,12 @@
 //! axial distance `z` is `L cos⁴θ dA / z²`), divided by the same estimate's mean at the film's
 //! centre, so a uniform white scene is 1 at the centre of the image: vignetting (the pupil's
 //! share that gets through, and the cos⁴ falloff) darkens the rest as the glass says.
+//!
+//! A point of the ellipse whose ray the glass stops is drawn again (rejection sampling), and
+//! what gets through is weighted by the share of the ellipse that does from that film place
+//! (`GlassParams::shares`, found here once): the expected value is the same, but a sample is
+//! never black for being stopped, so the image is not speckled by the housing (Bernoulli noise
+//! of the share that gets through, 3 to 15 % of samples stopped through Muller's fisheye).
 
 use bytemuck::{Pod, Zeroable};
 use glam::{DVec2, DVec3};
@@ -29,12 +35,20 @@ const METRES_PER_MM: f64 = 1e-3;
 const PUPIL_GRID: usize = 32;
 /// Film places a bin's pupil is found at: its inner edge, middle and outer edge.
 const PUPIL_FILM_POINTS: usize = 3;
+/// How the share of a bin's ellipse that gets through is measured (`passing_share`): rows
+/// across its upper half (the pupil seen from a film point on the +x axis is symmetric in y),
+/// points along each row that find where rays get through, and bisection steps that find
+/// each such run's ends (to 2⁻¹² of the row's length), so the share is good to about 1e-4
+/// (the rows' midpoint rule) where a grid of points would be off by its cells along the edge.
+const SHARE_ROWS: u32 = 32;
+const SHARE_POINTS: u32 = 16;
+const SHARE_BISECTIONS: u32 = 12;
 /// Directions (over half a turn) along which the pupil's edge is found, and the bisection
 /// steps that find it (to 2⁻²⁴ of the search square: far below a grid cell).
 const PUPIL_ANGLES: u32 = 64;
 const PUPIL_BISECTIONS: u32 = 24;
 
-/// A prescription on the film as `wgsl/glass.wgsl` reads it (2,608 bytes; a test checks the
+/// A prescription on the film as `wgsl/glass.wgsl` reads it (4,656 bytes; a test checks the
 /// layout against naga's). Lens frame: mm, z from the front vertex toward the film.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, PartialEq, Pod, Zeroable)]
@@ -57,9 +71,13 @@ pub struct GlassParams {
     /// film point on the +x axis in every channel (centre x, centre y, semi-axes x and y;
     /// zero where no ray gets through).
     pub pupil: [[f32; 4]; PUPIL_BINS as usize],
+    /// Per bin and channel (red, green, blue, 0): the share of its ellipse (by area, as the
+    /// kernel draws points) whose rays get through from its inner edge (`shares[2 * bin]`)
+    /// and its outer edge (`shares[2 * bin + 1]`) on the film, interpolated between.
+    pub shares: [[f32; 4]; 2 * PUPIL_BINS as usize],
 }
 
-const _: () = assert!(size_of::<GlassParams>() == 48 + 16 * (32 + 32 + 64));
+const _: () = assert!(size_of::<GlassParams>() == 48 + 16 * (32 + 32 + 64 + 128));
 
 impl GlassParams {
     /// The glass of `p` with its film `film_mm` behind the rear vertex, on an image of `width`
@@ -120,8 +138,16 @@ impl GlassParams {
             let index = |c: usize| channels[c % channels.len()].surfaces()[k].index as f32;
             out.indices[k] = [index(0), index(1), index(2), 0.0];
         }
-        for (slot, b) in out.pupil.iter_mut().zip(bins) {
-            *slot = b.map(|v| v as f32);
+        for (bin, b) in bins.iter().enumerate() {
+            out.pupil[bin] = b.map(|v| v as f32);
+            for edge in 0..2 {
+                let radius = (bin + edge) as f64 / f64::from(PUPIL_BINS) * reach;
+                let share = |c: usize| {
+                    let lens = &channels[c % channels.len()];
+                    passing_share(lens, DVec3::new(radius, 0.0, film_z), *b) as f32
+                };
+                out.shares[2 * bin + edge] = [share(0), share(1), share(2), 0.0];
+            }
         }
         Ok(out)
     }
@@ -229,6 +255,58 @@ fn exit_pupil(lenses: &[Prescription], film_z: f64, reach: f64) -> Vec<[f64; 4]>
         .collect()
 }
 
+/// The share of `ellipse` (centre x, centre y, semi-axes x and y on the rear vertex's plane;
+/// uniform by area, as the kernel draws its points) whose rays from `film` (on the +x axis)
+/// get through `p`, 0 for an ellipse with no area (no ray gets through from its bin): along
+/// each of [`SHARE_ROWS`] rows over its upper half, [`SHARE_POINTS`] points find the runs of
+/// the chord whose rays get through, and bisection finds each run's ends.
+fn passing_share(p: &Prescription, film: DVec3, ellipse: [f64; 4]) -> f64 {
+    let [cx, cy, a, b] = ellipse;
+    if a <= 0.0 || b <= 0.0 {
+        return 0.0;
+    }
+    let through = |x: f64, y: f64| passes(p, film, DVec3::new(x, y, p.rear_vertex()));
+    // Where along a row, between a point whose ray is stopped and one whose gets through,
+    // the run's end lies.
+    let end = |y: f64, mut stopped: f64, mut passed: f64| {
+        for _ in 0..SHARE_BISECTIONS {
+            let mid = 0.5 * (stopped + passed);
+            if through(mid, y) {
+                passed = mid;
+            } else {
+                stopped = mid;
+            }
+        }
+        0.5 * (stopped + passed)
+    };
+    let mut area = 0.0;
+    for row in 0..SHARE_ROWS {
+        let v = (f64::from(row) + 0.5) / f64::from(SHARE_ROWS);
+        let (y, half) = (cy + v * b, a * (1.0 - v * v).sqrt());
+        let (first, step) = (cx - half, 2.0 * half / f64::from(SHARE_POINTS));
+        // The points, and the chord's ends beyond them (outside the pupil: the ellipse holds it).
+        let at = |i: u32| first + (f64::from(i) + 0.5) * step;
+        let mut start = None;
+        for i in 0..=SHARE_POINTS {
+            let inside = i < SHARE_POINTS && through(at(i), y);
+            match (start, inside) {
+                (None, true) => {
+                    let before = if i == 0 { first } else { at(i - 1) };
+                    start = Some(end(y, before, at(i)));
+                }
+                (Some(from), false) => {
+                    let after = if i == SHARE_POINTS { cx + half } else { at(i) };
+                    area += end(y, after, at(i - 1)) - from;
+                    start = None;
+                }
+                _ => {}
+            }
+        }
+    }
+    // Both halves: each row stands for a strip b / SHARE_ROWS high, mirrored below the axis.
+    (2.0 * area * b / f64::from(SHARE_ROWS) / (std::f64::consts::PI * a * b)).min(1.0)
+}
+
 /// Whether the ray from `film` toward `target` gets out through the glass.
 fn passes(p: &Prescription, film: DVec3, target: DVec3) -> bool {
     let ray = Ray {
@@ -319,6 +397,7 @@ mod tests {
                 ("surfaces", offset_of!(GlassParams, surfaces)),
                 ("indices", offset_of!(GlassParams, indices)),
                 ("pupil", offset_of!(GlassParams, pupil)),
+                ("shares", offset_of!(GlassParams, shares)),
             ],
         );
     }

@@ -261,17 +261,10 @@ pub(crate) fn render(args: &RenderArgs) -> Result<()> {
              follow the fitted chief rays above",
             glass.counts[0]
         );
-        let (spp, adaptive) = args.spp.options(false);
-        if spp < 16 {
+        if args.spp.options(false).0 < 16 {
             eprintln!(
                 "warning: through glass each sample sees one point of the exit pupil: give \
-                 --spp 64 or so for a smooth picture"
-            );
-        } else if adaptive.is_some() {
-            eprintln!(
-                "warning: through glass the pupil's noise is everywhere, and adaptive sampling \
-                 stops some noisy pixels at 4 rays: --spp 16 or more gives less error for the \
-                 time (see the book's Adaptive sampling)"
+                 --spp 16 or more for a smooth picture where it is out of focus"
             );
         }
     }
