@@ -10,7 +10,7 @@ use common::ctx;
 use fisheye_rt::lens::ImageSize;
 use fisheye_rt::lens::glass::{GlassLens, camera_for};
 use fisheye_rt::lens::glass_gpu::{GlassParams, relative_illumination};
-use fisheye_rt::lens::gpu::trace_on_gpu;
+use fisheye_rt::lens::gpu::{pupil_points_on_gpu, trace_on_gpu};
 use fisheye_rt::lens::prescription::{Prescription, Ray};
 use fisheye_rt::scene::{Camera, Material, MeshBuilder, Scene};
 use fisheye_rt::trace::{RenderOptions, render};
@@ -558,4 +558,37 @@ fn red_and_blue_images_separate_as_dispersion_predicts() {
         expected_apart > 0.5 && (apart / expected_apart - 1.0).abs() < 0.1,
         "red and blue {apart:.3} px apart, predicted {expected_apart:.3}"
     );
+}
+
+/// A pixel's points on the exit pupil are stratified and nested as its film samples are: at
+/// 4 × 4 each of the 16 cells of the unit square holds one of its 16 points, at 2 × 2 each
+/// quarter one of its 4, and the first four of the 16 are the 2 × 2 points (so supersampling
+/// goes on from the estimate's samples through the glass), over 500 pixels' hashes; and the
+/// pupil's strata do not pair with the film's the same way in every pixel (the first point's
+/// cell varies).
+#[test]
+fn pupil_points_are_stratified_and_nested() {
+    let points = pupil_points_on_gpu(ctx(), 500).unwrap();
+    let cell = |p: [f32; 2], side: f32| {
+        assert!(p.iter().all(|v| (0.0..1.0).contains(v)), "{p:?}");
+        ((p[0] * side) as usize, (p[1] * side) as usize)
+    };
+    let mut first_cells = std::collections::HashSet::new();
+    for (pixel, p) in points.iter().enumerate() {
+        let mut fine = [[0; 4]; 4];
+        for &q in &p[..16] {
+            let (x, y) = cell(q, 4.0);
+            fine[y][x] += 1;
+        }
+        assert_eq!(fine, [[1; 4]; 4], "pixel {pixel}: {p:?}");
+        let mut quarters = [[0; 2]; 2];
+        for &q in &p[16..] {
+            let (x, y) = cell(q, 2.0);
+            quarters[y][x] += 1;
+        }
+        assert_eq!(quarters, [[1; 2]; 2], "pixel {pixel}: {p:?}");
+        assert_eq!(p[..4], p[16..], "pixel {pixel}: the 2 × 2 points first");
+        first_cells.insert(cell(p[4], 4.0));
+    }
+    assert!(first_cells.len() >= 8, "{first_cells:?}");
 }

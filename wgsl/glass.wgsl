@@ -194,8 +194,40 @@ fn concentric_disc(u: vec2<f32>) -> vec2<f32> {
 
 // Sample `k` of a pixel's `side`² samples on the exit pupil, in [0, 1)²: jittered strata,
 // turned by a shift hashed from the pixel so that its film and pupil strata do not pair the
-// same way in every pixel (the film's are `sample_offset`'s).
+// same way in every pixel (the film's are `sample_offset`'s). Nested as the film's are at
+// 4 × 4 (NESTED_SIDE): the first four are the 2 × 2 samples, each in a quarter of its own,
+// and the other twelve take the twelve cells of the 4 × 4 that those leave, one each, so that
+// supersampling can go on from the estimate's samples through the glass too.
 fn pupil_offset(index: u32, k: u32, side: u32) -> vec2<f32> {
+    if side != NESTED_SIDE || k < 4u {
+        return pupil_strata(index, k, select(side, 2u, side == NESTED_SIDE));
+    }
+    var taken = 0u;
+    for (var j = 0u; j < 4u; j++) {
+        let cell = vec2<u32>(pupil_strata(index, j, 2u) * f32(NESTED_SIDE));
+        taken |= 1u << (cell.y * NESTED_SIDE + cell.x);
+    }
+    let free = NESTED_SIDE * NESTED_SIDE - 4u;
+    let pick = (k - 4u + pcg2d(vec2<u32>(index, 0xfffffffeu)).x) % free;
+    // The pick-th cell the 2 × 2 samples left, in row-major order.
+    var cell = 0u;
+    var seen = 0u;
+    for (var c = 0u; c < NESTED_SIDE * NESTED_SIDE; c++) {
+        if (taken & (1u << c)) == 0u {
+            if seen == pick {
+                cell = c;
+            }
+            seen++;
+        }
+    }
+    let h = pcg2d(vec2<u32>(index, NESTED_SIDE * NESTED_SIDE + k));
+    let jitter = vec2<f32>(h >> vec2<u32>(8u)) * (1.0 / 16777216.0);
+    return (vec2<f32>(f32(cell % NESTED_SIDE), f32(cell / NESTED_SIDE)) + jitter) / f32(NESTED_SIDE);
+}
+
+// Sample `k` of `side`² jittered strata of the pupil, in an order turned by a hash of pixel
+// `index`.
+fn pupil_strata(index: u32, k: u32, side: u32) -> vec2<f32> {
     let count = side * side;
     let shift = pcg2d(vec2<u32>(index, 0xffffffffu)).x % count;
     let stratum = (k + shift) % count;

@@ -21,3 +21,24 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     results[2u * i] = vec4<f32>(out.origin, select(0.0, 1.0, out.passed));
     results[2u * i + 1u] = vec4<f32>(out.direction, 0.0);
 }
+
+// Points on the exit pupil (`pupil_offset`) of pixels 0, 1, ..., PUPIL_PROBE_SAMPLES a pixel
+// (an invocation each): its 16 (4 × 4, nested), then its 2 × 2, in results' xy.
+const PUPIL_PROBE_SAMPLES: u32 = 20u;
+
+@compute @workgroup_size(WORKGROUP_1D)
+fn pupil(@builtin(global_invocation_id) id: vec3<u32>) {
+    let i = id.x;
+    if i >= arrayLength(&results) {
+        return;
+    }
+    let pixel = i / PUPIL_PROBE_SAMPLES;
+    let k = i % PUPIL_PROBE_SAMPLES;
+    var u = vec2<f32>(0.0);
+    if k < 16u {
+        u = pupil_offset(pixel, k, 4u);
+    } else {
+        u = pupil_offset(pixel, k - 16u, 2u);
+    }
+    results[i] = vec4<f32>(u, 0.0, 0.0);
+}

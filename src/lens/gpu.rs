@@ -336,6 +336,42 @@ impl LensPoints {
     }
 }
 
+/// The points on the exit pupil (in [0, 1)², before the concentric map) that pixels 0 to
+/// `pixels` - 1 take through a prescription's glass (`pupil_offset` in `wgsl/glass.wgsl`,
+/// through `wgsl/glass_probe.wgsl`): each pixel's 16 at 4 × 4 samples, then its 4 at 2 × 2.
+/// For tests of their strata.
+pub fn pupil_points_on_gpu(
+    ctx: &crate::gpu::GpuContext,
+    pixels: u32,
+) -> Result<Vec<[[f32; 2]; 20]>> {
+    let count = pixels as usize * 20;
+    let results = ctx.checked("drawing points of the exit pupil", || {
+        let device = &ctx.device;
+        let pipeline = crate::shader::compute_pipeline(device, "glass_probe", "pupil", &[], &[]);
+        let results = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("fisheye.glass_probe.pupil"),
+            size: (count * size_of::<[f32; 4]>()) as u64,
+            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
+            mapped_at_creation: false,
+        });
+        let group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("fisheye.glass_probe.pupil"),
+            layout: &pipeline.get_bind_group_layout(0),
+            entries: &[wgpu::BindGroupEntry {
+                binding: 1,
+                resource: results.as_entire_binding(),
+            }],
+        });
+        crate::gpu::submit_over_elements(ctx, &pipeline, &group, count);
+        results
+    })?;
+    let out = ctx.read_buffer::<[f32; 4]>(&results)?;
+    Ok(out
+        .chunks_exact(20)
+        .map(|pixel| std::array::from_fn(|k| [pixel[k][0], pixel[k][1]]))
+        .collect())
+}
+
 /// Traces `rays` (lens frame, from the film's side) out through `glass` in `channel` (0 red,
 /// 1 green, 2 blue: the C, d and F lines) with the WGSL twin (`wgsl/glass_probe.wgsl`):
 /// where each leaves the front surface, `None` where the glass blocks it. For tests of the

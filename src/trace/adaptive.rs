@@ -80,12 +80,11 @@ pub fn stages_for(samples_per_side: u32, options: Adaptive) -> Vec<Stage> {
 
 /// The samples supersampling takes over from the estimating stage, with `samples_per_side`²
 /// at most: the estimate's 2 × 2 where the estimate runs and the pattern is the nested one
-/// (whose first samples are the 2 × 2 pattern's, `sampling::sample_offset`), else none. None
-/// through a prescription's `glass`: its samples' points on the exit pupil
-/// (`pupil_offset` in `wgsl/glass.wgsl`) are not nested.
-fn reused_samples(samples_per_side: u32, options: Adaptive, glass: bool) -> u32 {
+/// (whose first samples are the 2 × 2 pattern's, `sampling::sample_offset`, as their points
+/// on a prescription's exit pupil are, `pupil_offset` in `wgsl/glass.wgsl`), else none.
+fn reused_samples(samples_per_side: u32, options: Adaptive) -> u32 {
     let estimates = stages_for(samples_per_side, options).contains(&Stage::Estimate);
-    if estimates && samples_per_side == NESTED_SIDE && !glass {
+    if estimates && samples_per_side == NESTED_SIDE {
         ADAPTIVE_ESTIMATE_SIDE.pow(2)
     } else {
         0
@@ -94,11 +93,11 @@ fn reused_samples(samples_per_side: u32, options: Adaptive, glass: bool) -> u32 
 
 /// The rays each pixel listed at `stage` takes, with `samples_per_side`² samples at most: 1 at
 /// the stages that trace centres (`trace_list`), 2 × 2 estimating, all of them but those
-/// `reused` from the estimate ([`reused_samples`]) supersampling.
-fn samples_at(stage: Stage, samples_per_side: u32, reused: u32) -> u32 {
+/// reused from the estimate ([`reused_samples`]) supersampling.
+fn samples_at(stage: Stage, samples_per_side: u32, options: Adaptive) -> u32 {
     match stage {
         Stage::Estimate => ADAPTIVE_ESTIMATE_SIDE.pow(2),
-        Stage::Supersample => samples_per_side.pow(2) - reused,
+        Stage::Supersample => samples_per_side.pow(2) - reused_samples(samples_per_side, options),
         Stage::Coarse | Stage::Midpoints | Stage::Refine | Stage::Truth => 1,
     }
 }
@@ -118,9 +117,9 @@ fn listed_at(stage: Stage) -> usize {
 
 /// How many invocations of `trace_samples` (wgsl/adaptive_samples.wgsl) trace each pixel
 /// listed at `stage` side by side: one for each of its samples, at most a workgroup's, or one.
-fn sample_lanes(stage: Stage, samples_per_side: u32, reused: u32, lanes: SampleLanes) -> u32 {
+fn sample_lanes(stage: Stage, samples_per_side: u32, options: Adaptive, lanes: SampleLanes) -> u32 {
     match lanes {
-        SampleLanes::PerSample => samples_at(stage, samples_per_side, reused).min(WORKGROUP_1D),
+        SampleLanes::PerSample => samples_at(stage, samples_per_side, options).min(WORKGROUP_1D),
         SampleLanes::PerPixel => 1,
     }
 }
@@ -143,8 +142,6 @@ pub struct AdaptiveSpans<'a> {
 pub struct AdaptivePass {
     trace: TracePass,
     options: Adaptive,
-    /// The estimate's samples that supersampling takes over ([`reused_samples`]).
-    reused: u32,
     /// The coarse stage's kernel, `trace_lattice`: a ray through each lattice point.
     lattice: wgpu::ComputePipeline,
     /// The kernels that list the later stages' pixels: classify (the blocks), midpoints,
@@ -292,7 +289,6 @@ impl AdaptivePass {
                 import_swaps.push(("bvh", "bvh_rq"));
             }
             let side = trace.samples_per_side();
-            let reused = reused_samples(side, options, camera.glass.is_some());
             let in_file = |(file, swaps): (&str, &[(&str, &str)]),
                            entry: &str,
                            overrides: &[(&'static str, u32)]| {
@@ -309,8 +305,8 @@ impl AdaptivePass {
             let sampler = |mode: u32, stage: Stage| {
                 let overrides = [
                     ("LIST_MODE", mode),
-                    ("SAMPLE_LANES", sample_lanes(stage, side, reused, lanes)),
-                    ("REUSED", reused),
+                    ("SAMPLE_LANES", sample_lanes(stage, side, options, lanes)),
+                    ("REUSED", reused_samples(side, options)),
                 ];
                 in_file(
                     ("adaptive_samples", &import_swaps),
@@ -345,7 +341,7 @@ impl AdaptivePass {
                 entries: &[storage_entry(0, false), storage_entry(1, false)],
             });
             let args_kernel = |slice: u32, stage: Stage| {
-                let per_group = WORKGROUP_1D / sample_lanes(stage, side, reused, lanes);
+                let per_group = WORKGROUP_1D / sample_lanes(stage, side, options, lanes);
                 let constants = [
                     ("SLICE", f64::from(slice)),
                     ("PER_GROUP", f64::from(per_group)),
@@ -377,7 +373,6 @@ impl AdaptivePass {
             Self {
                 trace,
                 options,
-                reused,
                 lattice,
                 builders,
                 trace_lists,
@@ -647,7 +642,7 @@ impl AdaptivePass {
                 };
                 (
                     stage,
-                    u64::from(pixels) * u64::from(samples_at(stage, side, self.reused)),
+                    u64::from(pixels) * u64::from(samples_at(stage, side, self.options)),
                 )
             })
             .collect())
