@@ -408,25 +408,14 @@ fn every_pixel_first_gives_uniform_sampling_at_each_pixels_rays() {
         "{stages:?}"
     );
     assert_eq!(stages[0].1, u64::from(w * h), "a ray through every pixel");
-    let mut seen = [0; 3];
     for (i, &n) in rays.iter().enumerate() {
         // Every pixel whose centre the lens covers (pixels on the lens's edge whose centre
         // it masks may take the estimate's samples it covers).
         assert!(n >= 1 || !one.valid(i), "pixel {i}: {n} rays");
-        // Pixels the lens covers whole (the others' samples are partly masked).
-        if out.colour[i][3] != 1.0 {
-            continue;
-        }
-        let (wanted, kind) = match n {
-            1 => (&one, 0),
-            5 => (&four, 1),
-            17 => (&sixteen, 2),
-            _ => panic!("pixel {i}: {n} rays"),
-        };
-        assert_eq!(out.colour[i], wanted.colour[i], "pixel {i}, {n} rays");
-        seen[kind] += 1;
     }
-    assert!(seen.iter().all(|&k| k > 0), "1, 5 and 17 rays: {seen:?}");
+    // Pixels the lens covers whole (the others' samples are partly masked).
+    let whole = |i: usize| out.colour[i][3] == 1.0;
+    each_pixel_uniform_at_its_rays(&out, &rays, [&one, &four, &sixteen], whole);
     assert_eq!(out.geometry, one.geometry, "geometry");
     assert_eq!(out.ids, one.ids, "ids");
     let (again, rays_again, _) = adaptive_with(&gpu, &cam, 16, every(0.05), lanes);
@@ -447,6 +436,32 @@ fn every_pixel_first_gives_uniform_sampling_at_each_pixels_rays() {
     assert_eq!(image(), one.colour, "step 0");
     (1..=17).for_each(step);
     assert_eq!(image(), out.colour, "the steps' end");
+}
+
+/// Checks that each pixel of `out` that `judged` names and that took rays of its own (`rays`)
+/// took 1, 1 + 4 or 1 + 16 (the estimate's four reused) and is then `one`'s, `four`'s or
+/// `sixteen`'s (uniform sampling at those rays) bit for bit, and that each of the three occurs.
+fn each_pixel_uniform_at_its_rays(
+    out: &RenderOutput,
+    rays: &[u32],
+    [one, four, sixteen]: [&RenderOutput; 3],
+    judged: impl Fn(usize) -> bool,
+) {
+    let mut seen = [0; 3];
+    for (i, &n) in rays.iter().enumerate() {
+        if n == 0 || !judged(i) {
+            continue;
+        }
+        let (wanted, kind) = match n {
+            1 => (one, 0),
+            5 => (four, 1),
+            17 => (sixteen, 2),
+            _ => panic!("pixel {i}: {n} rays"),
+        };
+        assert_eq!(out.colour[i], wanted.colour[i], "pixel {i}, {n} rays");
+        seen[kind] += 1;
+    }
+    assert!(seen.iter().all(|&k| k > 0), "1, 5 and 17 rays: {seen:?}");
 }
 
 /// Supersampling takes the pixels that demand every sample (`AdaptivePass::read_demanding`)
