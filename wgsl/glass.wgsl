@@ -27,7 +27,8 @@ struct GlassParams {
 
 // The most points of the ellipse a sample draws before it counts as stopped (a point whose
 // ray the glass stops is drawn again): where a share p of the ellipse gets through, all of
-// them stop with chance (1 - p)^GLASS_TRIES, under 3e-4 for p ≥ 0.4.
+// them stop with chance (1 - p)^GLASS_TRIES (under 3e-4 for p ≥ 0.4), for which the weight
+// of the rays that get through makes up.
 const GLASS_TRIES: u32 = 16u;
 
 @group(0) @binding(6) var<uniform> glass: GlassParams;
@@ -148,6 +149,17 @@ fn glass_sample(offset: vec2<f32>, u: vec2<f32>, channel: u32) -> GlassSample {
         return none;
     }
     let share = mix(glass.shares[2u * bin][channel], glass.shares[2u * bin + 1u][channel], fract(place));
+    // The chance that some point of GLASS_TRIES gets through: a ray's weight is divided by it,
+    // so that the sample's expected weight is the ellipse's share times its mean over the
+    // points that get through, with nothing lost where every try is stopped.
+    var missed = 1.0;
+    for (var attempt = 0u; attempt < GLASS_TRIES; attempt++) {
+        missed *= 1.0 - share;
+    }
+    let found = 1.0 - missed;
+    if found <= 0.0 {
+        return none;
+    }
     // The bin's ellipse is for a film point on the +x axis: turn it to this one's.
     let c = select(vec2<f32>(1.0, 0.0), xy / r, r > 0.0);
     let film = vec3<f32>(xy, glass.film.x);
@@ -158,11 +170,11 @@ fn glass_sample(offset: vec2<f32>, u: vec2<f32>, channel: u32) -> GlassSample {
         let d = normalize(target_point - film);
         let out = glass_trace(film, d, channel);
         if out.passed {
-            // cos⁴θ · A / z² over the centre's mean, times the share of A that gets through:
-            // the sample's share of the irradiance.
+            // cos⁴θ · A / z² over the centre's mean, times the share of A that gets through
+            // (over the chance that a point was found): the sample's share of the irradiance.
             let z = glass.film.x - glass.film.y;
             let cos2 = d.z * d.z;
-            let weight = cos2 * cos2 * PI * e.z * e.w / (z * z) * share * glass.scale[channel];
+            let weight = cos2 * cos2 * PI * e.z * e.w / (z * z) * (share / found) * glass.scale[channel];
             let m = glass.scale.w;
             return GlassSample(
                 vec3<f32>(-out.origin.x, out.origin.y, -out.origin.z) * m,
