@@ -22,8 +22,8 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     results[2u * i + 1u] = vec4<f32>(out.direction, 0.0);
 }
 
-// Points on the exit pupil (`pupil_offset`) of pixels 0, 1, ..., PUPIL_PROBE_SAMPLES a pixel
-// (an invocation each): its 16 (4 × 4, nested), then its 2 × 2, in results' xy.
+// Points on the exit pupil (`pupil_offset`) of pixels 0, 1, ..., PUPIL_PROBE_SAMPLES of them
+// a pixel, an invocation each: its 16 (4 × 4, nested), then its 2 × 2, in results' xy.
 const PUPIL_PROBE_SAMPLES: u32 = 20u;
 
 @compute @workgroup_size(WORKGROUP_1D)

@@ -73,9 +73,9 @@ fn sample_radiance(pixel: vec2<u32>, index: u32, k: u32, side: u32) -> vec4<f32>
 }
 
 // Film sample `k` of pixel `pixel`'s `side`² (`sample_offset`, toward `pupil_offset`'s point
-// of the exit pupil) through the glass: its ray's radiance times its weight, zero where the
-// glass blocks it, so that the mean over a pixel's samples darkens with vignetting and
-// spreads an out-of-focus point as the glass does. Where the glass disperses, red, green and
+// of the exit pupil) through the glass: its ray's radiance times its weight (`glass_sample`:
+// zero only where the glass lets no ray through from there), so that the mean over a pixel's
+// samples darkens with vignetting and spreads an out-of-focus point as the glass does. Where the glass disperses, red, green and
 // blue are traced apart, each giving its channel.
 fn glass_radiance(pixel: vec2<u32>, index: u32, k: u32, side: u32) -> vec3<f32> {
     let centre = 0.5 * vec2<f32>(f32(lens.width), f32(lens.height));
