@@ -160,7 +160,8 @@ pub struct CompareReport {
     pub pose: String,
     /// Rays per pixel of the reference.
     pub reference_spp: u32,
-    /// Timed frames per setup (medians are reported), after a quarter of a second of untimed ones.
+    /// Timed frames per setup (medians are reported), in rounds of a frame of each setup of
+    /// a lens (see [`compare`]), after a quarter of a second of untimed rounds.
     pub frames: usize,
     /// How errors are measured.
     pub method_note: &'static str,
@@ -179,11 +180,12 @@ const COMPARE_NOTE: &str = "The reference is direct ray tracing with many strati
     0 to 1, at 67 pixels per degree). Mask agreement is the fraction of all pixels whose lens \
     mask matches the reference's. Errors within 5% count as equal on the Pareto front.";
 
-/// Untimed frames before each setup's timed ones: at least one (lavapipe compiles a pipeline
-/// at its first dispatch), and more until they fill this many milliseconds of wall time. A GPU
-/// lowers its clocks while idle, as it is while the next setup's pipelines compile, and takes
-/// a while under load to raise them again: on an H200 after one untimed frame, 4 rays a pixel
-/// timed slower than 16 and neighbouring setups' medians moved tenfold.
+/// Untimed rounds (a frame of each setup of a lens) before the timed ones: at least one
+/// (lavapipe compiles a pipeline at its first dispatch), and more until they fill this many
+/// milliseconds of wall time. A GPU lowers its clocks while idle, as it is while pipelines
+/// compile, and takes a while under load to raise them again: on an H200 after one untimed
+/// frame a setup, 4 rays a pixel timed slower than 16 and neighbouring setups' medians moved
+/// tenfold.
 const WARM_UP: Duration = Duration::from_millis(250);
 
 /// Runs `frame` once, then again until `least` has passed since the first began; returns how
@@ -198,9 +200,23 @@ fn warm_up(least: Duration, mut frame: impl FnMut() -> Result<()>) -> Result<usi
     Ok(frames)
 }
 
+/// The setups (of `n`) in the order round `r` times them: each once, from setup `r` on
+/// (wrapping round), so that any `n` rounds in a row time each setup once in every place.
+fn round_order(r: usize, n: usize) -> impl Iterator<Item = usize> {
+    (0..n).map(move |k| (r + k) % n)
+}
+
 /// Times `frames` frames of every setup at `pose` on every lens, measures each image's error
 /// against direct ray tracing at `reference_spp` rays per pixel, and writes the reference's
 /// image and each setup's error map into `out`.
+///
+/// A lens's setups are made first (each renders a frame, which compiles its pipelines), then
+/// timed in rounds, a frame of each in turn (`round_order`): a machine whose speed drifts
+/// while it runs slows every setup alike, so their ratios hold. Timed one setup after
+/// another, they did not: lavapipe's speed moves by up to 1.5× from one minute to the next,
+/// and four runs in a row of one small `compare` put its least ratio between 1.42× slower and
+/// 1.50× faster (the book's Speed against error). Every setup of a lens is held at once:
+/// their memory adds up.
 pub fn compare(
     study: &Study<'_>,
     pose: &Camera,
@@ -251,28 +267,44 @@ pub fn compare(
         )?;
         done += 1;
         let first = entries.len();
+        let mut renderers = Vec::with_capacity(setups.len());
         for &setup in setups {
             let what = format!("{} {}", lens.name, setup.label());
-            let renderer = study.renderer(lens, setup)?;
             progress(Progress {
                 done,
                 total,
                 what: &what,
             });
-            warm_up(WARM_UP, || {
-                renderer.frame(study.ctx, study.scenes, pose).map(drop)
-            })?;
+            let renderer = study.renderer(lens, setup)?;
+            renderer.frame(study.ctx, study.scenes, pose)?;
+            renderers.push(renderer);
             done += 1;
-            let mut times = Vec::with_capacity(frames);
-            for _ in 0..frames {
-                progress(Progress {
-                    done,
-                    total,
-                    what: &what,
-                });
-                times.push(renderer.frame(study.ctx, study.scenes, pose)?);
-                done += 1;
+        }
+        // Round `r`: a frame of each setup in turn (`round_order`), as (setup, its time).
+        let round = |r: usize| -> Result<Vec<(usize, FrameTime)>> {
+            round_order(r, renderers.len())
+                .map(|i| Ok((i, renderers[i].frame(study.ctx, study.scenes, pose)?)))
+                .collect()
+        };
+        let mut rounds = 0;
+        warm_up(WARM_UP, || {
+            rounds += 1;
+            round(rounds).map(drop)
+        })?;
+        let mut times = vec![Vec::with_capacity(frames); setups.len()];
+        for r in 0..frames {
+            let what = format!("{} round {} of {frames}", lens.name, r + 1);
+            progress(Progress {
+                done,
+                total,
+                what: &what,
+            });
+            for (i, time) in round(r)? {
+                times[i].push(time);
             }
+            done += setups.len();
+        }
+        for ((&setup, renderer), times) in setups.iter().zip(&renderers).zip(times) {
             let colour = renderer.colour(study.ctx)?;
             let covered = colour.iter().filter(|c| c[3] > 0.0).count().max(1) as f64;
             let rays_per_pixel = match renderer.rays_per_pixel(study.ctx)? {
@@ -507,7 +539,7 @@ impl CompareReport {
     /// The Markdown table: a row per lens and setup, then the verdicts.
     pub fn markdown(&self) -> String {
         let mut md = format!(
-            "# fisheye compare: {} ({} triangles), {}, {}\n\n{}\n{} Reference: {} rays per pixel. Times are medians of {} frames, after {} ms of untimed ones.\n\n",
+            "# fisheye compare: {} ({} triangles), {}, {}\n\n{}\n{} Reference: {} rays per pixel. Times are medians of {} frames a setup, timed in rounds (a frame of each setup in turn, so that a drift in the machine's speed slows all alike), after {} ms of untimed rounds.\n\n",
             self.run.scene,
             self.run.triangles,
             self.run.size,

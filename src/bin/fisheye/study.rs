@@ -35,8 +35,8 @@ pub(crate) struct BenchArgs {
 pub(crate) struct CompareArgs {
     #[command(flatten)]
     pub(crate) study: StudyArgs,
-    /// Timed frames per setup at the pose (the median is reported), after a quarter of a
-    /// second of untimed ones.
+    /// Timed frames per setup at the pose (the median is reported), in rounds of a frame of
+    /// each setup in turn, after a quarter of a second of untimed rounds.
     #[arg(long, default_value_t = 5)]
     pub(crate) frames: usize,
     /// Rays per pixel of the reference (direct tracing, the same box filter as the RT

@@ -21,6 +21,27 @@ fn the_warm_up_runs_frames_until_its_time_has_passed() {
     assert!(failed.is_err() && calls == 1);
 }
 
+/// Each round times every setup once; any n rounds in a row put each setup in every place
+/// of the round once (a Latin square), so no setup is always timed first or last.
+#[test]
+fn rounds_time_every_setup_once_in_turning_order() {
+    for n in 1..7 {
+        for start in [0, 3, 10] {
+            let mut places = vec![vec![0; n]; n];
+            for r in start..start + n {
+                let order: Vec<usize> = round_order(r, n).collect();
+                let mut sorted = order.clone();
+                sorted.sort_unstable();
+                assert_eq!(sorted, (0..n).collect::<Vec<_>>(), "round {r} of {n}");
+                for (place, &setup) in order.iter().enumerate() {
+                    places[setup][place] += 1;
+                }
+            }
+            assert!(places.iter().flatten().all(|&k| k == 1), "{n}: {places:?}");
+        }
+    }
+}
+
 /// A setup (`rt@Nspp`, `cube-rt@SIZE` or `cube-forward@SIZE`) with a time (GPU, else wall),
 /// an MSE and a ꟻLIP; RT traces a thousand pixels, and a cube's faces have SIZE² texels.
 fn entry(setup: &str, gpu_ms: Option<f64>, wall_ms: f64, mse: f64) -> CompareEntry {
