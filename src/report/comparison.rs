@@ -286,11 +286,13 @@ pub fn compare(
                 .map(|i| Ok((i, renderers[i].frame(study.ctx, study.scenes, pose)?)))
                 .collect()
         };
-        let mut rounds = 0;
-        warm_up(WARM_UP, || {
-            rounds += 1;
-            round(rounds).map(drop)
-        })?;
+        if !renderers.is_empty() {
+            let mut rounds = 0;
+            warm_up(WARM_UP, || {
+                rounds += 1;
+                round(rounds).map(drop)
+            })?;
+        }
         let mut times = vec![Vec::with_capacity(frames); setups.len()];
         for r in 0..frames {
             let what = format!("{} round {} of {frames}", lens.name, r + 1);
