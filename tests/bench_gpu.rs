@@ -189,6 +189,15 @@ fn compare_measures_both_families_against_the_many_ray_reference() {
     let out = std::env::temp_dir().join("fisheye-test-compare");
     let _ = std::fs::remove_dir_all(&out);
     let study = study_on(&scene, &scenes, &lenses, &all);
+    // No frame to take a median of is refused before any work, as `bench` refuses it.
+    for refused in [
+        report::compare(&study, &scene.camera, 0, 16, &out, &mut |_| {}).err(),
+        report::bench(&study, PathKind::Walk, 0, 1, &mut |_| {}).err(),
+    ] {
+        let message = refused.expect("0 frames are refused").to_string();
+        assert!(message.contains("frames 0"), "{message}");
+    }
+    assert!(!out.exists(), "a refused compare wrote {}", out.display());
     // A reference of 16 rays: the same rays as the 16-ray setup's, so that one has no error.
     let report = report::compare(&study, &scene.camera, 1, 16, &out, &mut |_| {}).unwrap();
     let entry = |label: &str| report.entries.iter().find(|e| e.setup == label).unwrap();

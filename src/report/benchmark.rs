@@ -77,7 +77,7 @@ const BENCH_NOTE: &str = "Per frame: the pose is set, all passes are recorded in
     once per scene (the lights do not move) and are not in the frame time.";
 
 /// Runs `frames` frames of every setup on every lens along `path`, after `warmup` untimed
-/// frames each.
+/// frames each (`frames` 0 is an error).
 pub fn bench(
     study: &Study<'_>,
     path: PathKind,
@@ -86,7 +86,9 @@ pub fn bench(
     progress: &mut dyn FnMut(Progress<'_>),
 ) -> Result<BenchReport> {
     if frames == 0 {
-        return Err(Error::Scene("a benchmark needs at least one frame".into()));
+        return Err(Error::Option(
+            "frames 0: a median needs at least one timed frame".into(),
+        ));
     }
     let poses = camera_path(study.scene, path, frames)?;
     let (setups, mut skipped) = study.runnable();

@@ -12,7 +12,7 @@ use serde::Serialize;
 use super::{Progress, Run, Study, file_stem, machine_lines, sig, speed_ratio, write_report};
 use crate::compare::{Envelope, ImageError, error_map, flip_error, image_error, pareto_front};
 use crate::cube::CubeMethod;
-use crate::error::Result;
+use crate::error::{Error, Result};
 use crate::gpu::median;
 use crate::renderer::Method;
 use crate::renderer::{FrameTime, Setup};
@@ -216,7 +216,7 @@ fn round_order(r: usize, n: usize) -> impl Iterator<Item = usize> {
 /// another, they did not: lavapipe's speed moves by up to 1.5× from one minute to the next,
 /// and four runs in a row of one small `compare` put its least ratio between 1.42× slower and
 /// 1.50× faster (the book's Speed against error). Every setup of a lens is held at once:
-/// their memory adds up.
+/// their memory adds up. `frames` 0 is an error.
 pub fn compare(
     study: &Study<'_>,
     pose: &Camera,
@@ -225,8 +225,12 @@ pub fn compare(
     out: &Path,
     progress: &mut dyn FnMut(Progress<'_>),
 ) -> Result<CompareReport> {
+    if frames == 0 {
+        return Err(Error::Option(
+            "frames 0: a median needs at least one timed frame".into(),
+        ));
+    }
     let (setups, mut skipped) = study.runnable();
-    let frames = frames.max(1);
     // Each lens's setups, less those it cannot run (listed with why).
     let per_lens: Vec<Vec<Setup>> = study
         .lenses

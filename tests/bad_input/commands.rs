@@ -168,6 +168,16 @@ fn every_error_says_each_clause_once() {
             "/sys/fisheye-compare",
         ),
         (
+            vec!["bench", "--frames", "0"],
+            vec![],
+            "at least one timed frame",
+        ),
+        (
+            vec!["compare", "--frames", "0"],
+            vec![],
+            "at least one timed frame",
+        ),
+        (
             vec!["render"],
             vec![("FISHEYE_INJECT_FAULT", "device-lost")],
             "device was lost",

@@ -19,7 +19,7 @@ pub(crate) struct BenchArgs {
     #[command(flatten)]
     pub(crate) study: StudyArgs,
     /// Timed frames per setup along the path.
-    #[arg(long, default_value_t = 60)]
+    #[arg(long, default_value_t = 60, value_parser = at_least_one)]
     pub(crate) frames: usize,
     /// Untimed frames first, per setup.
     #[arg(long, default_value_t = 3)]
@@ -37,13 +37,22 @@ pub(crate) struct CompareArgs {
     pub(crate) study: StudyArgs,
     /// Timed frames per setup at the pose (the median is reported), in rounds of a frame of
     /// each setup in turn, after a quarter of a second of untimed rounds.
-    #[arg(long, default_value_t = 5)]
+    #[arg(long, default_value_t = 5, value_parser = at_least_one)]
     pub(crate) frames: usize,
     /// Rays per pixel of the reference (direct tracing, the same box filter as the RT
     /// setups; a square up to 256): 16 times the most the setups use leaves it about a
     /// sixteenth of their error.
     #[arg(long, default_value_t = 256)]
     pub(crate) reference_spp: u32,
+}
+
+/// Reads `--frames`: a whole number of at least one (a median of no frames is no time).
+fn at_least_one(text: &str) -> std::result::Result<usize, String> {
+    match text.parse::<usize>() {
+        Ok(0) => Err("a median needs at least one timed frame".into()),
+        Ok(n) => Ok(n),
+        Err(_) => Err("not a whole number of frames".into()),
+    }
 }
 
 /// What `bench` and `compare` set up from their shared arguments.
