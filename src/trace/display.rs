@@ -55,16 +55,29 @@ pub enum Tone {
 }
 
 impl Tone {
-    /// The curve at `x` (linear, ≥ 0), in [0, 1].
+    /// The curve at `x` (linear, ≥ 0), in [0, 1]; infinite `x` is 1.
     pub fn map(self, x: f32) -> f32 {
         match self {
             Tone::Clamp => x.clamp(0.0, 1.0),
+            // Clipped from x ≈ 7.24 on: returned before the quotient, whose terms overflow to
+            // ∞ / ∞ (not a number) from x ≈ 1e19 on.
+            Tone::Aces if x >= ACES_CLIPPED => 1.0,
             Tone::Aces => {
                 let x = x.max(0.0);
                 (x * (2.51 * x + 0.03) / (x * (2.43 * x + 0.59) + 0.14)).clamp(0.0, 1.0)
             }
         }
     }
+}
+
+/// A value from which [`Tone::Aces`] is 1: past the root of 0.08x² − 0.56x − 0.14 (≈ 7.24),
+/// where the curve reaches 1.
+const ACES_CLIPPED: f32 = 8.0;
+
+/// `x` times `scale` (`2^exposure`), where no light stays none at any exposure: 0 × ∞ (an
+/// exposure past 2^128, f32's largest) would be not a number.
+fn exposed(x: f32, scale: f32) -> f32 {
+    if x > 0.0 { x * scale } else { 0.0 }
 }
 
 /// How radiance is shown: scaled by `2^exposure` (stops, EV), then the tone curve.
@@ -79,7 +92,7 @@ pub struct Display {
 impl Display {
     /// A linear radiance value as displayed, in [0, 1] before sRGB encoding.
     pub fn map(&self, x: f32) -> f32 {
-        self.tone.map(x * self.exposure.exp2())
+        self.tone.map(exposed(x, self.exposure.exp2()))
     }
 }
 
@@ -216,9 +229,9 @@ fn write_exr<T: exr::prelude::IntoSample>(
     exr::prelude::write_rgba_file(path, width, size.height as usize, |x, y| {
         let c = colour[y * width + x];
         (
-            sample(c[0] * scale),
-            sample(c[1] * scale),
-            sample(c[2] * scale),
+            sample(exposed(c[0], scale)),
+            sample(exposed(c[1], scale)),
+            sample(exposed(c[2], scale)),
             sample(c[3]),
         )
     })
@@ -404,6 +417,34 @@ mod tests {
             tone: Tone::Clamp,
         };
         assert_eq!(minus_two.map(2.0), 0.5);
+        // The clipped part of ACES is 1 however bright (the quotient alone is ∞ / ∞ from
+        // about 1e19 on), and the curves the same on either side of where it is cut short.
+        let quotient = |x: f32| x * (2.51 * x + 0.03) / (x * (2.43 * x + 0.59) + 0.14);
+        assert!(quotient(1e20).is_nan());
+        for x in [7.9f32, 8.0, 8.1, 1e20, f32::MAX, f32::INFINITY] {
+            assert_eq!(Tone::Aces.map(x), 1.0, "{x}");
+        }
+    }
+
+    /// Exposures past f32's range (2^128 is ∞, 2^-150 is 0) show light as white and none as
+    /// black, not as not-a-number (which encoded black: `render --exposure 1e9` was black).
+    #[test]
+    fn exposures_past_f32s_range_saturate() {
+        for tone in [Tone::Aces, Tone::Clamp] {
+            let bright = Display {
+                exposure: 1e9,
+                tone,
+            };
+            assert_eq!(
+                (bright.map(1e-30), bright.map(0.5), bright.map(0.0)),
+                (1.0, 1.0, 0.0)
+            );
+            let dark = Display {
+                exposure: -1e9,
+                tone,
+            };
+            assert_eq!((dark.map(1e30), dark.map(0.0)), (0.0, 0.0));
+        }
     }
 
     #[test]
