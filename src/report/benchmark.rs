@@ -6,9 +6,11 @@ use std::path::Path;
 
 use serde::Serialize;
 
-use super::{Progress, Run, Study, file_stem, is_pinhole, machine_lines, sig, write_report};
+use super::{
+    Progress, Run, Study, check_frames, file_stem, is_pinhole, machine_lines, sig, write_report,
+};
 use crate::bench::{FrameStats, Memory, PathKind, camera_path};
-use crate::error::{Error, Result};
+use crate::error::Result;
 use crate::gpu::median;
 use crate::plot;
 use crate::renderer::{FrameTime, Pass};
@@ -85,11 +87,7 @@ pub fn bench(
     warmup: usize,
     progress: &mut dyn FnMut(Progress<'_>),
 ) -> Result<BenchReport> {
-    if frames == 0 {
-        return Err(Error::Option(
-            "frames 0: a median needs at least one timed frame".into(),
-        ));
-    }
+    check_frames(frames)?;
     let poses = camera_path(study.scene, path, frames)?;
     let (setups, mut skipped) = study.runnable();
     let mut runs = Vec::new();

@@ -9,10 +9,12 @@ use std::time::{Duration, Instant};
 
 use serde::Serialize;
 
-use super::{Progress, Run, Study, file_stem, machine_lines, sig, speed_ratio, write_report};
+use super::{
+    Progress, Run, Study, check_frames, file_stem, machine_lines, sig, speed_ratio, write_report,
+};
 use crate::compare::{Envelope, ImageError, error_map, flip_error, image_error, pareto_front};
 use crate::cube::CubeMethod;
-use crate::error::{Error, Result};
+use crate::error::Result;
 use crate::gpu::median;
 use crate::renderer::Method;
 use crate::renderer::{FrameTime, Setup};
@@ -225,11 +227,7 @@ pub fn compare(
     out: &Path,
     progress: &mut dyn FnMut(Progress<'_>),
 ) -> Result<CompareReport> {
-    if frames == 0 {
-        return Err(Error::Option(
-            "frames 0: a median needs at least one timed frame".into(),
-        ));
-    }
+    check_frames(frames)?;
     let (setups, mut skipped) = study.runnable();
     // Each lens's setups, less those it cannot run (listed with why).
     let per_lens: Vec<Vec<Setup>> = study

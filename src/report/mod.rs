@@ -14,7 +14,7 @@ pub use comparison::{CompareEntry, CompareReport, Verdict, compare};
 
 use crate::bench::Machine;
 pub use crate::bench::PathKind;
-use crate::error::Result;
+use crate::error::{Error, Result};
 use crate::gpu::GpuContext;
 use crate::lens::LensCamera;
 use crate::plot;
@@ -164,6 +164,17 @@ fn write_report<'a>(
         draw(lens)?;
     }
     Ok(None)
+}
+
+/// Refuses `frames` 0 for [`bench`] and [`compare`]: their times are medians of the frames
+/// timed.
+fn check_frames(frames: usize) -> Result<()> {
+    if frames == 0 {
+        return Err(Error::Option(
+            "frames 0: a median needs at least one timed frame".into(),
+        ));
+    }
+    Ok(())
 }
 
 pub(crate) fn machine_lines(m: &Machine) -> String {
