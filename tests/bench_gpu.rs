@@ -255,6 +255,28 @@ fn compare_measures_both_families_against_the_many_ray_reference() {
             assert_eq!(l.fewer, Some(entry(&l.cube).samples / (64.0 * 48.0)));
         }
     }
+    // The ceiling: the fastest cube map's frame over RT's fastest, which no least exceeds.
+    assert_eq!(report.ceilings.len(), 1);
+    let ceiling = &report.ceilings[0];
+    let fastest = |cube: bool| {
+        report
+            .entries
+            .iter()
+            .filter(|e| e.cube_size.is_some() == cube)
+            .map(|e| e.ms())
+            .fold(f64::INFINITY, f64::min)
+    };
+    assert_eq!(
+        (ceiling.cube_ms, ceiling.rt_ms),
+        (fastest(true), fastest(false))
+    );
+    assert_eq!(entry(&ceiling.cube).ms(), ceiling.cube_ms);
+    for v in &report.verdicts {
+        assert!(
+            v.least_speedup.unwrap() <= ceiling.ratio,
+            "{v:?} {ceiling:?}"
+        );
+    }
     // The reference, error maps and both plots were written.
     assert_eq!(report.write(&out).unwrap(), None, "plots need a font");
     for file in [

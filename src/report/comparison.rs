@@ -152,6 +152,27 @@ pub struct RayLevel {
     pub fewer: Option<f64>,
 }
 
+/// The most direct RT can be faster than the cube maps at the error of their fastest setup,
+/// whatever its sampling reaches there: that setup's time over RT's fastest frame, at any
+/// error. A verdict's least speed-up cannot exceed it (the cube maps' fastest setup is the
+/// first level, and RT needs at least its fastest frame's time for any error), so where it
+/// is under 4 only cheaper RT frames, not better sampling, can meet the goal.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Ceiling {
+    /// Lens name.
+    pub lens: String,
+    /// The cube maps' fastest setup.
+    pub cube: String,
+    /// Its ms per frame.
+    pub cube_ms: f64,
+    /// Direct RT's fastest setup.
+    pub rt: String,
+    /// Its ms per frame.
+    pub rt_ms: f64,
+    /// `cube_ms / rt_ms`.
+    pub ratio: f64,
+}
+
 /// What `fisheye compare` measured.
 #[derive(Serialize)]
 pub struct CompareReport {
@@ -171,6 +192,8 @@ pub struct CompareReport {
     pub entries: Vec<CompareEntry>,
     /// Per lens and metric, RT against the cube maps.
     pub verdicts: Vec<Verdict>,
+    /// Per lens with both families, the most RT can be faster at the coarsest cube's error.
+    pub ceilings: Vec<Ceiling>,
     /// Setups the adapter could not run, and why.
     pub skipped: Vec<String>,
 }
@@ -251,6 +274,7 @@ pub fn compare(
     let mut done = 0;
     let mut entries = Vec::new();
     let mut verdicts = Vec::new();
+    let mut ceilings = Vec::new();
     for (lens, setups) in study.lenses.iter().zip(&per_lens) {
         let size = lens.camera.size;
         let stem = file_stem(&lens.name);
@@ -357,6 +381,7 @@ pub fn compare(
             }
             verdicts.extend(verdict(&lens.name, lens_entries, metric));
         }
+        ceilings.extend(ceiling(&lens.name, lens_entries));
     }
     progress(Progress {
         done: total,
@@ -375,6 +400,7 @@ pub fn compare(
         method_note: COMPARE_NOTE,
         entries,
         verdicts,
+        ceilings,
         skipped,
     })
 }
@@ -500,6 +526,26 @@ fn verdict(lens: &str, entries: &[CompareEntry], metric: Metric) -> Option<Verdi
     })
 }
 
+/// The cube maps' fastest frame over direct RT's on one lens (see [`Ceiling`]); `None`
+/// without both families.
+fn ceiling(lens: &str, entries: &[CompareEntry]) -> Option<Ceiling> {
+    let fastest = |family: fn(&CompareEntry) -> bool| {
+        entries
+            .iter()
+            .filter(|e| family(e))
+            .min_by(|a, b| a.ms().total_cmp(&b.ms()))
+    };
+    let (cube, rt) = (fastest(is_cube)?, fastest(is_rt)?);
+    Some(Ceiling {
+        lens: lens.to_string(),
+        cube: cube.setup.clone(),
+        cube_ms: cube.ms(),
+        rt: rt.setup.clone(),
+        rt_ms: rt.ms(),
+        ratio: cube.ms() / rt.ms(),
+    })
+}
+
 /// A count of rays or texels to three significant figures, in thousands (k) or millions (M)
 /// above a thousand.
 fn count(n: f64) -> String {
@@ -613,6 +659,26 @@ impl CompareReport {
                 format!("least: {}", speed_ratio(s))
             });
             let _ = writeln!(md, "- {}, {metric} ({least}): {}", v.lens, parts.join("; "));
+        }
+        if !self.ceilings.is_empty() {
+            md.push_str(
+                "\nThe most RT can be faster at the error of the cube maps' fastest setup, \
+                 whatever its sampling reaches there: that setup's time over RT's fastest frame \
+                 (at any error). No least speed-up above can exceed it; under 4, only cheaper RT \
+                 frames can meet the goal:\n\n",
+            );
+        }
+        for c in &self.ceilings {
+            let _ = writeln!(
+                md,
+                "- {}: {} ({} ms) over {} ({} ms): at most {}",
+                c.lens,
+                c.cube,
+                sig(c.cube_ms),
+                c.rt,
+                sig(c.rt_ms),
+                speed_ratio(c.ratio)
+            );
         }
         if self.verdicts.iter().any(|v| !v.rays.is_empty()) {
             md.push_str(

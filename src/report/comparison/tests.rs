@@ -162,6 +162,77 @@ fn the_verdict_compares_the_families_at_the_cubes_errors() {
     assert!(verdict("lens", &walls[..1], Metric::Mse).is_none());
 }
 
+/// The ceiling is the cube maps' fastest frame over RT's: on `family`, 5 ms of the 64-texel
+/// cube over RT's 1 ray's 10 ms, which reaches that cube's error, so the least speed-up is
+/// the ceiling. Where RT's fastest frame misses the coarsest cube's error it needs more time
+/// there, and the least falls below the ceiling; over families of any times and errors it
+/// never exceeds it. No ceiling without both families.
+#[test]
+fn no_least_speed_up_exceeds_the_ceiling() {
+    let c = ceiling("lens", &family()).unwrap();
+    assert_eq!(
+        (c.cube.as_str(), c.cube_ms, c.rt.as_str(), c.rt_ms, c.ratio),
+        ("cube-rt@64", 5.0, "rt@1spp", 10.0, 0.5)
+    );
+    assert_eq!(
+        verdict("lens", &family(), Metric::Mse)
+            .unwrap()
+            .least_speedup,
+        Some(0.5)
+    );
+
+    let mut coarse = family();
+    coarse[0].error.mse = 1e-2;
+    let v = verdict("lens", &coarse, Metric::Mse).unwrap();
+    assert!(v.least_speedup.unwrap() < ceiling("lens", &coarse).unwrap().ratio);
+
+    // A small linear congruential generator: values in [0, 1).
+    let mut state = 12345u64;
+    let mut next = move || {
+        state = state
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        (state >> 11) as f64 / (1u64 << 53) as f64
+    };
+    let names = [
+        "rt@1spp",
+        "rt@4spp",
+        "rt@16spp",
+        "cube-rt@64",
+        "cube-rt@128",
+        "cube-forward@3",
+    ];
+    let mut compared = 0;
+    for _ in 0..500 {
+        let entries: Vec<CompareEntry> = names
+            .iter()
+            .map(|name| {
+                entry(
+                    name,
+                    Some(1.0 + 99.0 * next()),
+                    1.0,
+                    10f64.powf(-5.0 * next()),
+                )
+            })
+            .collect();
+        let ceiling = ceiling("lens", &entries).unwrap();
+        for metric in [Metric::Mse, Metric::Flip] {
+            if let Some(least) = verdict("lens", &entries, metric).unwrap().least_speedup {
+                assert!(
+                    least <= ceiling.ratio * (1.0 + 1e-12),
+                    "{least} > {ceiling:?}"
+                );
+                compared += 1;
+            }
+        }
+    }
+    assert!(compared > 500, "{compared} verdicts with a least speed-up");
+
+    let rt_only: Vec<CompareEntry> = family().into_iter().take(3).collect();
+    assert!(ceiling("lens", &rt_only).is_none());
+    assert!(ceiling("lens", &family()[3..]).is_none());
+}
+
 /// The report says each level, what only one family reaches, and the least speed-up.
 #[test]
 fn the_markdown_states_every_level() {
@@ -186,6 +257,7 @@ fn the_markdown_states_every_level() {
         method_note: COMPARE_NOTE,
         entries,
         verdicts,
+        ceilings: vec![ceiling("lens", &family()).unwrap()],
         skipped: Vec::new(),
     };
     let md = report.markdown();
@@ -201,5 +273,9 @@ fn the_markdown_states_every_level() {
         "{md}"
     );
     assert_eq!(per_sample_ns(1.0, 0.0), "—");
+    assert!(
+        md.contains("- lens: cube-rt@64 (5.00 ms) over rt@1spp (10.0 ms): at most 2.00x slower"),
+        "{md}"
+    );
     assert!(md.contains("- lens, MSE (least: 4.10x fewer): at cube-rt@64's MSE 8.00e-3 (4.10 k texels) RT needs 1.00 k rays: 4.10x fewer; at cube-rt@128's MSE 2.00e-3 (16.4 k texels) RT needs 2.00 k rays: 8.19x fewer"), "{md}");
 }
