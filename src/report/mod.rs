@@ -10,7 +10,7 @@ use std::path::Path;
 use serde::Serialize;
 
 pub use benchmark::{BenchEntry, BenchReport, bench};
-pub use comparison::{CompareEntry, CompareReport, Verdict, compare};
+pub use comparison::{Ceiling, CompareEntry, CompareReport, Level, RayLevel, Verdict, compare};
 
 use crate::bench::Machine;
 pub use crate::bench::PathKind;

@@ -5,10 +5,8 @@
 
 use std::path::Path;
 
-use super::{
-    CompareEntry, CompareReport, Cost, Metric, envelope, is_cube, is_rt, is_traced_cube,
-    is_uniform, samples, time,
-};
+use super::verdicts::{Cost, envelope, is_cube, is_rt, is_traced_cube, is_uniform, samples, time};
+use super::{CompareEntry, CompareReport, Metric};
 use crate::compare::pareto_front;
 use crate::error::Result;
 use crate::plot;

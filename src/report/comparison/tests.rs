@@ -1,4 +1,6 @@
+use super::verdicts::{ceiling, verdict};
 use super::*;
+use crate::compare::ImageError;
 
 /// The warm-up runs at least one frame, and frames until its time has passed: frames of
 /// at least 5 ms fill 20 ms in no fewer than 4. A frame's error ends it.
