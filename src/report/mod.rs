@@ -10,7 +10,9 @@ use std::path::Path;
 use serde::Serialize;
 
 pub use benchmark::{BenchEntry, BenchReport, bench};
-pub use comparison::{Ceiling, CompareEntry, CompareReport, Level, RayLevel, Verdict, compare};
+pub use comparison::{
+    Ceiling, CompareEntry, CompareReport, Level, Metric, RayLevel, Verdict, compare,
+};
 
 use crate::bench::Machine;
 pub use crate::bench::PathKind;
