@@ -187,7 +187,7 @@ pub(super) fn envelope<'a>(
 }
 
 /// The setup of `family` at a point of its envelope.
-pub(super) fn name_at(
+fn name_at(
     entries: &[CompareEntry],
     metric: Metric,
     family: fn(&CompareEntry) -> bool,
@@ -203,7 +203,7 @@ pub(super) fn name_at(
 /// At each setup on the envelope of the cube setups `cube` picks, in `cost` against error:
 /// its name, error and cost, and the cost RT's family needs for that error (`None` where it
 /// does not reach it).
-pub(super) fn at_cube_errors(
+fn at_cube_errors(
     entries: &[CompareEntry],
     metric: Metric,
     cube: fn(&CompareEntry) -> bool,
@@ -240,7 +240,7 @@ pub(super) fn is_traced_cube(e: &CompareEntry) -> bool {
 }
 
 /// The least of some ratios, `None` without any.
-pub(super) fn least(ratios: impl Iterator<Item = Option<f64>>) -> Option<f64> {
+fn least(ratios: impl Iterator<Item = Option<f64>>) -> Option<f64> {
     ratios.flatten().min_by(f64::total_cmp)
 }
 
