@@ -232,3 +232,106 @@ fn the_readme_is_a_front_page_whose_commands_run() {
     }
     assert!(commands >= 10, "{commands} commands in the table");
 }
+
+/// mdbook's anchor for a heading: its text lowercased, spaces as hyphens, and no punctuation
+/// but hyphens and underscores (inline code and emphasis marks dropped with it).
+fn anchor(heading: &str) -> String {
+    heading
+        .chars()
+        .filter_map(|c| match c {
+            c if c.is_alphanumeric() || c == '_' || c == '-' => Some(c.to_ascii_lowercase()),
+            c if c.is_whitespace() => Some('-'),
+            _ => None,
+        })
+        .collect()
+}
+
+/// The anchors of a Markdown file's headings (outside fenced blocks).
+fn anchors(markdown: &str) -> Vec<String> {
+    prose(markdown)
+        .lines()
+        .filter_map(|line| line.strip_prefix('#'))
+        .map(|line| anchor(line.trim_start_matches('#').trim()))
+        .collect()
+}
+
+/// A Markdown file without its fenced blocks.
+fn prose(markdown: &str) -> String {
+    let mut fenced = false;
+    let mut kept = String::new();
+    for line in markdown.lines() {
+        if line.starts_with("```") {
+            fenced = !fenced;
+        } else if !fenced {
+            kept.push_str(line);
+            kept.push('\n');
+        }
+    }
+    kept
+}
+
+/// The READMEs under `folder`, at any depth.
+fn readmes(folder: &Path) -> Vec<PathBuf> {
+    let mut found = Vec::new();
+    for entry in std::fs::read_dir(folder).unwrap() {
+        let path = entry.unwrap().path();
+        if path.is_dir() {
+            found.extend(readmes(&path));
+        } else if path.file_name().is_some_and(|name| name == "README.md") {
+            found.push(path);
+        }
+    }
+    found
+}
+
+/// Every relative link of the README, the book and the results' READMEs reaches a file or
+/// folder that exists, and a link to a heading (`page.md#anchor`, or `#anchor` on the same
+/// page) reaches one that the page has, so that moving a section cannot leave a link
+/// pointing nowhere.
+#[test]
+fn links_reach_their_files_and_headings() {
+    let mut pages = pages();
+    pages.push(root().join("README.md"));
+    pages.extend(readmes(&root().join("results")));
+    let mut checked = 0;
+    for page in pages {
+        let text = std::fs::read_to_string(&page).unwrap();
+        for link in prose(&text).split("](").skip(1) {
+            let target = &link[..link.find(')').unwrap()];
+            if target.contains("://") || target.starts_with("mailto:") {
+                continue;
+            }
+            let (path, heading) = target.split_once('#').unwrap_or((target, ""));
+            let file = if path.is_empty() {
+                page.clone()
+            } else {
+                page.parent().unwrap().join(path)
+            };
+            let at = format!("{} links {target}", page.display());
+            assert!(file.exists(), "{at}, which is missing");
+            if !heading.is_empty() {
+                let linked = std::fs::read_to_string(&file).unwrap();
+                assert!(
+                    anchors(&linked).iter().any(|a| a == heading),
+                    "{at}, a heading {} does not have",
+                    file.display()
+                );
+            }
+            checked += 1;
+        }
+    }
+    assert!(checked >= 100, "{checked} links");
+}
+
+#[test]
+fn anchors_follow_mdbook() {
+    assert_eq!(
+        anchor("The tent filter: one ray, less aliasing"),
+        "the-tent-filter-one-ray-less-aliasing"
+    );
+    assert_eq!(
+        anchor("Through a prescription's glass"),
+        "through-a-prescriptions-glass"
+    );
+    assert_eq!(anchor("`compare` and `bench`"), "compare-and-bench");
+}
