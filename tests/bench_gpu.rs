@@ -96,6 +96,11 @@ fn adaptive_frames_time_listing_and_tracing_apart_and_count_their_rays() {
         rays.iter().skip(1).step_by(2).all(|&n| n == 0),
         "listing traces nothing: {rays:?}"
     );
+    // The bookkeeping `bench` and `render` report is those listing passes' time together.
+    let (spent, share) = Pass::bookkeeping(&passes, &ms).unwrap();
+    let listed: f64 = ms.iter().skip(1).step_by(2).sum();
+    assert!((spent - listed).abs() < 1e-9, "{spent} against {listed}");
+    assert!(share > 0.0 && share < 1.0, "{share}");
     // The block corners the lens covers: every 4th pixel along each axis and the last (the
     // 180° circle masks the image's corners, and the coarse stage traces nothing there).
     let corners = |n: u32| (0..n).filter(move |&i| i % 4 == 0 || i == n - 1);

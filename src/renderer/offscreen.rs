@@ -265,6 +265,24 @@ impl Pass {
             Pass::Filter => "filter",
         }
     }
+
+    /// The time of adaptive sampling's listing passes (the bookkeeping: compaction, the
+    /// neighbour tests, interpolation) among a frame's `passes` timed `ms`, and its share of
+    /// them all; `None` where none lists (uniform sampling, cube maps).
+    pub fn bookkeeping(passes: &[Pass], ms: &[f64]) -> Option<(f64, f64)> {
+        let listing: Vec<f64> = passes
+            .iter()
+            .zip(ms)
+            .filter(|(pass, _)| ALL_STAGES.iter().any(|&s| Pass::listing(s) == Some(**pass)))
+            .map(|(_, &ms)| ms)
+            .collect();
+        if listing.is_empty() {
+            return None;
+        }
+        let spent: f64 = listing.iter().sum();
+        let all: f64 = ms.iter().sum();
+        Some((spent, if all > 0.0 { spent / all } else { 0.0 }))
+    }
 }
 
 /// The scene on the GPU as each method needs it: the software BVH, and the driver's
@@ -616,5 +634,43 @@ mod tests {
         let tent_only = Setup::all(&[Method::Rt], &[], &samplings, &[PixelFilter::Tent]);
         let labels: Vec<String> = tent_only.iter().map(Setup::label).collect();
         assert_eq!(labels, ["rt@1spp+tent", "rt@16spp"]);
+    }
+
+    #[test]
+    fn bookkeeping_is_the_listing_passes_share() {
+        let passes = [
+            Pass::Coarse,
+            Pass::MidpointList,
+            Pass::Midpoints,
+            Pass::RefineList,
+            Pass::Refine,
+            Pass::Filter,
+        ];
+        let ms = [0.5, 1.0, 0.75, 0.5, 1.25, 1.0];
+        let (spent, share) = Pass::bookkeeping(&passes, &ms).unwrap();
+        assert_eq!(spent, 1.5);
+        assert_eq!(share, 0.3);
+        // Every stage's listing counts, and no tracing pass does.
+        for stage in ALL_STAGES {
+            let listing = Pass::listing(stage).map_or(0.0, |_| 2.0);
+            let passes: Vec<Pass> = [Some(Pass::of(stage)), Pass::listing(stage)]
+                .into_iter()
+                .flatten()
+                .collect();
+            let ms = [3.0, 2.0];
+            let found = Pass::bookkeeping(&passes, &ms[..passes.len()]);
+            assert_eq!(
+                found.map(|(spent, _)| spent),
+                (listing > 0.0).then_some(2.0)
+            );
+        }
+        assert_eq!(
+            Pass::bookkeeping(&[Pass::Trace, Pass::Filter], &[4.0, 1.0]),
+            None
+        );
+        assert_eq!(
+            Pass::bookkeeping(&[Pass::Faces, Pass::Sampler], &[4.0, 1.0]),
+            None
+        );
     }
 }

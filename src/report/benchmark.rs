@@ -204,25 +204,34 @@ impl BenchReport {
         };
         let _ = writeln!(
             md,
-            "| lens | setup | mean fps ({clock}) | fps variance | min fps | max fps | p50 ms | p99 ms | wall mean fps | median ms per pass (ns per ray) |\n|---|---|---:|---:|---:|---:|---:|---:|---:|---|"
+            "| lens | setup | mean fps ({clock}) | fps variance | min fps | max fps | p50 ms | p99 ms | wall mean fps | median ms per pass (ns per ray; adaptive sampling's listing passes together, and their share) |\n|---|---|---:|---:|---:|---:|---:|---:|---:|---|"
         );
         for e in &self.entries {
             let s = e.stats();
             let passes = match &e.pass_median_ms {
-                Some(ms) => e
-                    .passes
-                    .iter()
-                    .zip(ms)
-                    .enumerate()
-                    .map(|(k, (p, ms))| {
-                        let per_ray = e.pass_median_ns_per_ray.as_ref().and_then(|n| n[k]);
-                        match per_ray {
-                            Some(ns) => format!("{} {} ({} ns/ray)", p.name(), sig(*ms), sig(ns)),
-                            None => format!("{} {}", p.name(), sig(*ms)),
-                        }
-                    })
-                    .collect::<Vec<_>>()
-                    .join(", "),
+                Some(ms) => {
+                    e.passes
+                        .iter()
+                        .zip(ms)
+                        .enumerate()
+                        .map(|(k, (p, ms))| {
+                            let per_ray = e.pass_median_ns_per_ray.as_ref().and_then(|n| n[k]);
+                            match per_ray {
+                                Some(ns) => {
+                                    format!("{} {} ({} ns/ray)", p.name(), sig(*ms), sig(ns))
+                                }
+                                None => format!("{} {}", p.name(), sig(*ms)),
+                            }
+                        })
+                        .collect::<Vec<_>>()
+                        .join(", ")
+                        + &Pass::bookkeeping(&e.passes, ms).map_or(
+                            String::new(),
+                            |(spent, share)| {
+                                format!("; listing {} ({:.0} %)", sig(spent), 100.0 * share)
+                            },
+                        )
+                }
                 None => "untimed".into(),
             };
             let _ = writeln!(

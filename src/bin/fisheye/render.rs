@@ -303,9 +303,19 @@ pub(crate) fn render(args: &RenderArgs) -> Result<()> {
                     rays => format!("{} {ms:.2} ({rays} rays)", pass.name()),
                 })
                 .collect();
+            let listing = time
+                .passes_ms
+                .as_ref()
+                .and_then(|ms| Pass::bookkeeping(renderer.passes(), ms))
+                .map_or(String::new(), |(spent, share)| {
+                    format!(
+                        "; the listing passes {spent:.2} ms together ({:.0} %)",
+                        100.0 * share
+                    )
+                });
             let what = format!(
                 "trace ({}): {rays} pixels, {traced} rays for their colour ({per_pixel:.2} a \
-                 pixel on average, at most {spp}){}",
+                 pixel on average, at most {spp}){}{listing}",
                 setup.label(),
                 match passes.is_empty() {
                     true => String::new(),
