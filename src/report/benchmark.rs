@@ -210,7 +210,8 @@ impl BenchReport {
             let s = e.stats();
             let passes = match &e.pass_median_ms {
                 Some(ms) => {
-                    e.passes
+                    let timed: Vec<String> = e
+                        .passes
                         .iter()
                         .zip(ms)
                         .enumerate()
@@ -223,14 +224,12 @@ impl BenchReport {
                                 None => format!("{} {}", p.name(), sig(*ms)),
                             }
                         })
-                        .collect::<Vec<_>>()
-                        .join(", ")
-                        + &Pass::bookkeeping(&e.passes, ms).map_or(
-                            String::new(),
-                            |(spent, share)| {
-                                format!("; listing {} ({:.0} %)", sig(spent), 100.0 * share)
-                            },
-                        )
+                        .collect();
+                    let listing =
+                        Pass::bookkeeping(&e.passes, ms).map_or(String::new(), |(spent, share)| {
+                            format!("; listing {} ({:.0} %)", sig(spent), 100.0 * share)
+                        });
+                    timed.join(", ") + &listing
                 }
                 None => "untimed".into(),
             };

@@ -1,7 +1,7 @@
 //! The plan of an adaptive frame: its stages, which a frame runs, and what each traces.
 
-use crate::trace::options::{Adaptive, SampleLanes};
 use crate::shared::{ADAPTIVE_ESTIMATE_SIDE, NESTED_SIDE, WORKGROUP_1D};
+use crate::trace::options::{Adaptive, SampleLanes};
 
 /// A part of an adaptive frame, each its own compute pass (and its own timestamps).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
