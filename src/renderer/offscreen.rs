@@ -270,16 +270,14 @@ impl Pass {
     /// neighbour tests, interpolation) among a frame's `passes` timed `ms`, and its share of
     /// them all; `None` where none lists (uniform sampling, cube maps).
     pub fn bookkeeping(passes: &[Pass], ms: &[f64]) -> Option<(f64, f64)> {
-        let listing: Vec<f64> = passes
+        let mut listing = passes
             .iter()
             .zip(ms)
             .filter(|(pass, _)| ALL_STAGES.iter().any(|&s| Pass::listing(s) == Some(**pass)))
             .map(|(_, &ms)| ms)
-            .collect();
-        if listing.is_empty() {
-            return None;
-        }
-        let spent: f64 = listing.iter().sum();
+            .peekable();
+        listing.peek()?;
+        let spent: f64 = listing.sum();
         let all: f64 = ms.iter().sum();
         Some((spent, if all > 0.0 { spent / all } else { 0.0 }))
     }
