@@ -233,16 +233,14 @@ fn the_readme_is_a_front_page_whose_commands_run() {
     assert!(commands >= 10, "{commands} commands in the table");
 }
 
-/// mdbook's anchor for a heading: its text lowercased, spaces as hyphens, and no punctuation
-/// but hyphens and underscores (inline code and emphasis marks dropped with it).
+/// mdbook's anchor for a heading: its text lowercased (Unicode's lowercase, as mdbook's is),
+/// spaces as hyphens, and no punctuation but hyphens and underscores (inline code and
+/// emphasis marks dropped with it).
 fn anchor(heading: &str) -> String {
     heading
         .chars()
-        .filter_map(|c| match c {
-            c if c.is_alphanumeric() || c == '_' || c == '-' => Some(c.to_ascii_lowercase()),
-            c if c.is_whitespace() => Some('-'),
-            _ => None,
-        })
+        .filter(|&c| c.is_alphanumeric() || c == '_' || c == '-' || c.is_whitespace())
+        .flat_map(|c| if c.is_whitespace() { '-' } else { c }.to_lowercase())
         .collect()
 }
 
@@ -334,4 +332,5 @@ fn anchors_follow_mdbook() {
         "through-a-prescriptions-glass"
     );
     assert_eq!(anchor("`compare` and `bench`"), "compare-and-bench");
+    assert_eq!(anchor("Šibenik at 512×384"), "šibenik-at-512384");
 }
