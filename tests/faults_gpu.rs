@@ -4,10 +4,10 @@
 
 use fisheye_rt::Error;
 use fisheye_rt::cube::{CubeMap, CubeMethod, CubeSettings};
-use fisheye_rt::gpu::GpuContext;
+use fisheye_rt::gpu::{GpuContext, GpuJob};
 use fisheye_rt::raster::RasterMethod;
 use fisheye_rt::scene::builtin;
-use fisheye_rt::trace::{GpuScene, RenderOptions, TracePass, render};
+use fisheye_rt::trace::{Adaptive, AdaptivePass, GpuScene, RenderOptions, TracePass, render};
 
 mod common;
 
@@ -40,6 +40,15 @@ fn a_lost_device_is_an_error_at_every_step() {
         TracePass::new(&ctx, &camera, &gpu_scene, options.directions),
         "creating a pass",
     );
+    let adaptive = Adaptive {
+        threshold: 0.02,
+        ground_truth: true,
+        every_pixel: false,
+    };
+    lost(
+        AdaptivePass::new(&ctx, &camera, &gpu_scene, options.directions, 16, adaptive),
+        "creating adaptive sampling's passes",
+    );
     for method in [
         CubeMethod::Traced,
         CubeMethod::Raster(RasterMethod::Forward),
@@ -58,15 +67,7 @@ fn a_lost_device_is_an_error_at_every_step() {
 #[test]
 fn refused_allocations_are_errors_naming_the_step() {
     let ctx = GpuContext::new().unwrap();
-    let size = ctx.device.limits().max_buffer_size + 4;
-    let result = ctx.checked("allocating a huge buffer", || {
-        ctx.device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("fisheye.test.huge"),
-            size,
-            usage: wgpu::BufferUsages::STORAGE,
-            mapped_at_creation: false,
-        })
-    });
+    let result = ctx.checked("allocating a huge buffer", || huge_buffer(&ctx));
     match result {
         Err(Error::Gpu { during, message }) => {
             assert_eq!(during, "allocating a huge buffer");
@@ -76,6 +77,60 @@ fn refused_allocations_are_errors_naming_the_step() {
         Ok(_) => panic!("a buffer past max_buffer_size was created"),
     }
     // The device survives it: the next step works.
+    let scene = builtin::scene("default").unwrap();
+    let camera = common::camera("equidistant:f=0.5", 16, 16);
+    render(&ctx, &scene, &camera, &RenderOptions::default()).unwrap();
+}
+
+/// A buffer past the device's size limit: a validation error where it is made.
+fn huge_buffer(ctx: &GpuContext) -> wgpu::Buffer {
+    ctx.device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("fisheye.test.huge"),
+        size: ctx.device.limits().max_buffer_size + 4,
+        usage: wgpu::BufferUsages::STORAGE,
+        mapped_at_creation: false,
+    })
+}
+
+/// Work run side by side (`checked_each`, as adaptive sampling makes its kernels) gives its
+/// values in order, and an error in one job, on a thread of its own, is caught by that
+/// thread's error scopes (wgpu's are per thread) and named: not left to escape as an
+/// uncaught error that would fail every later step.
+#[test]
+fn side_by_side_work_is_checked_on_its_own_thread() {
+    let ctx = GpuContext::new().unwrap();
+    let device = &ctx.device;
+    let jobs: Vec<GpuJob<'_, u64>> = (1..=4u64)
+        .map(|n| -> GpuJob<'_, u64> {
+            Box::new(move || {
+                let buffer = device.create_buffer(&wgpu::BufferDescriptor {
+                    label: Some("fisheye.test.small"),
+                    size: 4 * n,
+                    usage: wgpu::BufferUsages::STORAGE,
+                    mapped_at_creation: false,
+                });
+                buffer.size()
+            })
+        })
+        .collect();
+    assert_eq!(
+        ctx.checked_each("small buffers", jobs).unwrap(),
+        [4, 8, 12, 16]
+    );
+
+    let jobs: Vec<GpuJob<'_, Option<wgpu::Buffer>>> = vec![
+        Box::new(|| None),
+        Box::new(|| Some(huge_buffer(&ctx))),
+        Box::new(|| None),
+    ];
+    match ctx.checked_each("making buffers side by side", jobs) {
+        Err(Error::Gpu { during, message }) => {
+            assert_eq!(during, "making buffers side by side");
+            assert!(!message.is_empty());
+        }
+        Err(other) => panic!("wrong error: {other}"),
+        Ok(_) => panic!("a buffer past max_buffer_size was created"),
+    }
     let scene = builtin::scene("default").unwrap();
     let camera = common::camera("equidistant:f=0.5", 16, 16);
     render(&ctx, &scene, &camera, &RenderOptions::default()).unwrap();

@@ -203,6 +203,15 @@ pub const OPTIONAL_FEATURES: [(wgpu::Features, &str); 6] = [
     (wgpu::Features::SHADER_F64, "f64 in shaders"),
 ];
 
+/// Work that makes GPU objects, for [`GpuContext::checked_each`] to run beside other such work
+/// (on a thread of its own, except in a web page).
+#[cfg(not(target_arch = "wasm32"))]
+pub type GpuJob<'a, T> = Box<dyn FnOnce() -> T + Send + 'a>;
+/// Work that makes GPU objects, for [`GpuContext::checked_each`] (one after another in a web
+/// page, whose GPU objects stay on its one thread).
+#[cfg(target_arch = "wasm32")]
+pub type GpuJob<'a, T> = Box<dyn FnOnce() -> T + 'a>;
+
 /// A device and its queue: the GPU everything else runs on. [`GpuContext::new`] creates
 /// one; [`GpuContext::from_device`] wraps a caller's (a renderer that embeds the library).
 #[derive(Clone)]
@@ -455,6 +464,36 @@ impl GpuContext {
             }),
             None => Ok(value),
         }
+    }
+
+    /// Runs `jobs` as [`GpuContext::checked`] runs one, each on a thread of its own: a driver
+    /// compiles a pipeline on the thread that makes it (lavapipe takes most of a second over a
+    /// tracing kernel), so kernels made side by side are ready sooner. Their values in order,
+    /// or the first job's error in order.
+    #[cfg(not(target_arch = "wasm32"))]
+    pub fn checked_each<T: Send>(&self, during: &str, jobs: Vec<GpuJob<'_, T>>) -> Result<Vec<T>> {
+        std::thread::scope(|scope| {
+            let running: Vec<_> = jobs
+                .into_iter()
+                .map(|job| scope.spawn(move || self.checked(during, job)))
+                .collect();
+            running
+                .into_iter()
+                .map(|job| {
+                    job.join()
+                        .unwrap_or_else(|panic| std::panic::resume_unwind(panic))
+                })
+                .collect()
+        })
+    }
+
+    /// Runs `jobs` one after another as [`GpuContext::checked`] runs one (a web page has no
+    /// threads to run them on side by side).
+    #[cfg(target_arch = "wasm32")]
+    pub fn checked_each<T>(&self, during: &str, jobs: Vec<GpuJob<'_, T>>) -> Result<Vec<T>> {
+        jobs.into_iter()
+            .map(|job| self.checked(during, job))
+            .collect()
     }
 
     /// Runs `work`, after an error if the device was lost or earlier work failed. A web page

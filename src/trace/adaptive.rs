@@ -8,7 +8,7 @@
 use super::pass::{TracePass, check_storage_buffers, shared_entries};
 use super::{Adaptive, GpuScene, RenderOutput, SampleLanes};
 use crate::error::{Error, Result};
-use crate::gpu::{GpuContext, bind_group_at, storage_entry, uniform_entry};
+use crate::gpu::{GpuContext, GpuJob, bind_group_at, storage_entry, uniform_entry};
 use crate::lens::LensCamera;
 use crate::lens::gpu::DirectionSource;
 use crate::scene::Camera;
@@ -29,6 +29,14 @@ mod stages;
 
 pub use stages::{ALL_STAGES, Stage, stages_for};
 use stages::{lattice_points, listed_at, reused_samples, sample_lanes, samples_at};
+
+/// A kernel of a stage the frame runs, which [`AdaptivePass`] made with the pass (it makes
+/// only those: see its `builders`).
+fn made(kernel: &Option<wgpu::ComputePipeline>) -> &wgpu::ComputePipeline {
+    kernel
+        .as_ref()
+        .expect("the kernels of the stages a frame runs are made with the pass")
+}
 
 /// Timestamp writes for the stages of one frame, each but the first in two compute passes:
 /// the listing of its pixels (the bookkeeping), then the tracing of the list; the coarse
@@ -51,15 +59,17 @@ pub struct AdaptivePass {
     /// The coarse stage's kernel, `trace_lattice`: a ray through each lattice point.
     lattice: wgpu::ComputePipeline,
     /// The kernels that list the later stages' pixels: classify (the blocks), midpoints,
-    /// classify (the half-blocks), select_pixels, more, untraced.
-    builders: [wgpu::ComputePipeline; 6],
+    /// classify (the half-blocks), select_pixels, more, untraced. Here and below, only the
+    /// kernels of the stages a frame runs are made (`None` the others'): a tracing kernel
+    /// takes a driver most of a second to compile on lavapipe.
+    builders: [Option<wgpu::ComputePipeline>; 6],
     /// The tracing kernel of each listed [`Stage`] (all but the coarse, in order, see
     /// [`listed_at`]): `trace_list` or `trace_samples`.
-    trace_lists: [wgpu::ComputePipeline; 5],
+    trace_lists: [Option<wgpu::ComputePipeline>; 5],
     /// The kernels that size each listed [`Stage`]'s tracing dispatch over its whole list,
     /// then supersampling's over the next slice of it (progressive refinement,
     /// [`AdaptivePass::encode_step`]).
-    args: [wgpu::ComputePipeline; 6],
+    args: [Option<wgpu::ComputePipeline>; 6],
     group: wgpu::BindGroup,
     args_group: wgpu::BindGroup,
     work: wgpu::Buffer,
@@ -105,7 +115,7 @@ impl AdaptivePass {
                 options.threshold
             )));
         }
-        let trace = TracePass::supersampled(ctx, camera, scene, source, spp)?;
+        let trace = TracePass::deferred(ctx, camera, scene, source, spp)?;
         if trace.bands() > 1 {
             return Err(Error::Limit(format!(
                 "adaptive sampling of a {} image: its outputs exceed one storage binding of \
@@ -195,6 +205,8 @@ impl AdaptivePass {
                 import_swaps.push(("bvh", "bvh_rq"));
             }
             let side = trace.samples_per_side();
+            let stages = stages_for(side, options);
+            let runs = |stage: Stage| stages.contains(&stage);
             let in_file = |(file, swaps): (&str, &[(&str, &str)]),
                            entry: &str,
                            overrides: &[(&'static str, u32)]| {
@@ -220,28 +232,34 @@ impl AdaptivePass {
                     &overrides,
                 )
             };
+            // `select_pixels` lists the estimate's pixels, or supersampling's where there is
+            // no estimate; `more` supersampling's after one (every frame that estimates also
+            // supersamples).
+            let (estimates, supersamples) = (runs(Stage::Estimate), runs(Stage::Supersample));
             let builders = [
-                kernel("classify", 0, 0),
-                lister("midpoints"),
-                kernel("classify", 0, 1),
-                lister("select_pixels"),
-                lister("more"),
-                lister("untraced"),
+                runs(Stage::Midpoints).then(|| kernel("classify", 0, 0)),
+                runs(Stage::Midpoints).then(|| lister("midpoints")),
+                runs(Stage::Refine).then(|| kernel("classify", 0, 1)),
+                supersamples.then(|| lister("select_pixels")),
+                estimates.then(|| lister("more")),
+                runs(Stage::Truth).then(|| lister("untraced")),
             ];
-            // The modes of wgsl/adaptive.wgsl: centres, samples, first hits, estimates.
-            let lattice = in_file(
-                (file, source.swaps()),
-                "trace_lattice",
-                &[("EVERY_PIXEL", u32::from(options.every_pixel))],
-            );
-            let trace_centres = kernel("trace_list", 0, 0);
-            let trace_lists = [
-                trace_centres.clone(),
-                trace_centres,
-                sampler(3, Stage::Estimate),
-                sampler(1, Stage::Supersample),
-                kernel("trace_list", 2, 0),
+            // The tracing kernels, each most of a second's compiling on lavapipe, made side by
+            // side: the coarse stage's, then by the modes of wgsl/adaptive.wgsl, centres
+            // (shared by the stages that trace them), estimates, samples, first hits.
+            let coarse = [("EVERY_PIXEL", u32::from(options.every_pixel))];
+            let jobs: Vec<GpuJob<'_, _>> = vec![
+                Box::new(|| Some(in_file((file, source.swaps()), "trace_lattice", &coarse))),
+                Box::new(|| runs(Stage::Midpoints).then(|| kernel("trace_list", 0, 0))),
+                Box::new(|| estimates.then(|| sampler(3, Stage::Estimate))),
+                Box::new(|| supersamples.then(|| sampler(1, Stage::Supersample))),
+                Box::new(|| runs(Stage::Truth).then(|| kernel("trace_list", 2, 0))),
             ];
+            let tracers = ctx.checked_each("compiling the adaptive passes' kernels", jobs)?;
+            let [lattice, centres, estimate, samples, truth] =
+                <[_; 5]>::try_from(tracers).expect("a kernel for each job");
+            let lattice = lattice.expect("the coarse stage's kernel");
+            let trace_lists = [centres.clone(), centres, estimate, samples, truth];
             let args_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
                 label: Some("fisheye.adaptive.args"),
                 entries: &[storage_entry(0, false), storage_entry(1, false)],
@@ -263,12 +281,12 @@ impl AdaptivePass {
             // The stages that trace centres share one: a pixel a lane.
             let centres = args_kernel(0, Stage::Refine);
             let args = [
-                centres.clone(),
-                centres.clone(),
-                args_kernel(0, Stage::Estimate),
-                args_kernel(0, Stage::Supersample),
-                centres,
-                args_kernel(slice, Stage::Supersample),
+                runs(Stage::Midpoints).then(|| centres.clone()),
+                runs(Stage::Refine).then(|| centres.clone()),
+                estimates.then(|| args_kernel(0, Stage::Estimate)),
+                supersamples.then(|| args_kernel(0, Stage::Supersample)),
+                runs(Stage::Truth).then_some(centres),
+                supersamples.then(|| args_kernel(slice, Stage::Supersample)),
             ];
             let args_group = crate::gpu::bind_buffers(
                 device,
@@ -276,7 +294,7 @@ impl AdaptivePass {
                 &args_layout,
                 &[&work, &dispatch],
             );
-            Self {
+            Ok(Self {
                 trace,
                 options,
                 lattice,
@@ -289,8 +307,8 @@ impl AdaptivePass {
                 dispatch,
                 listed,
                 params,
-            }
-        })
+            })
+        })?
     }
 
     /// Makes each frame's colour output as `filter` says from now on: the tent filter with
@@ -480,6 +498,7 @@ impl AdaptivePass {
             Stage::Supersample => (vec![select], pixels),
             Stage::Truth => (vec![untraced], pixels),
         };
+        let listers: Vec<_> = listers.into_iter().map(made).collect();
         encoder.clear_buffer(&self.work, 0, Some(4 * u64::from(ADAPTIVE_HEADER)));
         let label = "fisheye.adaptive.list";
         self.dispatch_2d(encoder, scene, label, &listers, points, list);
@@ -508,10 +527,10 @@ impl AdaptivePass {
         } else {
             listed_at(stage)
         };
-        pass.set_pipeline(&self.args[args]);
+        pass.set_pipeline(made(&self.args[args]));
         pass.set_bind_group(0, &self.args_group, &[]);
         pass.dispatch_workgroups(1, 1, 1);
-        pass.set_pipeline(&self.trace_lists[listed_at(stage)]);
+        pass.set_pipeline(made(&self.trace_lists[listed_at(stage)]));
         for (index, group) in self.groups(scene).into_iter().enumerate() {
             pass.set_bind_group(index as u32, group, &[]);
         }

@@ -13,6 +13,7 @@ use crate::scene::Camera;
 use crate::shader;
 use crate::shared::{Frame, TRACE_STORAGE_BUFFERS};
 use glam::{DMat3, DVec3};
+use std::sync::OnceLock;
 
 /// Bytes between the frame uniforms of a [`TracePass`]'s views: the frame rounded up to
 /// wgpu's default (and largest) `min_uniform_buffer_offset_alignment`, 256.
@@ -35,7 +36,14 @@ fn band_frames(bands: &[(u32, u32)], frame: Frame) -> Vec<Frame> {
 /// The trace kernel for one lens, image size and scene: owns its pipeline, its frame bind
 /// group (group 0) and its outputs; records one frame per [`TracePass::encode`].
 pub struct TracePass {
-    pipeline: wgpu::ComputePipeline,
+    /// The kernel, specialised to the lens, the direction source and the scene's features:
+    /// made with the pass, or at its first frame for a pass whose outputs other kernels write
+    /// ([`TracePass::deferred`]).
+    pipeline: OnceLock<wgpu::ComputePipeline>,
+    /// What the kernel is made with: the device, group 0's layout, the direction source.
+    device: wgpu::Device,
+    layout: wgpu::BindGroupLayout,
+    source: DirectionSource,
     /// One bind group per view, each with its slot of `frame`.
     bind_groups: Vec<wgpu::BindGroup>,
     /// The outputs the kernel writes: the whole image's, or one band's.
@@ -98,6 +106,36 @@ impl TracePass {
         views: u32,
         samples_per_side: u32,
     ) -> Result<Self> {
+        let pass = Self::outputs(ctx, camera, scene, source, views, samples_per_side)?;
+        ctx.checked("creating the trace kernel", || {
+            pass.pipeline(scene);
+        })?;
+        Ok(pass)
+    }
+
+    /// As [`TracePass::supersampled`], with the kernel made at the first frame that traces
+    /// (if one ever does) rather than now: for passes whose own kernels write this one's
+    /// outputs (adaptive sampling's), which compiling the kernel too would only slow.
+    pub(crate) fn deferred(
+        ctx: &GpuContext,
+        camera: &LensCamera,
+        scene: &GpuScene,
+        source: DirectionSource,
+        spp: u32,
+    ) -> Result<Self> {
+        let side = sampling::samples_per_side(spp)?;
+        Self::outputs(ctx, camera, scene, source, 1, side)
+    }
+
+    /// The pass's buffers and bind groups, its kernel not yet made (`TracePass::pipeline`).
+    fn outputs(
+        ctx: &GpuContext,
+        camera: &LensCamera,
+        scene: &GpuScene,
+        source: DirectionSource,
+        views: u32,
+        samples_per_side: u32,
+    ) -> Result<Self> {
         ctx.check_image(camera.size)?;
         let pixels = camera.size.pixels() as u64;
         let bands = output_bands(ctx, camera.size, views)?;
@@ -113,17 +151,6 @@ impl TracePass {
                 entries: &shared_entries(source),
             });
             let constants = trace_constants(camera, scene, samples_per_side);
-            let mut layouts = vec![&layout, &scene.layout];
-            let file = match &scene.ray_query {
-                Some(rq) => {
-                    layouts.push(&rq.layout);
-                    "trace_rq"
-                }
-                None => "trace",
-            };
-            let composed = (&scene.arrays, source.swaps());
-            let pipeline =
-                shader::scene_pipeline(device, file, composed, "main", &constants, &layouts);
             let output = |label: &str, bytes: u64, usage: wgpu::BufferUsages| {
                 device.create_buffer(&wgpu::BufferDescriptor {
                     label: Some(label),
@@ -184,7 +211,10 @@ impl TracePass {
                 })
                 .collect();
             Self {
-                pipeline,
+                pipeline: OnceLock::new(),
+                device: device.clone(),
+                layout,
+                source,
                 bind_groups,
                 colour,
                 geometry,
@@ -200,6 +230,23 @@ impl TracePass {
                 whole,
                 tent: None,
             }
+        })
+    }
+
+    /// The kernel for `scene` (the pass's own), made at its first use.
+    fn pipeline(&self, scene: &GpuScene) -> &wgpu::ComputePipeline {
+        self.pipeline.get_or_init(|| {
+            let mut layouts = vec![&self.layout, &scene.layout];
+            let file = match &scene.ray_query {
+                Some(rq) => {
+                    layouts.push(&rq.layout);
+                    "trace_rq"
+                }
+                None => "trace",
+            };
+            let composed = (&scene.arrays, self.source.swaps());
+            let constants = &self.constants;
+            shader::scene_pipeline(&self.device, file, composed, "main", constants, &layouts)
         })
     }
 
@@ -434,7 +481,7 @@ impl TracePass {
         dispatch_over_image(
             encoder,
             "fisheye.trace",
-            &self.pipeline,
+            self.pipeline(scene),
             &groups,
             extent,
             timestamp_writes,
