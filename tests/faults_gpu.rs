@@ -68,18 +68,7 @@ fn a_lost_device_is_an_error_at_every_step() {
 fn refused_allocations_are_errors_naming_the_step() {
     let ctx = GpuContext::new().unwrap();
     let result = ctx.checked("allocating a huge buffer", || huge_buffer(&ctx));
-    match result {
-        Err(Error::Gpu { during, message }) => {
-            assert_eq!(during, "allocating a huge buffer");
-            assert!(!message.is_empty());
-        }
-        Err(other) => panic!("wrong error: {other}"),
-        Ok(_) => panic!("a buffer past max_buffer_size was created"),
-    }
-    // The device survives it: the next step works.
-    let scene = builtin::scene("default").unwrap();
-    let camera = common::camera("equidistant:f=0.5", 16, 16);
-    render(&ctx, &scene, &camera, &RenderOptions::default()).unwrap();
+    refused_and_survived(&ctx, result, "allocating a huge buffer");
 }
 
 /// A buffer past the device's size limit: a validation error where it is made.
@@ -90,6 +79,25 @@ fn huge_buffer(ctx: &GpuContext) -> wgpu::Buffer {
         usage: wgpu::BufferUsages::STORAGE,
         mapped_at_creation: false,
     })
+}
+
+/// `result`, of work that made a [`huge_buffer`], is its refusal, named as made `during`, and
+/// the device survives it: the next step works.
+fn refused_and_survived<T>(ctx: &GpuContext, result: fisheye_rt::Result<T>, during: &str) {
+    match result {
+        Err(Error::Gpu {
+            during: named,
+            message,
+        }) => {
+            assert_eq!(named, during);
+            assert!(!message.is_empty());
+        }
+        Err(other) => panic!("wrong error: {other}"),
+        Ok(_) => panic!("a buffer past max_buffer_size was created"),
+    }
+    let scene = builtin::scene("default").unwrap();
+    let camera = common::camera("equidistant:f=0.5", 16, 16);
+    render(ctx, &scene, &camera, &RenderOptions::default()).unwrap();
 }
 
 /// Work run side by side (`checked_each`, as adaptive sampling makes its kernels) gives its
@@ -123,15 +131,6 @@ fn side_by_side_work_is_checked_on_its_own_thread() {
         Box::new(|| Some(huge_buffer(&ctx))),
         Box::new(|| None),
     ];
-    match ctx.checked_each("making buffers side by side", jobs) {
-        Err(Error::Gpu { during, message }) => {
-            assert_eq!(during, "making buffers side by side");
-            assert!(!message.is_empty());
-        }
-        Err(other) => panic!("wrong error: {other}"),
-        Ok(_) => panic!("a buffer past max_buffer_size was created"),
-    }
-    let scene = builtin::scene("default").unwrap();
-    let camera = common::camera("equidistant:f=0.5", 16, 16);
-    render(&ctx, &scene, &camera, &RenderOptions::default()).unwrap();
+    let result = ctx.checked_each("making buffers side by side", jobs);
+    refused_and_survived(&ctx, result, "making buffers side by side");
 }
