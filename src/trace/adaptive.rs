@@ -82,10 +82,11 @@ pub struct AdaptivePass {
 }
 
 impl AdaptivePass {
-    /// Creates the kernels and buffers for `camera` on `scene`, with at most `spp` samples a
-    /// pixel (a square, as uniform sampling takes them), its samples spread over invocations
-    /// as suits the device ([`SampleLanes::for_device`]). Refuses an image whose outputs do
-    /// not fit one storage binding, and a device with too few storage buffers per stage.
+    /// Creates the kernels (those of the stages its frames run, [`stages_for`]) and buffers
+    /// for `camera` on `scene`, with at most `spp` samples a pixel (a square, as uniform
+    /// sampling takes them), its samples spread over invocations as suits the device
+    /// ([`SampleLanes::for_device`]). Refuses an image whose outputs do not fit one storage
+    /// binding, and a device with too few storage buffers per stage.
     pub fn new(
         ctx: &GpuContext,
         camera: &LensCamera,
