@@ -19,10 +19,11 @@
 //    of their edges and their centres, and `trace_list` traces them;
 // 3. `classify` at level 1 does the same for the half-blocks of those blocks (interpolating
 //    bilinearly), and the pixels of the half-blocks whose corners disagree are listed and
-//    traced: rays subdivide where the image changes, as Painter and Sloan (1989) and Thomas,
-//    Netravali and Fox (1989) refined a coarse sampling level by level, so an edge takes a
-//    band of rays half a block wide, and a block whose colour bends only at its own scale is
-//    interpolated from its half-blocks;
+//    traced (at one ray a pixel at most, but for those between two of their corners that
+//    agree, interpolated between them: `on_agreeing_edge`): rays subdivide where the image
+//    changes, as Painter and Sloan (1989) and Thomas, Netravali and Fox (1989) refined a
+//    coarse sampling level by level, so an edge takes a band of rays half a block wide, and
+//    a block whose colour bends only at its own scale is interpolated from its half-blocks;
 // 4. `select_pixels` (in `adaptive_lists.wgsl`, with `more` and `untraced`) lists the pixels
 //    traced whose displayed colour bends across them (the second difference with their
 //    neighbours, along either axis) by the threshold or more, and those on the lens's edge: a
@@ -485,6 +486,12 @@ fn block_mask_is(first: vec2<u32>, end: vec2<u32>, covered: bool) -> bool {
     return true;
 }
 
+// Whether pixel `p` of the half-block from `first` lies on its top edge and that edge's corners
+// agree (`agree.x`), or on its left edge and those corners agree (`agree.y`).
+fn on_agreeing_edge(p: vec2<u32>, first: vec2<u32>, agree: vec2<bool>) -> bool {
+    return (agree.x && p.y == first.y) || (agree.y && p.x == first.x);
+}
+
 // Decides LEVEL's blocks (an invocation a block): where its corners agree (see the file's
 // header) the block's other pixels are interpolated between them; else, at level 0, its
 // decision is kept for `midpoints` and its half-blocks (its pixels are left to level 1), and
@@ -529,6 +536,9 @@ fn classify(
     let t11 = tile_index(origin, vec2<i32>(l11));
     var refine = false;
     var listed = 0u;
+    // At level 1, whether a refined half-block's top and left edges (the ones whose pixels
+    // it holds) join corners that agree (`on_agreeing_edge`).
+    var agree = vec2<bool>(false);
     if inside {
         let a = tile_corner[t00];
         let b = tile_corner[t10];
@@ -545,11 +555,21 @@ fn classify(
         } else if any(masked) {
             refine = true;
         } else {
-            let bent = max(
-                max(edge_bend(origin, l, l10), edge_bend(origin, l01, l11)),
-                max(edge_bend(origin, l, l01), edge_bend(origin, l10, l11)),
-            );
-            refine = bent >= adaptive.threshold;
+            let top = edge_bend(origin, l, l10);
+            let left = edge_bend(origin, l, l01);
+            let bottom = edge_bend(origin, l01, l11);
+            let right = edge_bend(origin, l10, l11);
+            refine = max(max(top, bottom), max(left, right)) >= adaptive.threshold;
+            // At one ray a pixel at most, a pixel between two corners of a refined half-block
+            // that agree is interpolated between them: an edge through the half-block passes
+            // between the other two. Where pixels may be supersampled it is traced, as those
+            // beside an edge need (their traced colour shows the bend that lists them).
+            if LEVEL == 1u && SAMPLES_PER_SIDE == 1u && !edge_near {
+                agree = vec2<bool>(
+                    top < adaptive.threshold && same_surface(a, b),
+                    left < adaptive.threshold && same_surface(a, c),
+                );
+            }
             if !refine {
                 refine = !(same_surface(a, b) && same_surface(a, c) && same_surface(b, d)
                     && same_surface(c, d) && same_surface(a, d) && same_surface(b, c))
@@ -568,7 +588,8 @@ fn classify(
         } else if refine {
             for (var y = first.y; y < end.y; y++) {
                 for (var x = first.x; x < end.x; x++) {
-                    listed += select(1u, 0u, is_lattice(vec2<u32>(x, y)));
+                    let p = vec2<u32>(x, y);
+                    listed += select(1u, 0u, is_lattice(p) || on_agreeing_edge(p, first, agree));
                 }
             }
         }
@@ -627,7 +648,8 @@ fn classify(
                 continue;
             }
             let i = index_of(p);
-            if refine {
+            let on_edge = refine && on_agreeing_edge(p, first, agree);
+            if refine && !on_edge {
                 atomicStore(&work[slot], i);
                 slot += 1u;
                 continue;
@@ -641,7 +663,9 @@ fn classify(
             }
             let fx = f32(x - first.x) / span.x;
             var c = mix(down1, down2, fx);
-            if LEVEL == 0u {
+            if on_edge {
+                c = select(mix(c00, c01, fy), mix(c00, c10, fx), y == first.y);
+            } else if LEVEL == 0u {
                 c = clamp(spline(catmull_rom(fx), down0, down1, down2, down3, sides), low, high);
             }
             colour_out[i] = vec4<f32>(c, 1.0);

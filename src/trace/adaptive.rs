@@ -434,7 +434,8 @@ impl AdaptivePass {
     /// Records step `step` of a progressive frame, which shows a picture at once and sharpens
     /// it step by step, ending with the frame [`AdaptivePass::encode`] makes, bit for bit:
     /// - step 0 is the frame below one ray per pixel: the coarse and refining stages (and the
-    ///   ground truth's, where asked for), as `--spp auto:T:1` makes it (with
+    ///   ground truth's, where asked for), as `--spp auto:T:1` makes it but for the pixels
+    ///   that frame interpolates beside edges, which a frame that may supersample traces (with
     ///   [`Adaptive::every_pixel`], a ray through every pixel);
     /// - step 1 runs the estimating stage, where there is one, and lists the pixels to
     ///   supersample;

@@ -313,11 +313,13 @@ fn smooth_blocks_are_interpolated_bicubically() {
 
 /// A plane's straight far edge against the sky: the blocks it crosses (their corners
 /// disagree) get their midpoints traced, and within them only the half-blocks it crosses get
-/// a ray in every pixel; the half-blocks beside it, on the plane or in the sky, are
-/// interpolated (a straight edge that crosses a square separates its corners, so every
-/// half-block it crosses is in a refined block). Judged from uniform sampling's hits.
+/// rays; the half-blocks beside it, on the plane or in the sky, are interpolated (a straight
+/// edge that crosses a square separates its corners, so every half-block it crosses is in a
+/// refined block). In a half-block it crosses, the pixels between two corners that both see
+/// the plane or both the sky are interpolated between them, the others traced. Judged from
+/// uniform sampling's hits.
 #[test]
-fn only_the_half_blocks_an_edge_crosses_are_traced() {
+fn only_the_pixels_between_disagreeing_corners_are_traced() {
     // Wide enough that its sides are out of view: the one edge seen is its far one, at y = 20.
     let plane = lit_plane(
         "halves",
@@ -334,7 +336,7 @@ fn only_the_half_blocks_an_edge_crosses_are_traced() {
     let hit = |x: u32, y: u32| one.ids[(y * w + x) as usize] != NO_HIT;
     let half = ADAPTIVE_BLOCK / 2;
     let on = |v: u32, n: u32, step: u32| v.is_multiple_of(step) || v == n - 1;
-    let (mut crossed, mut beside) = (0, 0);
+    let (mut crossed, mut on_agreeing_edges, mut beside) = (0, 0, 0);
     for y in 0..h {
         for x in 0..w {
             if on(x, w, half) && on(y, h, half) {
@@ -345,22 +347,34 @@ fn only_the_half_blocks_an_edge_crosses_are_traced() {
             let (x1, y1) = ((x0 + half).min(w - 1), (y0 + half).min(h - 1));
             let corners = [hit(x0, y0), hit(x1, y0), hit(x0, y1), hit(x1, y1)];
             let disagree = corners.contains(&true) && corners.contains(&false);
+            // A pixel on the half-block's top edge lies between its top corners, one on its
+            // left edge between its left ones; any other between all four.
+            let between = if y == y0 {
+                corners[0] != corners[1]
+            } else if x == x0 {
+                corners[0] != corners[2]
+            } else {
+                true
+            };
             let n = rays[(y * w + x) as usize];
             assert_eq!(
                 n,
-                u32::from(disagree),
+                u32::from(disagree && between),
                 "pixel ({x}, {y}), corners {corners:?}"
             );
-            if disagree {
+            if disagree && between {
                 crossed += 1;
+            } else if disagree {
+                on_agreeing_edges += 1;
             } else if !(on(x, w, ADAPTIVE_BLOCK) && on(y, h, ADAPTIVE_BLOCK)) {
                 beside += 1;
             }
         }
     }
     assert!(
-        crossed > 30 && beside > 1000,
-        "{crossed} crossed, {beside} beside"
+        crossed > 30 && on_agreeing_edges > 15 && beside > 1000,
+        "{crossed} crossed, {on_agreeing_edges} on crossed half-blocks' agreeing edges, \
+         {beside} beside"
     );
     // Some interpolated pixels lie in blocks the edge crosses (traced whole before).
     let in_crossed_blocks = (0..h)

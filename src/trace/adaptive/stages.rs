@@ -11,7 +11,8 @@ pub enum Stage {
     /// The blocks whose corners disagree: a ray through each of their edges' midpoints and
     /// their centres (the corners of their half-blocks); the other blocks interpolated.
     Midpoints,
-    /// The half-blocks whose corners disagree: one ray per pixel; the rest interpolated.
+    /// The half-blocks whose corners disagree: one ray per pixel (at one ray a pixel at most,
+    /// not those between two corners that agree); the rest interpolated.
     Refine,
     /// The traced pixels whose colour differs from their neighbours': 2 × 2 samples, and
     /// the error estimate that decides which take all of them (more than 4 samples a pixel,
