@@ -428,9 +428,10 @@ impl Renderer {
 
     /// As [`Renderer::encode`], but refining progressively while the camera stays still: with
     /// adaptive sampling ([`RenderOptions::adaptive`]), the first frame at a new `pose` is the
-    /// one below one ray per pixel (as `--spp auto:T:1` makes it), and each frame recorded at
-    /// the same pose after it sharpens it for about one ray per pixel, until the image is the
-    /// one [`Renderer::encode`] makes, bit for bit (see [`AdaptivePass::encode_step`]); after
+    /// one below one ray per pixel (as `--spp auto:T:1` makes it, but for the pixels beside
+    /// edges that it interpolates, there traced), and each frame recorded at the same pose
+    /// after it sharpens it for about one ray per pixel, until the image is the one
+    /// [`Renderer::encode`] makes, bit for bit (see [`AdaptivePass::encode_step`]); after
     /// that a frame costs next to nothing. Any other pose starts again. Other samplings and
     /// methods make their whole frame at a new pose and leave it as it is while the pose
     /// stays. Record progressive frames in the order they are submitted.

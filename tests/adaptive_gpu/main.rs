@@ -601,8 +601,9 @@ fn progressive_steps_sharpen_into_the_adaptive_frame() {
     let (first, mut spent, first_rays) = step(0);
     // Step 0 is the auto:T:1 frame, but for the pixels that frame interpolates between two
     // agreeing corners of a half-block an edge crosses: a frame that may supersample traces
-    // them (whether they need it shows in their own colour).
+    // them (whether they need it shows in their own colour), and they have one ray's colour.
     let (coarse, coarse_rays) = adaptive(&gpu, &cam, 1, threshold, true);
+    let one_ray = uniform(&gpu, &cam, 1);
     assert_eq!(
         first.ids, coarse.ids,
         "step 0 has the auto:T:1 frame's ground truth"
@@ -611,6 +612,7 @@ fn progressive_steps_sharpen_into_the_adaptive_frame() {
     for (i, (&n, &m)) in first_rays.iter().zip(&coarse_rays).enumerate() {
         if (n, m) == (1, 0) {
             beside_edges += 1;
+            assert_eq!(first.colour[i], one_ray.colour[i], "pixel {i}'s colour");
         } else {
             assert_eq!(n, m, "pixel {i}'s rays");
             assert_eq!(first.colour[i], coarse.colour[i], "pixel {i}'s colour");
