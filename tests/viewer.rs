@@ -67,13 +67,15 @@ fn assert_shows(what: &str, window: &image::RgbaImage, expected: &image::RgbaIma
 
 /// As `assert_shows`, where each pixel may be any of `expected`'s (the nearest counts).
 fn assert_shows_one_of(what: &str, window: &image::RgbaImage, expected: &[&image::RgbaImage]) {
+    for image in expected {
+        assert_eq!(window.dimensions(), image.dimensions(), "{what}");
+    }
     let mut worst = 0;
     let mut total = 0u64;
     for (i, w) in window.pixels().enumerate() {
         let (x, y) = (i as u32 % window.width(), i as u32 / window.width());
         let mut nearest: Option<(u8, u64)> = None;
         for image in expected {
-            assert_eq!(window.dimensions(), image.dimensions(), "{what}");
             let e = image.get_pixel(x, y);
             if e[3] != 0 && e[3] != 255 {
                 continue;
