@@ -638,7 +638,9 @@ fn classify(
             if sides.y {
                 down3 = column(t10 + 1u, t11 + 1u, 3u, w, points);
             }
-        } else if interpolated {
+        } else if interpolated || any(agree) {
+            // Lines down the sides; at a refined half-block's agreeing top edge (fy = 0) or
+            // left edge (fx = 0) the line between those two corners.
             down1 = mix(c00, c01, fy);
             down2 = mix(c10, c11, fy);
         }
@@ -648,8 +650,7 @@ fn classify(
                 continue;
             }
             let i = index_of(p);
-            let on_edge = refine && on_agreeing_edge(p, first, agree);
-            if refine && !on_edge {
+            if refine && !on_agreeing_edge(p, first, agree) {
                 atomicStore(&work[slot], i);
                 slot += 1u;
                 continue;
@@ -663,9 +664,7 @@ fn classify(
             }
             let fx = f32(x - first.x) / span.x;
             var c = mix(down1, down2, fx);
-            if on_edge {
-                c = select(mix(c00, c01, fy), mix(c00, c10, fx), y == first.y);
-            } else if LEVEL == 0u {
+            if LEVEL == 0u {
                 c = clamp(spline(catmull_rom(fx), down0, down1, down2, down3, sides), low, high);
             }
             colour_out[i] = vec4<f32>(c, 1.0);
