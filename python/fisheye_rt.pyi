@@ -23,7 +23,7 @@ class Lens:
     """A lens at an image size: a classic model or a calibrated camera."""
 
     @staticmethod
-    def from_spec(spec: str, size: Tuple[int, int]) -> "Lens":
+    def from_spec(spec: str, size: Sequence[int]) -> "Lens":
         """A lens from its spec (`fisheye lens list`: "samyang-7.5mm",
         "equisolid:f=0.6,fov=180", "kb:fx=...,k1=...", or "prescription:FILE[,sensor=MM]
         [,fstop=N][,focus=METRES][,rays=glass|fit][,model=kb|ds|equidistant]" for a lens's
@@ -106,8 +106,9 @@ class Renderer:
         is released while the GPU works."""
 
 def look_at(
-    eye: Tuple[float, float, float],
-    target: Tuple[float, float, float],
-    up: Tuple[float, float, float] = (0.0, 1.0, 0.0),
+    eye: npt.ArrayLike,
+    target: npt.ArrayLike,
+    up: Optional[npt.ArrayLike] = None,
 ) -> npt.NDArray[np.float64]:
-    """The 4×4 T_scene_camera of a camera at `eye` looking at `target`, level with `up`."""
+    """The 4×4 T_scene_camera of a camera at `eye` looking at `target`, level with `up`
+    ((0, 1, 0) if None); each three finite numbers (a tuple, a list or a numpy array)."""

@@ -89,6 +89,25 @@ fn points_of<const N: usize>(
     Ok((shape[..shape.len() - 1].to_vec(), points))
 }
 
+/// One point of `N` finite numbers (a tuple, a list or a numpy array).
+fn point_of<const N: usize>(
+    array: &PyArrayLikeDyn<'_, f64, AllowTypeChange>,
+    what: &str,
+) -> PyResult<[f64; N]> {
+    let view = array.as_array();
+    let values: Vec<f64> = view.iter().copied().collect();
+    match <[f64; N]>::try_from(values) {
+        Ok(point) if view.ndim() == 1 && point.iter().all(|v| v.is_finite()) => Ok(point),
+        Ok(point) if view.ndim() == 1 => Err(PyValueError::new_err(format!(
+            "{what}={point:?}: give finite numbers"
+        ))),
+        _ => Err(PyValueError::new_err(format!(
+            "{what} has shape {:?}; give {N} numbers",
+            view.shape()
+        ))),
+    }
+}
+
 /// `values` as an array of shape `leading + (n,)`.
 fn array_of<'py>(
     py: Python<'py>,
@@ -113,10 +132,15 @@ impl Lens {
     /// `"equisolid:f=0.6,fov=180"`, `"kb:fx=...,k1=..."`, or
     /// `"prescription:FILE[,sensor=MM][,fstop=N][,focus=METRES][,rays=glass|fit][,model=kb|ds|equidistant]"`
     /// for a lens's glass: rendered through its surfaces, mapped by its chief rays) at
-    /// `size = (width, height)`.
+    /// `size = (width, height)` (a tuple, a list or a numpy array).
     #[staticmethod]
-    fn from_spec(spec: &str, size: (u32, u32)) -> PyResult<Self> {
-        let size = ImageSize::new(size.0, size.1).map_err(lens_error)?;
+    fn from_spec(spec: &str, size: Vec<u32>) -> PyResult<Self> {
+        let [width, height] = size[..] else {
+            return Err(PyValueError::new_err(format!(
+                "size={size:?}: give (width, height)"
+            )));
+        };
+        let size = ImageSize::new(width, height).map_err(lens_error)?;
         Ok(Self {
             camera: camera_for(spec, size).map_err(lens_error)?,
         })
@@ -281,18 +305,22 @@ impl Scene {
 }
 
 /// `T_scene_camera` (4×4, OpenCV camera frame) of a camera at `eye` looking at `target`, level
-/// with `up`.
+/// with `up` (`(0, 1, 0)` if not given); each three numbers, as a tuple, a list or a numpy array.
 #[pyfunction]
-#[pyo3(signature = (eye, target, up = (0.0, 1.0, 0.0)))]
+#[pyo3(signature = (eye, target, up = None))]
 fn look_at<'py>(
     py: Python<'py>,
-    eye: (f64, f64, f64),
-    target: (f64, f64, f64),
-    up: (f64, f64, f64),
+    eye: PyArrayLikeDyn<'py, f64, AllowTypeChange>,
+    target: PyArrayLikeDyn<'py, f64, AllowTypeChange>,
+    up: Option<PyArrayLikeDyn<'py, f64, AllowTypeChange>>,
 ) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+    let up = match up {
+        Some(up) => point_of::<3>(&up, "up")?,
+        None => [0.0, 1.0, 0.0],
+    };
     let camera = Camera {
-        position: eye.into(),
-        look_at: target.into(),
+        position: point_of::<3>(&eye, "eye")?.into(),
+        look_at: point_of::<3>(&target, "target")?.into(),
         up: up.into(),
     };
     if (camera.look_at - camera.position).length_squared() == 0.0 {

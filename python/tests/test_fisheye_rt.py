@@ -276,6 +276,21 @@ def test_the_camera_moves_without_uploading_the_scene_again(tmp_path):
     assert np.mean(ids == moved["id"]) > 0.999
 
 
+def test_poses_and_sizes_take_tuples_lists_and_arrays():
+    """A pose's points and a lens's size may be tuples, lists or numpy arrays (of floats or
+    integers): each gives the same as the tuple."""
+    pose = fr.look_at((1.0, 1.2, 2.0), (-1.0, 1.0, -2.0), (0.0, 1.0, 0.0))
+    assert np.array_equal(pose, fr.look_at([1.0, 1.2, 2.0], [-1, 1, -2]))
+    assert np.array_equal(pose, fr.look_at(np.array([1.0, 1.2, 2.0]), np.array([-1, 1, -2]), up=[0, 1, 0]))
+    # A camera at the origin looking down -z, level with +y: OpenCV's x right, y down, z forward.
+    assert np.allclose(
+        fr.look_at([0, 0, 0], [0, 0, -1]),
+        [[1, 0, 0, 0], [0, -1, 0, 0], [0, 0, -1, 0], [0, 0, 0, 1]],
+    )
+    assert fr.Lens.from_spec("samyang-7.5mm", size=[64, 48]).size == (64, 48)
+    assert fr.Lens.from_spec("samyang-7.5mm", size=np.array([64, 48])).size == (64, 48)
+
+
 def test_the_gil_is_released_while_the_gpu_renders():
     """Another Python thread runs while a render is in flight."""
     renderer = fr.Renderer(fr.Scene.load("builtin:default"))
@@ -311,6 +326,10 @@ def test_bad_input_raises_with_the_librarys_message(tmp_path):
         (lambda: fr.Scene.load("builtin:nope"), ValueError, "nope"),
         (lambda: fr.Renderer(fr.Scene.load("builtin:default"), bvh="best"), ValueError, "bvh"),
         (lambda: fr.look_at((0, 0, 0), (0, 0, 0)), ValueError, "same point"),
+        (lambda: fr.look_at((0, 0), (0, 0, 1)), ValueError, "eye"),
+        (lambda: fr.look_at((0, 0, 0), [[0, 0, 1]]), ValueError, "target"),
+        (lambda: fr.look_at((0, 0, 0), (0, 0, 1), up=(0, float("nan"), 0)), ValueError, "up"),
+        (lambda: fr.Lens.from_spec("samyang-7.5mm", size=(10, 10, 3)), ValueError, "size"),
     ]
     lens = fr.Lens.from_spec("samyang-7.5mm", size=(16, 12))
     cases += [
