@@ -12,8 +12,10 @@ use obvhs::cwbvh::node::CwBvhNode;
 use crate::clock::Stopwatch;
 use crate::error::{Error, Result};
 use crate::scene::Scene;
+pub(crate) mod binary;
 mod stages;
 mod sweep;
+pub mod unshadowed;
 
 pub use crate::shared::{GpuInstance, GpuTriangle, TRAVERSAL_STACK};
 use crate::shared::{InstanceKnot, KNOT_VEC4S};
@@ -106,6 +108,8 @@ pub struct SceneBvh {
     pub depth: u32,
     /// Time obvhs spent building.
     pub build_time: Duration,
+    /// The lights found to reach whole triangles ([`unshadowed::search`]; a flat scene's).
+    pub unshadowed: unshadowed::Unshadowed,
     /// What the top level is built from, where instances move: [`TopLevel::build`] rebuilds
     /// it for each time, into the first [`TopLevel::reserved`] nodes.
     pub top: Option<TopLevel>,
@@ -243,7 +247,7 @@ fn triangle_level(
                 v1: t[1].into(),
                 material: scene.material_of[stored],
                 v2: t[2].into(),
-                pad: 0,
+                unshadowed: 0,
             }
         })
         .collect();
@@ -297,6 +301,7 @@ impl SceneBvh {
     pub fn build(scene: &Scene, origin: DVec3, quality: BvhQuality) -> Result<Self> {
         let world = rounded(&scene.triangles[..scene.world_triangles], origin, 0)?;
         let mut build_time = Duration::ZERO;
+        let mut unshadowed = unshadowed::Unshadowed::default();
         if scene.is_empty() {
             return Ok(Self {
                 nodes: vec![CwBvhNode::default()],
@@ -305,11 +310,17 @@ impl SceneBvh {
                 origin,
                 depth: 1,
                 build_time,
+                unshadowed,
                 top: None,
             });
         }
         if !scene.is_instanced() {
-            let level = triangle_level(scene, &world, 0, quality, &mut build_time)?;
+            let mut level = triangle_level(scene, &world, 0, quality, &mut build_time)?;
+            let (lights, found) = unshadowed::search(scene);
+            for t in &mut level.leaves {
+                t.unshadowed = lights[t.triangle as usize];
+            }
+            unshadowed = found;
             return Ok(Self {
                 nodes: level.nodes,
                 triangles: level.leaves,
@@ -317,6 +328,7 @@ impl SceneBvh {
                 origin,
                 depth: level.depth,
                 build_time,
+                unshadowed,
                 top: None,
             });
         }
@@ -402,6 +414,7 @@ impl SceneBvh {
             origin,
             depth: depth.max(built.depth),
             build_time,
+            unshadowed,
             top: scene.moves().then_some(top),
         })
     }

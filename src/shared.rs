@@ -341,6 +341,10 @@ pub fn wgsl_nested_samples() -> String {
     )
 }
 
+/// The lights below this index can be marked as reaching every point of a triangle
+/// ([`GpuTriangle::unshadowed`], a bit each); shading traces the others' shadow rays always.
+pub const UNSHADOWED_LIGHTS: u32 = 32;
+
 /// The f32 constants every WGSL module sees, as `const NAME: f32` lines.
 pub fn wgsl_float_constants() -> [(&'static str, f32); 2] {
     [
@@ -361,6 +365,7 @@ pub fn wgsl_constants() -> Vec<(String, u32)> {
         ("MAX_DEPTH_LIMIT", MAX_DEPTH_LIMIT),
         ("NO_TEXTURE", NO_TEXTURE),
         ("MAX_SHADOW_LAYERS", MAX_SHADOW_LAYERS),
+        ("UNSHADOWED_LIGHTS", UNSHADOWED_LIGHTS),
         ("NO_HIT", NO_HIT),
         ("ADAPTIVE_BLOCK", ADAPTIVE_BLOCK),
         ("ADAPTIVE_STRIP", ADAPTIVE_STRIP),
@@ -551,8 +556,9 @@ pub struct GpuTriangle {
     pub material: u32,
     /// Third corner.
     pub v2: [f32; 3],
-    /// Padding to 16-byte alignment.
-    pub pad: u32,
+    /// The lights no other triangle stands between any point of it and (bit `k` for light
+    /// `k`, [`crate::bvh::unshadowed`]): shading skips their shadow rays.
+    pub unshadowed: u32,
 }
 
 const _: () = assert!(std::mem::size_of::<GpuTriangle>() == 48);

@@ -57,7 +57,8 @@ fn shadow_transmittance(origin: vec3<f32>, to_light: vec3<f32>, distance: f32) -
     return 0.0;
 }
 
-// Direct light at a diffuse surface: ambient, then each light through a shadow ray.
+// Direct light at a diffuse surface: ambient, then each light through a shadow ray, but for
+// the lights nothing stands between the surface's triangle and (`Surface::unshadowed`).
 fn direct_light(s: Surface, view: vec3<f32>) -> vec3<f32> {
     var colour = s.material.diffuse * shading.ambient;
     let origin = offset_origin(s.position, s.geometric);
@@ -66,7 +67,10 @@ fn direct_light(s: Surface, view: vec3<f32>) -> vec3<f32> {
         if !light.lit {
             continue;
         }
-        let transmittance = shadow_transmittance(origin, light.to_light, light.distance);
+        var transmittance = 1.0;
+        if i >= UNSHADOWED_LIGHTS || (s.unshadowed & (1u << i)) == 0u {
+            transmittance = shadow_transmittance(origin, light.to_light, light.distance);
+        }
         if transmittance > 0.0 {
             colour += reflected(s, view, light, transmittance);
         }

@@ -191,6 +191,8 @@ struct Surface {
     material: Material,
     // The scene triangle (as ids name it).
     triangle: u32,
+    // The lights that reach every point of it (`BvhTriangle::unshadowed`).
+    unshadowed: u32,
 }
 
 // A vertex normal of the hit's triangle in the world, unit length.
@@ -230,7 +232,8 @@ fn surface_at(ray: Ray, hit: Hit, lod: f32) -> Surface {
         let uv = w * a.xy + hit.u * a.zw + hit.v * b.xy;
         material.diffuse *= sample_texture(material, uv, lod);
     }
-    return Surface(position, geometric, normal, front, material, scene_triangle(hit.slot, hit.instance));
+    return Surface(position, geometric, normal, front, material, scene_triangle(hit.slot, hit.instance),
+        tri.unshadowed);
 }
 
 // A light as it arrives at a point: the unit vector towards it, its distance (3e38 for a

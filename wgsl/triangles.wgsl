@@ -3,14 +3,15 @@
 // types that the tracer, the shading code and the rasterizer share.
 
 // Mirrors `fisheye_rt::bvh::GpuTriangle` (48 bytes): corners (camera-relative, or in their
-// mesh's space in an instanced scene), the stored triangle it came from and its material.
+// mesh's space in an instanced scene), the stored triangle it came from, its material, and
+// the lights no other triangle stands between any point of it and (bit k for light k).
 struct BvhTriangle {
     v0: vec3<f32>,
     triangle: u32,
     v1: vec3<f32>,
     material: u32,
     v2: vec3<f32>,
-    pad: u32,
+    unshadowed: u32,
 }
 
 // `triangle_at(slot)` reads them from `bvh_triangles` (group 1, binding 1) and, in a scene

@@ -16,7 +16,7 @@ fn gpu_structs_match_their_wgsl_twins() {
             ("v1", offset_of!(GpuTriangle, v1)),
             ("material", offset_of!(GpuTriangle, material)),
             ("v2", offset_of!(GpuTriangle, v2)),
-            ("pad", offset_of!(GpuTriangle, pad)),
+            ("unshadowed", offset_of!(GpuTriangle, unshadowed)),
         ],
     );
     assert_wgsl_layout(

@@ -201,6 +201,8 @@ pub struct GpuScene {
     pub bvh_depth: u32,
     /// obvhs's build time.
     pub bvh_build_time: std::time::Duration,
+    /// The lights found to reach whole triangles, whose shadow rays shading skips.
+    pub unshadowed: crate::bvh::unshadowed::Unshadowed,
     /// The acceleration structure, with [`Traversal::RayQuery`].
     pub ray_query: Option<RayQueryScene>,
     /// What the scene's buffers hold on the device.
@@ -424,6 +426,7 @@ impl GpuScene {
                 bvh_nodes: bvh.nodes.len(),
                 bvh_depth: bvh.depth,
                 bvh_build_time: bvh.build_time,
+                unshadowed: bvh.unshadowed,
                 bytes,
                 frame,
                 moving: bvh.top.map(|top| (top, nodes[0].clone(), records.clone())),

@@ -463,6 +463,15 @@ pub(crate) fn scene_report(spec: &str, scene: &Scene, gpu: &GpuScene, bvh: BvhQu
         gpu.bvh_depth,
         gpu.bvh_build_time.as_secs_f64() * 1e3
     );
+    let found = gpu.unshadowed;
+    if found.pairs > 0 {
+        out += &format!(
+            "shadows: the lights reach every point of {:.0}% of (triangle, light) pairs, whose \
+             shadow rays are skipped; found in {:.0} ms\n",
+            100.0 * found.open as f64 / found.pairs as f64,
+            found.time.as_secs_f64() * 1e3
+        );
+    }
     let bytes = gpu.bytes;
     let per = |b: u64| b as f64 / f64::from(gpu.triangles.max(1));
     let mib = |b: u64| b as f64 / f64::from(1 << 20);

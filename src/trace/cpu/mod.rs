@@ -7,14 +7,16 @@
 //! instances that place meshes, whose rays it maps into the mesh's space with the f32 maps the
 //! GPU gets. Rays come from the f64 lens reference.
 
+mod affine;
 mod surface;
-mod tree;
 
 pub(super) use surface::srgb_to_linear;
 
+use affine::*;
 use glam::{DMat3, DVec2, DVec3, Vec3};
 use surface::*;
-use tree::*;
+
+use crate::bvh::binary::Tree;
 
 use super::{MAX_DEPTH_LIMIT, MAX_SHADOW_LAYERS, NO_HIT, RenderOutput};
 use crate::lens::LensCamera;
