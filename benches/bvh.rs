@@ -39,7 +39,9 @@ fn build(c: &mut Criterion) {
                 BenchmarkId::from_parameter(quality.name()),
                 &quality,
                 |b, &q| {
-                    b.iter(|| SceneBvh::build(black_box(&scene), scene.camera.position, q).unwrap())
+                    b.iter(|| {
+                        SceneBvh::build(black_box(&scene), scene.camera.position, q, false).unwrap()
+                    })
                 },
             );
         }

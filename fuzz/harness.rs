@@ -159,7 +159,7 @@ fn check_scene(scene: &Scene) {
     }
     let c = &scene.camera;
     assert!(c.position.is_finite() && c.look_at.is_finite() && c.up.is_finite());
-    let _ = SceneBvh::build(scene, c.position, BvhQuality::Fast);
+    let _ = SceneBvh::build(scene, c.position, BvhQuality::Fast, true);
     if let Ok((lights, _)) = gpu_lights(scene, c.position) {
         for l in lights {
             assert!(

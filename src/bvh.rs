@@ -297,8 +297,9 @@ pub(crate) fn gpu_instance(
 }
 
 impl SceneBvh {
-    /// Builds the BVH of `scene` relative to `origin`.
-    pub fn build(scene: &Scene, origin: DVec3, quality: BvhQuality) -> Result<Self> {
+    /// Builds the BVH of `scene` relative to `origin`; for a flat scene that rays shade
+    /// (`shaded`), with the lights that reach whole triangles ([`unshadowed`]).
+    pub fn build(scene: &Scene, origin: DVec3, quality: BvhQuality, shaded: bool) -> Result<Self> {
         let world = rounded(&scene.triangles[..scene.world_triangles], origin, 0)?;
         let mut build_time = Duration::ZERO;
         let mut unshadowed = unshadowed::Unshadowed::default();
@@ -316,11 +317,9 @@ impl SceneBvh {
         }
         if !scene.is_instanced() {
             let mut level = triangle_level(scene, &world, 0, quality, &mut build_time)?;
-            let (lights, found) = unshadowed::search(scene);
-            for t in &mut level.leaves {
-                t.unshadowed = lights[t.triangle as usize];
+            if shaded {
+                unshadowed = unshadowed::mark(scene, &mut level.leaves);
             }
-            unshadowed = found;
             return Ok(Self {
                 nodes: level.nodes,
                 triangles: level.leaves,
@@ -627,7 +626,7 @@ mod tests {
             up: DVec3::Y,
         };
         let scene = b.finish(Vec::new(), Vec3::ZERO, Vec3::ZERO, camera);
-        let message = SceneBvh::build(&scene, scene.camera.position, BvhQuality::Fast)
+        let message = SceneBvh::build(&scene, scene.camera.position, BvhQuality::Fast, false)
             .err()
             .expect("refused")
             .to_string();
@@ -660,7 +659,7 @@ mod tests {
                 up: DVec3::Y,
             };
             let scene = b.finish(Vec::new(), Vec3::ZERO, Vec3::ZERO, camera);
-            SceneBvh::build(&scene, scene.camera.position, BvhQuality::Fast).map(|b| b.depth)
+            SceneBvh::build(&scene, scene.camera.position, BvhQuality::Fast, false).map(|b| b.depth)
         };
         // 2^69 (with its 10% triangle) panicked inside obvhs; 2^58 is within 1e18.
         let message = chain(69).expect_err("refused").to_string();

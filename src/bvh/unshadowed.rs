@@ -19,7 +19,7 @@ use glam::DVec3;
 
 use super::binary::Tree;
 use crate::scene::{Light, Scene};
-use crate::shared::UNSHADOWED_LIGHTS;
+use crate::shared::{GpuTriangle, UNSHADOWED_LIGHTS};
 
 /// What [`search`] found in a scene, and what it took.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -52,6 +52,16 @@ pub fn search(scene: &Scene) -> (Vec<u32>, Unshadowed) {
         time: started.elapsed(),
     };
     (lights, summary)
+}
+
+/// Sets each of a flat `scene`'s BVH triangles' [`GpuTriangle::unshadowed`] from
+/// [`search`], and returns what that found.
+pub fn mark(scene: &Scene, leaves: &mut [GpuTriangle]) -> Unshadowed {
+    let (lights, found) = search(scene);
+    for t in leaves {
+        t.unshadowed = lights[t.triangle as usize];
+    }
+    found
 }
 
 /// For each of `scene`'s world triangles, the lights (bit `k` for light `k` below

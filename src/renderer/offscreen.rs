@@ -328,7 +328,7 @@ impl SceneSet {
                     traversal: Traversal::Software,
                     ..*options
                 };
-                GpuScene::new(
+                GpuScene::for_rasterizer(
                     ctx,
                     &scene.flattened(crate::scene::MAX_FLATTENED)?,
                     &options,

@@ -237,6 +237,26 @@ impl SceneBytes {
 impl GpuScene {
     /// Builds the BVH and uploads everything, relative to the scene camera's position.
     pub fn new(ctx: &GpuContext, scene: &Scene, options: &RenderOptions) -> Result<Self> {
+        Self::upload(ctx, scene, options, true)
+    }
+
+    /// As [`GpuScene::new`], for a scene only the rasterized cube faces draw (they read
+    /// shadow maps): no search for the lights that reach whole triangles
+    /// ([`crate::bvh::unshadowed`]), which only shading by rays uses.
+    pub fn for_rasterizer(
+        ctx: &GpuContext,
+        scene: &Scene,
+        options: &RenderOptions,
+    ) -> Result<Self> {
+        Self::upload(ctx, scene, options, false)
+    }
+
+    fn upload(
+        ctx: &GpuContext,
+        scene: &Scene,
+        options: &RenderOptions,
+        shaded: bool,
+    ) -> Result<Self> {
         if options.max_depth > MAX_DEPTH_LIMIT {
             return Err(Error::Limit(format!(
                 "max depth {} is above the limit of {MAX_DEPTH_LIMIT}",
@@ -266,7 +286,7 @@ impl GpuScene {
             |nodes, triangles| SceneArrays::plan(binding_limit, nodes, triangles, vertex_vectors);
         check_bindings(ctx, &plan(0, stored), stored)?;
         let origin = scene.camera.position;
-        let bvh = SceneBvh::build(scene, origin, options.bvh)?;
+        let bvh = SceneBvh::build(scene, origin, options.bvh, shaded)?;
         let arrays = plan(bvh.nodes.len() as u64, bvh.triangles.len() as u64);
         check_bindings(ctx, &arrays, stored)?;
         // The scene's records (`records` in wgsl/triangles.wgsl), in vec4s of words: the

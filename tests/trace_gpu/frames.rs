@@ -111,7 +111,7 @@ fn bvh_as_deep_as_the_stack_renders_and_deeper_is_refused() {
     use fisheye_rt::bvh::{BvhQuality, SceneBvh, TRAVERSAL_STACK};
     let full = nested_triangles(227);
     let depth = |scene: &fisheye_rt::scene::Scene| {
-        SceneBvh::build(scene, scene.camera.position, BvhQuality::Fast).map(|b| b.depth)
+        SceneBvh::build(scene, scene.camera.position, BvhQuality::Fast, false).map(|b| b.depth)
     };
     assert_eq!(depth(&full).unwrap(), TRAVERSAL_STACK);
     let (gpu, cpu) = both(&full, &camera("rectilinear:f=0.8", 64, 48));
