@@ -92,14 +92,20 @@ impl Tree {
         visit: &mut dyn FnMut(u32) -> bool,
     ) {
         let inv = DVec3::ONE / dir;
-        self.any(&|lo, hi| box_hit(lo, hi, origin, inv, tmin, limit()), visit);
+        self.any(
+            &|lo, hi| box_hit(lo, hi, origin, inv, tmin, limit()),
+            None,
+            visit,
+        );
     }
 
     /// Whether `visit` returns true for an id whose leaf `reach` admits (a box it may meet),
-    /// down inner nodes `reach` admits; it stops at the first.
+    /// down inner nodes `reach` admits; it stops at the first. With a point `near`, of two
+    /// children the one whose box's centre is nearer it is visited first.
     pub(crate) fn any(
         &self,
         reach: &dyn Fn(DVec3, DVec3) -> bool,
+        near: Option<DVec3>,
         visit: &mut dyn FnMut(u32) -> bool,
     ) -> bool {
         // Depth-first, at most a node a level and its sibling waiting: 64 levels hold any
@@ -127,14 +133,31 @@ impl Tree {
                     right,
                 } => {
                     if reach(lo, hi) {
-                        stack[waiting] = left;
-                        stack[waiting + 1] = right;
+                        // The second pushed is the first visited.
+                        let (later, sooner) = match near {
+                            Some(p)
+                                if self.centre(left).distance_squared(p)
+                                    < self.centre(right).distance_squared(p) =>
+                            {
+                                (right, left)
+                            }
+                            _ => (left, right),
+                        };
+                        stack[waiting] = later;
+                        stack[waiting + 1] = sooner;
                         waiting += 2;
                     }
                 }
             }
         }
         false
+    }
+
+    /// The centre of node `index`'s box.
+    fn centre(&self, index: u32) -> DVec3 {
+        match self.nodes[index as usize] {
+            Node::Leaf { lo, hi, .. } | Node::Inner { lo, hi, .. } => (lo + hi) * 0.5,
+        }
     }
 }
 

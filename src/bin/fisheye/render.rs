@@ -464,13 +464,30 @@ pub(crate) fn scene_report(spec: &str, scene: &Scene, gpu: &GpuScene, bvh: BvhQu
         gpu.bvh_build_time.as_secs_f64() * 1e3
     );
     let found = gpu.unshadowed;
+    let unsearched = match found.unsearched {
+        0 => String::new(),
+        n => format!(
+            "{n} light{} left out ({} triangles a light would take the search past its {} \
+             pairs), whose shadow rays are all traced",
+            if n == 1 { "" } else { "s" },
+            scene.world_triangles,
+            fisheye_rt::bvh::unshadowed::SEARCH_PAIRS,
+        ),
+    };
     if found.pairs > 0 {
         out += &format!(
             "shadows: the lights reach every point of {:.0}% of (triangle, light) pairs, whose \
-             shadow rays are skipped; found in {:.0} ms\n",
+             shadow rays are skipped; found in {:.0} ms{}\n",
             100.0 * found.open as f64 / found.pairs as f64,
-            found.time.as_secs_f64() * 1e3
+            found.time.as_secs_f64() * 1e3,
+            if unsearched.is_empty() {
+                String::new()
+            } else {
+                format!("; {unsearched}")
+            }
         );
+    } else if !unsearched.is_empty() {
+        out += &format!("shadows: {unsearched}\n");
     }
     let bytes = gpu.bytes;
     let per = |b: u64| b as f64 / f64::from(gpu.triangles.max(1));
