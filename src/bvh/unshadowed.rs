@@ -25,9 +25,13 @@ use crate::shared::{GpuTriangle, UNSHADOWED_LIGHTS};
 
 /// The most (triangle, light) pairs the search looks at in one scene (2^20): about 3 s of
 /// two cores at 2.5 to 3 µs a pair, some five times what building the BVH of a million
-/// triangles takes on them. Lights are searched in order while their pairs fit; a scene of
-/// more triangles searches none.
-pub const SEARCH_PAIRS: u64 = 1 << 20;
+/// triangles takes on them; in WebAssembly, which searches on one thread, 2^18. Lights are
+/// searched in order while their pairs fit; a scene of more triangles searches none.
+pub const SEARCH_PAIRS: u64 = if cfg!(target_arch = "wasm32") {
+    1 << 18
+} else {
+    1 << 20
+};
 
 /// What [`search`] found in a scene, and what it took.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
