@@ -62,6 +62,7 @@ pub mod scene;
 pub mod shader;
 pub mod shared;
 pub mod split;
+mod threads;
 pub mod trace;
 
 // The tools of the `fisheye` command (the default `cli` feature).

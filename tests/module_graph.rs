@@ -285,8 +285,9 @@ fn a_cycle_is_found() {
 /// The layers, lowest first: a module may read its own layer's and lower ones. A module's
 /// layer is that of its top-level folder (`lens::gpu` is `lens`'s).
 const LAYERS: [&[&str]; 8] = [
-    // What the GPU and Rust share, and a clock that works in a web page, read by everything.
-    &["shared", "split", "clock"],
+    // What the GPU and Rust share, and a clock and threads that work in a web page, read by
+    // everything.
+    &["shared", "split", "clock", "threads"],
     // Shader assembly, errors, bounded input, rigid transforms.
     &["shader", "error", "input", "pose"],
     // Lens models, the device, and its trigonometry measured.

@@ -112,13 +112,7 @@ fn unshadowed_lights(scene: &Scene, searched: &[usize]) -> Vec<u32> {
         let [a, b, c] = corners(i);
         (a.min(b).min(c), a.max(b).max(c))
     });
-    let threads = if cfg!(target_arch = "wasm32") {
-        1
-    } else {
-        std::thread::available_parallelism().map_or(1, |n| n.get())
-    };
-    let chunk = lights.len().div_ceil(threads).max(1);
-    let classify = |first: usize, out: &mut [u32]| {
+    crate::threads::in_parts(&mut lights, |first, out| {
         // Each light's last blocker, tried first: neighbouring triangles (a mesh's are
         // stored together) are often blocked by the same one.
         let mut last = vec![None; searched.len()];
@@ -162,16 +156,7 @@ fn unshadowed_lights(scene: &Scene, searched: &[usize]) -> Vec<u32> {
                 }
             }
         }
-    };
-    if threads == 1 {
-        classify(0, &mut lights);
-    } else {
-        std::thread::scope(|s| {
-            for (c, out) in lights.chunks_mut(chunk).enumerate() {
-                s.spawn(move || classify(c * chunk, out));
-            }
-        });
-    }
+    });
     lights
 }
 

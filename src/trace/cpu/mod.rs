@@ -311,32 +311,19 @@ impl<'a> Reference<'a> {
     pub fn render_samples(&self, camera: &LensCamera, samples_per_side: u32) -> RenderOutput {
         let size = camera.size;
         let directions = camera.directions();
-        let threads = std::thread::available_parallelism().map_or(1, |n| n.get());
-        let chunk = directions.len().div_ceil(threads).max(1);
         let mut pixels = vec![([0.0f32; 4], [0.0f32; 4], NO_HIT); directions.len()];
-        std::thread::scope(|s| {
-            for (c, (out, dirs)) in pixels
-                .chunks_mut(chunk)
-                .zip(directions.chunks(chunk))
-                .enumerate()
-            {
-                s.spawn(move || {
-                    for (j, (o, d)) in out.iter_mut().zip(dirs).enumerate() {
-                        let index = c * chunk + j;
-                        let width = size.width as usize;
-                        let centre =
-                            DVec2::new((index % width) as f64, (index / width) as f64) + 0.5;
-                        *o = match d {
-                            Some(d) => {
-                                self.pixel(self.rotation * *d, self.spread(camera, centre, *d, 1.0))
-                            }
-                            None => ([0.0; 4], [0.0; 4], NO_HIT),
-                        };
-                        if samples_per_side > 1 {
-                            o.0 = self.samples(camera, c * chunk + j, samples_per_side);
-                        }
-                    }
-                });
+        crate::threads::in_parts(&mut pixels, |first, out| {
+            for (j, (o, d)) in out.iter_mut().zip(&directions[first..]).enumerate() {
+                let index = first + j;
+                let width = size.width as usize;
+                let centre = DVec2::new((index % width) as f64, (index / width) as f64) + 0.5;
+                *o = match d {
+                    Some(d) => self.pixel(self.rotation * *d, self.spread(camera, centre, *d, 1.0)),
+                    None => ([0.0; 4], [0.0; 4], NO_HIT),
+                };
+                if samples_per_side > 1 {
+                    o.0 = self.samples(camera, index, samples_per_side);
+                }
             }
         });
         RenderOutput {
