@@ -29,55 +29,6 @@ fn offset_origin(p: vec3<f32>, n: vec3<f32>) -> vec3<f32> {
     return select(p_i, p + (1.0 / 65536.0) * n, abs(p) < vec3<f32>(1.0 / 32.0));
 }
 
-// The fraction of a light's irradiance that reaches `origin`: 0 or 1 through opaque scenes;
-// through partially transparent diffuse surfaces the product of their (1 - opacity), nearest
-// first, up to MAX_SHADOW_LAYERS of them.
-fn shadow_transmittance(origin: vec3<f32>, to_light: vec3<f32>, distance: f32) -> f32 {
-    if !HAS_TRANSLUCENT {
-        return select(1.0, 0.0, bvh_trace(Ray(origin, to_light, 0.0, distance), true).slot != NO_HIT);
-    }
-    var o = origin;
-    var remaining = distance;
-    var transmittance = 1.0;
-    for (var layer = 0u; layer <= MAX_SHADOW_LAYERS; layer++) {
-        let hit = bvh_trace(Ray(o, to_light, 0.0, remaining), false);
-        if hit.slot == NO_HIT {
-            return transmittance;
-        }
-        let tri = triangle_at(hit.slot);
-        let m = material_at(tri.material);
-        transmittance *= 1.0 - m.opacity;
-        if m.surface != SURFACE_DIFFUSE || transmittance < MIN_WEIGHT || layer == MAX_SHADOW_LAYERS {
-            return 0.0;
-        }
-        let n = hit_face_normal(hit);
-        o = offset_origin(hit_position(hit), select(-n, n, dot(n, to_light) > 0.0));
-        remaining -= hit.t;
-    }
-    return 0.0;
-}
-
-// Direct light at a diffuse surface: ambient, then each light through a shadow ray, but for
-// the lights nothing stands between the surface's triangle and (`Surface::unshadowed`).
-fn direct_light(s: Surface, view: vec3<f32>) -> vec3<f32> {
-    var colour = s.material.diffuse * shading.ambient;
-    let origin = offset_origin(s.position, s.geometric);
-    for (var i = 0u; i < shading.light_count; i++) {
-        let light = incident(s, origin, light_at(i));
-        if !light.lit {
-            continue;
-        }
-        var transmittance = 1.0;
-        if i >= UNSHADOWED_LIGHTS || (s.unshadowed & (1u << i)) == 0u {
-            transmittance = shadow_transmittance(origin, light.to_light, light.distance);
-        }
-        if transmittance > 0.0 {
-            colour += reflected(s, view, light, transmittance);
-        }
-    }
-    return colour;
-}
-
 struct Pending {
     origin: vec3<f32>,
     depth: u32,
@@ -127,18 +78,116 @@ fn first_hit(primary: Ray) -> Traced {
     return out;
 }
 
+// The diffuse surface whose lights `shade` is gathering, a shadow ray at a time: what
+// `reflected` needs of it, the weight its light takes in the pixel, the light gathered so far
+// (ambient first), the next light to look at and, while a shadow ray is under way toward it,
+// that ray's state. Through partially transparent diffuse surfaces a shadow ray goes on past
+// each (nearest first, up to MAX_SHADOW_LAYERS of them), its transmittance the product of
+// their (1 - opacity); through opaque scenes it stops at any hit.
+struct Lighting {
+    surface: Surface,
+    view: vec3<f32>,
+    weight: vec3<f32>,
+    gathered: vec3<f32>,
+    origin: vec3<f32>,
+    next: u32,
+    incident: Incident,
+    shadow_origin: vec3<f32>,
+    remaining: f32,
+    transmittance: f32,
+    layer: u32,
+    shadowing: bool,
+}
+
+// Moves `l` on to its next shadow ray: the lights the surface faces, but for those nothing
+// stands between its triangle and (`Surface::unshadowed`), whose light it gathers at once.
+// False once every light is looked at.
+fn next_shadow_ray(l: ptr<function, Lighting>) -> bool {
+    for (; (*l).next < shading.light_count; (*l).next++) {
+        let i = (*l).next;
+        let light = incident((*l).surface, (*l).origin, light_at(i));
+        if !light.lit {
+            continue;
+        }
+        if i < UNSHADOWED_LIGHTS && ((*l).surface.unshadowed & (1u << i)) != 0u {
+            (*l).gathered += reflected((*l).surface, (*l).view, light, 1.0);
+            continue;
+        }
+        (*l).incident = light;
+        (*l).shadow_origin = (*l).origin;
+        (*l).remaining = light.distance;
+        (*l).transmittance = 1.0;
+        (*l).layer = 0u;
+        return true;
+    }
+    return false;
+}
+
+// Takes the hit of `l`'s shadow ray: true while the ray goes on (past a partially
+// transparent diffuse surface); else its light, dimmed by what it passed, is gathered.
+fn shadow_goes_on(l: ptr<function, Lighting>, hit: Hit) -> bool {
+    if hit.slot != NO_HIT {
+        if !HAS_TRANSLUCENT {
+            (*l).transmittance = 0.0;
+        } else {
+            let m = material_at(triangle_at(hit.slot).material);
+            (*l).transmittance *= 1.0 - m.opacity;
+            if m.surface != SURFACE_DIFFUSE || (*l).transmittance < MIN_WEIGHT
+                || (*l).layer == MAX_SHADOW_LAYERS {
+                (*l).transmittance = 0.0;
+            } else {
+                let n = hit_face_normal(hit);
+                let to_light = (*l).incident.to_light;
+                (*l).shadow_origin = offset_origin(hit_position(hit), select(-n, n, dot(n, to_light) > 0.0));
+                (*l).remaining -= hit.t;
+                (*l).layer += 1u;
+                return true;
+            }
+        }
+    }
+    if (*l).transmittance > 0.0 {
+        (*l).gathered += reflected((*l).surface, (*l).view, (*l).incident, (*l).transmittance);
+    }
+    (*l).next += 1u;
+    return false;
+}
+
 // Whitted's recursion as a loop over a stack of pending rays (depth-first; a binary tree of
-// depth MAX_DEPTH_LIMIT needs one more entry than its depth).
+// depth MAX_DEPTH_LIMIT needs one more entry than its depth), each diffuse surface's shadow
+// rays traced before the next pending ray. Every ray, shadow rays too, is traced at the one
+// `bvh_trace` call: a GPU compiles each call site's traversal anew (lavapipe takes seconds
+// for each), and lanes tracing different kinds of ray still share its iterations.
 fn shade(primary: Ray) -> Traced {
     var out = Traced(vec3<f32>(0.0), Hit(0.0, 0.0, 0.0, NO_HIT, 0u), vec3<f32>(0.0), NO_HIT);
     var stack: array<Pending, MAX_DEPTH_LIMIT + 1u>;
     stack[0] = Pending(primary.origin, 0u, primary.dir, vec3<f32>(1.0));
     var count = 1u;
-    while count > 0u {
-        count -= 1u;
-        let ray_in = stack[count];
-        let ray = Ray(ray_in.origin, ray_in.dir, 0.0, 3.0e38);
-        let hit = bvh_trace(ray, false);
+    var l: Lighting;
+    var lighting = false;
+    loop {
+        if lighting && !l.shadowing {
+            l.shadowing = next_shadow_ray(&l);
+            if !l.shadowing {
+                out.colour += l.weight * l.gathered;
+                lighting = false;
+            }
+        }
+        var ray: Ray;
+        var ray_in: Pending;
+        if l.shadowing {
+            ray = Ray(l.shadow_origin, l.incident.to_light, 0.0, l.remaining);
+        } else if count > 0u {
+            count -= 1u;
+            ray_in = stack[count];
+            ray = Ray(ray_in.origin, ray_in.dir, 0.0, 3.0e38);
+        } else {
+            break;
+        }
+        let hit = bvh_trace(ray, l.shadowing && !HAS_TRANSLUCENT);
+        if l.shadowing {
+            l.shadowing = shadow_goes_on(&l, hit);
+            continue;
+        }
         if hit.slot == NO_HIT {
             out.colour += ray_in.weight * shading.sky;
             continue;
@@ -190,7 +239,15 @@ fn shade(primary: Ray) -> Traced {
                 count += 1u;
             }
         } else {
-            out.colour += surface_weight * direct_light(s, ray.dir);
+            // Direct light: ambient, then each light through a shadow ray (the iterations
+            // that follow).
+            l.surface = s;
+            l.view = ray.dir;
+            l.weight = surface_weight;
+            l.gathered = s.material.diffuse * shading.ambient;
+            l.origin = offset_origin(s.position, s.geometric);
+            l.next = 0u;
+            lighting = true;
         }
     }
     return out;

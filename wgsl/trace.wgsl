@@ -19,26 +19,25 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     let index = pixel.y * lens.width + pixel.x;
     let stored = index - frame.offset.w * lens.width;
     let ray = primary_ray(pixel);
-    if ray.w == 0.0 {
-        colour_out[stored] = vec4<f32>(0.0);
-        if SAMPLES_PER_SIDE > 1u && !GLASS {
-            colour_out[stored] = supersampled(pixel, index);
+    // The samples make the colour where there are several (or the glass), also in a pixel
+    // whose centre the lens masks but whose samples it may not; the centre (the glass's
+    // fitted model's) gives the ground truth, its hit alone. Each kernel calls the tracer
+    // from as few places as it can: every call is compiled anew (lavapipe takes seconds).
+    let sampled = GLASS || SAMPLES_PER_SIDE > 1u;
+    var traced = Traced(vec3<f32>(0.0), Hit(0.0, 0.0, 0.0, NO_HIT, 0u), vec3<f32>(0.0), NO_HIT);
+    if ray.w != 0.0 {
+        let centre = centre_ray(pixel, ray.xyz);
+        if sampled {
+            traced = first_hit(centre);
+        } else {
+            traced = shade_centre(pixel, ray.xyz);
         }
-        geometry_out[stored] = vec4<f32>(0.0);
-        ids_out[stored] = NO_HIT;
-        return;
     }
-    let centre = centre_ray(pixel, ray.xyz);
-    var traced: Traced;
-    if GLASS || SAMPLES_PER_SIDE > 1u {
-        // The samples make the colour (through the glass, where there is one); the centre
-        // (the glass's fitted model's) gives the ground truth, its hit alone.
-        traced = first_hit(centre);
-        colour_out[stored] = supersampled(pixel, index);
-    } else {
-        traced = shade_centre(pixel, ray.xyz);
-        colour_out[stored] = vec4<f32>(traced.colour, 1.0);
+    var colour = vec4<f32>(traced.colour, select(0.0, 1.0, ray.w != 0.0));
+    if sampled && (ray.w != 0.0 || !GLASS) {
+        colour = supersampled(pixel, index);
     }
+    colour_out[stored] = colour;
     geometry_out[stored] = geometry_of(traced);
     ids_out[stored] = traced.triangle;
 }

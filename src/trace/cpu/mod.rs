@@ -575,7 +575,7 @@ impl<'a> Reference<'a> {
 }
 
 impl Reference<'_> {
-    /// As `shadow_transmittance` in `wgsl/shade.wgsl`: the product of (1 - opacity) over the
+    /// As a shadow ray of `shade` in `wgsl/shade.wgsl` (`shadow_goes_on`): the product of (1 - opacity) over the
     /// partially transparent diffuse surfaces between `origin` and the light.
     fn shadow_transmittance(&self, origin: DVec3, to_light: DVec3, distance: f64) -> f64 {
         if !self.features.translucent {
