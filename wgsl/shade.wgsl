@@ -64,10 +64,15 @@ struct Traced {
     triangle: u32,
 }
 
+// What a ray that hits nothing sees: no colour, no hit.
+fn missed() -> Traced {
+    return Traced(vec3<f32>(0.0), Hit(0.0, 0.0, 0.0, NO_HIT, 0u), vec3<f32>(0.0), NO_HIT);
+}
+
 // A primary ray's closest hit and its surface, unshaded (colour zero): the ground truth at a
 // pixel's centre when its colour comes from several samples.
 fn first_hit(primary: Ray) -> Traced {
-    var out = Traced(vec3<f32>(0.0), Hit(0.0, 0.0, 0.0, NO_HIT, 0u), vec3<f32>(0.0), NO_HIT);
+    var out = missed();
     let hit = bvh_trace(primary, false);
     if hit.slot != NO_HIT {
         let s = surface_at(primary, hit, 0.0);
@@ -158,7 +163,7 @@ fn shadow_goes_on(l: ptr<function, Lighting>, hit: Hit) -> bool {
 // `bvh_trace` call: a GPU compiles each call site's traversal anew (lavapipe takes seconds
 // for each), and lanes tracing different kinds of ray still share its iterations.
 fn shade(primary: Ray) -> Traced {
-    var out = Traced(vec3<f32>(0.0), Hit(0.0, 0.0, 0.0, NO_HIT, 0u), vec3<f32>(0.0), NO_HIT);
+    var out = missed();
     var stack: array<Pending, MAX_DEPTH_LIMIT + 1u>;
     stack[0] = Pending(primary.origin, 0u, primary.dir, vec3<f32>(1.0));
     var count = 1u;

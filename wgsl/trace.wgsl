@@ -24,11 +24,10 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     // fitted model's) gives the ground truth, its hit alone. Each kernel calls the tracer
     // from as few places as it can: every call is compiled anew (lavapipe takes seconds).
     let sampled = GLASS || SAMPLES_PER_SIDE > 1u;
-    var traced = Traced(vec3<f32>(0.0), Hit(0.0, 0.0, 0.0, NO_HIT, 0u), vec3<f32>(0.0), NO_HIT);
+    var traced = missed();;
     if ray.w != 0.0 {
-        let centre = centre_ray(pixel, ray.xyz);
         if sampled {
-            traced = first_hit(centre);
+            traced = first_hit(centre_ray(pixel, ray.xyz));
         } else {
             traced = shade_centre(pixel, ray.xyz);
         }

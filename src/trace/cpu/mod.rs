@@ -575,8 +575,9 @@ impl<'a> Reference<'a> {
 }
 
 impl Reference<'_> {
-    /// As a shadow ray of `shade` in `wgsl/shade.wgsl` (`shadow_goes_on`): the product of (1 - opacity) over the
-    /// partially transparent diffuse surfaces between `origin` and the light.
+    /// As a shadow ray of `shade` in `wgsl/shade.wgsl` (`shadow_goes_on`): the product of
+    /// (1 - opacity) over the partially transparent diffuse surfaces between `origin` and the
+    /// light.
     fn shadow_transmittance(&self, origin: DVec3, to_light: DVec3, distance: f64) -> f64 {
         if !self.features.translucent {
             return match self.trace(origin, to_light, 0.0, distance, true) {
