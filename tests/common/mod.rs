@@ -3,16 +3,37 @@
 #![allow(dead_code)]
 
 use std::path::{Path, PathBuf};
-use std::sync::OnceLock;
+use std::sync::Mutex;
 
 use fisheye_rt::gpu::GpuContext;
 use fisheye_rt::lens::{ImageSize, LensCamera, parse_spec};
 use fisheye_rt::scene::Scene;
 use fisheye_rt::trace::{NO_HIT, RenderOptions, RenderOutput, cpu::Reference, render};
 
+/// The device of the calling test's thread. Each test thread holds its own while it runs and
+/// hands it on when it ends, so as many devices exist as tests run at once (cargo's
+/// `--test-threads`, the cores by default). One device for them all would serialize them:
+/// lavapipe compiles a pipeline at its first dispatch, on the device's one queue thread, and
+/// compiling is most of these tests' time (`adaptive_gpu` from an empty shader cache on a
+/// 2-core AMD EPYC: 254 s with one device, using 1.2 of the 2 cores; 172 s with one a thread).
 pub fn ctx() -> &'static GpuContext {
-    static CTX: OnceLock<GpuContext> = OnceLock::new();
-    CTX.get_or_init(|| GpuContext::new().expect("these tests need a GPU adapter (or lavapipe)"))
+    static FREE: Mutex<Vec<&'static GpuContext>> = Mutex::new(Vec::new());
+    struct Held(&'static GpuContext);
+    impl Drop for Held {
+        fn drop(&mut self) {
+            FREE.lock().unwrap_or_else(|e| e.into_inner()).push(self.0);
+        }
+    }
+    thread_local! {
+        static HELD: Held = Held({
+            let free = FREE.lock().unwrap_or_else(|e| e.into_inner()).pop();
+            free.unwrap_or_else(|| {
+                let made = GpuContext::new().expect("these tests need a GPU adapter (or lavapipe)");
+                Box::leak(Box::new(made))
+            })
+        });
+    }
+    HELD.with(|held| held.0)
 }
 
 pub fn camera(spec: &str, w: u32, h: u32) -> LensCamera {
