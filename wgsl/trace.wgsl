@@ -24,7 +24,7 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     // fitted model's) gives the ground truth, its hit alone. Each kernel calls the tracer
     // from as few places as it can: every call is compiled anew (lavapipe takes seconds).
     let sampled = GLASS || SAMPLES_PER_SIDE > 1u;
-    var traced = missed();;
+    var traced = missed();
     if ray.w != 0.0 {
         if sampled {
             traced = first_hit(centre_ray(pixel, ray.xyz));
