@@ -360,7 +360,8 @@ fn scenes_split_across_bindings_render_bit_identically() {
         // size the triangles and shading data take 10 and 25 bindings, and lavapipe took 114 s
         // to compile the tracer and casts that read them all (the whole test now takes 45).
         if scene.is_instanced() {
-            let (small, split) = split_at((80 * whole.bvh_nodes as u64 / 2).max(floor));
+            let nodes = fisheye_rt::split::NODE_BYTES * whole.bvh_nodes as u64;
+            let (small, split) = split_at((nodes / 2).max(floor));
             assert!(split.arrays.nodes.chunks >= 2, "{name}: {:?}", split.arrays);
             assert!(
                 cast(ctx(), &whole, false) == cast(&small, &split, false),
