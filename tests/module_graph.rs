@@ -3,8 +3,8 @@
 //! re-exporting its children) has no cycle, no module reads one of a higher layer ([`LAYERS`],
 //! the order `src/lib.rs` describes), `shared` and `split` read nothing of the crate, and
 //! `shader` reads only them. Comments, the `#[cfg(test)] mod tests` at a file's end and test
-//! files (`tests.rs`, `tests/`) are left out: tests may reach anywhere. And no source file of
-//! the repository is longer than [`MAX_LINES`].
+//! files (`tests.rs`, `tests/`) are left out: tests may reach anywhere. No source file of
+//! the repository is longer than [`MAX_LINES`], and each file's module doc is its own.
 
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::Path;
@@ -406,4 +406,90 @@ fn no_source_file_is_over_700_lines() {
         "over {MAX_LINES} lines, split along what each part does:\n{}",
         long.join("\n")
     );
+}
+
+/// The prose of a Rust file's module doc: its `//!` lines outside code fences, trimmed, of
+/// [`DOC_LINE`] characters or more.
+fn module_doc_prose(text: &str) -> Vec<String> {
+    let mut fenced = false;
+    let mut out = Vec::new();
+    for line in text.lines().map(str::trim) {
+        let Some(doc) = line.strip_prefix("//!") else {
+            continue;
+        };
+        let doc = doc.trim();
+        if doc.starts_with("```") {
+            fenced = !fenced;
+        } else if !fenced && doc.chars().count() >= DOC_LINE {
+            out.push(doc.to_string());
+        }
+    }
+    out
+}
+
+/// Lines shorter than this may well be the same in two docs.
+const DOC_LINE: usize = 40;
+
+/// Each line of module-doc prose that stands in more than one of `files` (path, text), with
+/// the first two files it stands in.
+fn repeated_doc_lines(files: &[(String, String)]) -> Vec<String> {
+    let mut first: BTreeMap<String, &str> = BTreeMap::new();
+    let mut repeated = Vec::new();
+    for (path, text) in files {
+        for line in module_doc_prose(text) {
+            match first.get(&line) {
+                Some(&other) if other != path => {
+                    repeated.push(format!("{other} and {path}: {line}"))
+                }
+                Some(_) => {}
+                None => {
+                    first.insert(line, path);
+                }
+            }
+        }
+    }
+    repeated
+}
+
+/// Every Rust file under `dir`, with its text.
+fn rust_files(dir: &Path, out: &mut Vec<(String, String)>) {
+    for entry in std::fs::read_dir(dir).unwrap() {
+        let path = entry.unwrap().path();
+        if path.is_dir() {
+            rust_files(&path, out);
+        } else if path.extension().is_some_and(|e| e == "rs") {
+            let text = std::fs::read_to_string(&path).unwrap();
+            out.push((path.display().to_string(), text));
+        }
+    }
+}
+
+/// A module's doc says what that module does: a file split off a module that keeps a copy of
+/// its parent's doc (as five once did, their copies gone stale) says what it is not.
+#[test]
+fn each_module_doc_is_its_own() {
+    let mut files = Vec::new();
+    rust_files(
+        &Path::new(env!("CARGO_MANIFEST_DIR")).join("src"),
+        &mut files,
+    );
+    assert!(files.iter().any(|(p, _)| p.ends_with("src/lib.rs")));
+    let repeated = repeated_doc_lines(&files);
+    assert!(
+        repeated.is_empty(),
+        "module docs that repeat another file's:\n{}",
+        repeated.join("\n")
+    );
+    // The check finds a copy, and not code examples or short lines.
+    let parent = "//! Calibration files: read and write the camera intrinsics of three tools.\n\
+                  //! ```\n//! use fisheye_rt::lens::calib::read_the_calibration_file;\n//! ```\n";
+    let child = format!("//! Writing a calibration.\n\n{parent}");
+    let pair = |a: &str, b: &str| [("a".into(), a.into()), ("b".into(), b.into())];
+    assert_eq!(
+        repeated_doc_lines(&pair(parent, &child)),
+        ["a and b: Calibration files: read and write the camera intrinsics of three tools."]
+    );
+    let example = "//! ```\n//! use fisheye_rt::lens::calib::read_the_calibration_file;\n//! ```\n";
+    assert!(repeated_doc_lines(&pair(example, example)).is_empty());
+    assert!(repeated_doc_lines(&pair("//! Short.", "//! Short.")).is_empty());
 }

@@ -1,23 +1,6 @@
 //! The readers of each calibration format: OpenCV's YAML and XML `FileStorage`, Kalibr's
 //! camchain YAML, Basalt's JSON; each gives a [`Calibration`] or says what is wrong.
 
-//! Calibration files: read and write the camera intrinsics of OpenCV, Kalibr and Basalt.
-//!
-//! - **OpenCV** `cv::FileStorage` YAML or XML with the keys of OpenCV's camera-calibration
-//!   sample (`samples/cpp/calibration.cpp`): `image_width`, `image_height`, `fisheye_model`
-//!   (1: `cv::fisheye`, i.e. Kannala–Brandt with `distortion_coefficients` k1..k4; otherwise
-//!   the pinhole radial-tangential model, k1, k2, p1, p2[, k3]), `camera_matrix` (3×3, no
-//!   skew) and `distortion_coefficients`, as `opencv-matrix` nodes.
-//! - **Kalibr** camchain YAML: per camera `camera_model` (`pinhole`, `omni` (Mei's unified
-//!   model, intrinsics `[xi, fu, fv, pu, pv]`), `ds` (`[xi, alpha, fu, fv, pu, pv]`), `eucm`
-//!   (`[alpha, beta, fu, fv, pu, pv]`)), `distortion_model` (`equidistant` (Kannala–Brandt),
-//!   `radtan`, `fov`, `none`), `intrinsics`, `distortion_coeffs` and `resolution`.
-//! - **Basalt** calibration JSON: `value0.intrinsics[i].camera_type` (`kb4`, `ds`, `eucm`,
-//!   `ucm`, `fov`, `pinhole`) with named `intrinsics`, and `value0.resolution[i]`.
-//!
-//! All three put the centre of the top-left pixel at (0, 0); this project puts it at
-//! (0.5, 0.5), so the principal point is shifted by half a pixel on the way in and out.
-
 use super::calibration::Calibration;
 use crate::lens::calibrated::{CalibratedLens, CalibratedModel, Intrinsics};
 use crate::lens::camera::ImageSize;

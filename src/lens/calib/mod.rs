@@ -8,7 +8,8 @@
 //! - **Kalibr** camchain YAML: per camera `camera_model` (`pinhole`, `omni` (Mei's unified
 //!   model, intrinsics `[xi, fu, fv, pu, pv]`), `ds` (`[xi, alpha, fu, fv, pu, pv]`), `eucm`
 //!   (`[alpha, beta, fu, fv, pu, pv]`)), `distortion_model` (`equidistant` (Kannala–Brandt),
-//!   `radtan`, `fov`, `none`), `intrinsics`, `distortion_coeffs` and `resolution`.
+//!   `radtan`, `fov`, `none`), `intrinsics`, `distortion_coeffs` and `resolution`, and a
+//!   rolling shutter's `line_delay` (seconds) where it has one.
 //! - **Basalt** calibration JSON: `value0.intrinsics[i].camera_type` (`kb4`, `ds`, `eucm`,
 //!   `ucm`, `fov`, `pinhole`) with named `intrinsics`, and `value0.resolution[i]`.
 //!

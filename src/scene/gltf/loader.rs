@@ -1,29 +1,6 @@
 //! The walk over a glTF scene's nodes: transforms composed, meshes flattened or instanced,
 //! materials, textures, lights and cameras mapped to this project's scene.
 
-//! glTF 2.0 scenes (`.gltf` with external or embedded buffers, `.glb`) through the `gltf`
-//! crate's document model and validation. Buffers and images are read here, through the
-//! loader's `read` (so within the input budgets). A mesh that one node uses is placed in world
-//! space; a mesh that several nodes use is stored once, in its own space, and each node places
-//! an instance of it (see [`crate::scene::Instance`]).
-//!
-//! What maps to what (the README's table says the same):
-//! - the default scene (or the one asked for), its node hierarchy with TRS or matrix transforms;
-//! - triangle primitives (strips and fans split into triangles; points and lines skipped with a
-//!   warning), u8/u16/u32 and sparse accessors, normals, the first UV set (v flipped to the
-//!   OBJ convention the shaders use);
-//! - materials: base colour factor and texture (sRGB); emissive factor times
-//!   `KHR_materials_emissive_strength`; `KHR_materials_transmission` ≥ 0.5 is glass of
-//!   `KHR_materials_ior` (1.5 by default) tinted by the base colour; else metallic ≥ 0.5 with
-//!   roughness ≤ 0.25 is a mirror tinted by the base colour; else a diffuse of base colour × (1 -
-//!   metallic) with a Phong lobe of F0 = mix(0.04, base, metallic) and exponent 2/α² - 2 (α =
-//!   roughness², Walter et al.'s Beckmann–Phong correspondence), 1 to 10⁴; alpha `MASK` is opacity
-//!   0 or 1 by the cutoff, `BLEND` the factor's alpha;
-//! - `KHR_lights_punctual`: point lights (candela / 683 lm/W as W/sr), directional (lux / 683 as
-//!   W/m²), spot lights as points without their cone (warned);
-//! - camera nodes: their poses (looking down the node's -z, up its +y), for `--camera gltf:N`;
-//! - anything else (animations, skins, morph targets, other textures, other extensions, sampler
-//!   modes other than repeat and linear) is left out with one warning per feature.
 /// Nodes nested deeper than this are refused (glTF's hierarchy is a tree; no stack overflow on
 /// hostile input).
 pub(super) const MAX_DEPTH: usize = 256;

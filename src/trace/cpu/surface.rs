@@ -1,15 +1,6 @@
 //! Shading helpers of the reference: the surface point a hit leaves, reflection, refraction's
 //! Fresnel term, and texture lookups in linear colour.
 
-//! The f64 reference tracer, the ground truth for the GPU's.
-//!
-//! It sees exactly the data the GPU sees (camera-relative vertices, lights and camera axes
-//! rounded to f32 once, then promoted), shades with the same Whitted model, but computes in
-//! f64 and finds hits with its own binary BVHs (median splits; independent of obvhs), itself
-//! tested against brute force: one over the world's triangles, one per mesh, and one over the
-//! instances that place meshes, whose rays it maps into the mesh's space with the f32 maps the
-//! GPU gets. Rays come from the f64 lens reference.
-
 use crate::scene::Texture;
 use glam::{DVec2, DVec3};
 
