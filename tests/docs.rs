@@ -331,6 +331,62 @@ fn links_reach_their_files_and_headings() {
     assert!(checked >= 100, "{checked} links");
 }
 
+/// The repository's folders that a path in the docs may start from; what the builds write
+/// (`target/`, `web/dist/`) is not among them.
+const TOP_FOLDERS: [&str; 13] = [
+    ".ci", "benches", "docs", "examples", "fuzz", "lenses", "python", "results", "scenes", "src",
+    "tests", "web", "wgsl",
+];
+
+/// The paths from the repository's root that a Markdown text names in inline code
+/// (`src/trace/pass.rs`, `tests/dataset/`), outside fenced blocks: those starting with one of
+/// [`TOP_FOLDERS`], with no placeholder (`<gpu>`, `N`), wildcard or braces in them.
+fn named_paths(markdown: &str) -> Vec<String> {
+    let prose = prose(markdown);
+    let mut found = Vec::new();
+    for code in prose.split('`').skip(1).step_by(2) {
+        let generated = code.starts_with("web/dist");
+        let placeholder = code.contains(|c: char| "<>*{}[] $".contains(c));
+        let top = code.split('/').next().unwrap();
+        if code.contains('/') && TOP_FOLDERS.contains(&top) && !generated && !placeholder {
+            found.push(code.to_string());
+        }
+    }
+    found
+}
+
+/// Every file or folder the README, the book and the results' READMEs name in inline code
+/// from the repository's root exists, so that moving or splitting a file cannot leave the
+/// docs sending a reader to one that is gone (`src/trace/cpu.rs` once, after it became a
+/// folder).
+#[test]
+fn paths_the_docs_name_exist() {
+    let mut pages = pages();
+    pages.push(root().join("README.md"));
+    pages.extend(readmes(&root().join("results")));
+    let mut checked = 0;
+    for page in pages {
+        let text = std::fs::read_to_string(&page).unwrap();
+        for path in named_paths(&text) {
+            assert!(
+                root().join(&path).exists(),
+                "{} names `{path}`, which is missing",
+                page.display()
+            );
+            checked += 1;
+        }
+    }
+    assert!(checked >= 100, "{checked} paths");
+    // What counts as a path: from a top folder, no placeholder, not generated, not fenced.
+    assert_eq!(
+        named_paths(
+            "`src/lib.rs`, `bvh/stages.rs`, `results/<gpu>/`, `web/dist/`, `fisheye render`\n\
+             ```sh\ncat `tests/docs.rs`\n```\n`tests/`"
+        ),
+        ["src/lib.rs", "tests/"]
+    );
+}
+
 #[test]
 fn anchors_follow_mdbook() {
     assert_eq!(
