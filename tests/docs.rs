@@ -19,6 +19,9 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 use std::sync::atomic::{AtomicUsize, Ordering};
 
+#[path = "common/paths.rs"]
+mod paths;
+
 /// A fenced block: its info string, its text, and the line it starts on.
 struct Block {
     info: String,
@@ -331,34 +334,24 @@ fn links_reach_their_files_and_headings() {
     assert!(checked >= 100, "{checked} links");
 }
 
-/// The repository's folders that a path in the docs may start from; what the builds write
-/// (`target/`, `web/dist/`) is not among them.
-const TOP_FOLDERS: [&str; 13] = [
-    ".ci", "benches", "docs", "examples", "fuzz", "lenses", "python", "results", "scenes", "src",
-    "tests", "web", "wgsl",
-];
-
 /// The paths from the repository's root that a Markdown text names in inline code
-/// (`src/trace/pass.rs`, `tests/dataset/`), outside fenced blocks: those starting with one of
-/// [`TOP_FOLDERS`], with no placeholder (`<gpu>`, `N`), wildcard or braces in them.
+/// (`src/trace/pass.rs`, `tests/dataset/`) outside fenced blocks, as
+/// [`paths::names_a_path`] tells them.
 fn named_paths(markdown: &str) -> Vec<String> {
     let prose = prose(markdown);
-    let mut found = Vec::new();
-    for code in prose.split('`').skip(1).step_by(2) {
-        let generated = code.starts_with("web/dist");
-        let placeholder = code.contains(|c: char| "<>*{}[] $".contains(c));
-        let top = code.split('/').next().unwrap();
-        if code.contains('/') && TOP_FOLDERS.contains(&top) && !generated && !placeholder {
-            found.push(code.to_string());
-        }
-    }
-    found
+    prose
+        .split('`')
+        .skip(1)
+        .step_by(2)
+        .filter(|code| paths::names_a_path(code))
+        .map(str::to_string)
+        .collect()
 }
 
 /// Every file or folder the README, the book and the results' READMEs name in inline code
 /// from the repository's root exists, so that moving or splitting a file cannot leave the
-/// docs sending a reader to one that is gone (`src/trace/cpu.rs` once, after it became a
-/// folder).
+/// docs sending a reader to one that is gone (the f64 reference's `cpu.rs` once, after it
+/// became a folder).
 #[test]
 fn paths_the_docs_name_exist() {
     let mut pages = pages();

@@ -4,10 +4,14 @@
 //! the order `src/lib.rs` describes), `shared` and `split` read nothing of the crate, and
 //! `shader` reads only them. Comments, the `#[cfg(test)] mod tests` at a file's end and test
 //! files (`tests.rs`, `tests/`) are left out: tests may reach anywhere. No source file of
-//! the repository is longer than [`MAX_LINES`], and each file's module doc is its own.
+//! the repository is longer than [`MAX_LINES`], each file's module doc is its own, and every
+//! file or folder a comment names from the repository's root exists.
 
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::Path;
+
+#[path = "common/paths.rs"]
+mod paths;
 
 /// Module path (`lens::gpu`; `` for lib.rs) of every file under `src/`, with its code.
 fn modules() -> BTreeMap<String, String> {
@@ -353,8 +357,8 @@ fn no_module_reads_a_higher_layer() {
 const MAX_LINES: usize = 700;
 
 /// The files under `dir` (not `target/`, `.git/` or other hidden folders) whose names end in
-/// one of `extensions`, with their line counts.
-fn line_counts(dir: &Path, extensions: &[&str], out: &mut Vec<(String, usize)>) {
+/// one of `extensions`, with their texts.
+fn sources(dir: &Path, extensions: &[&str], out: &mut Vec<(String, String)>) {
     for entry in std::fs::read_dir(dir).unwrap() {
         let path = entry.unwrap().path();
         let name = path.file_name().unwrap().to_string_lossy().into_owned();
@@ -362,23 +366,24 @@ fn line_counts(dir: &Path, extensions: &[&str], out: &mut Vec<(String, usize)>) 
             // Build outputs and fetched packages are not sources (web/dist: `web/build`'s).
             let built = name == "target" || name == "node_modules" || name == "dist";
             if !(name.starts_with('.') || built) {
-                line_counts(&path, extensions, out);
+                sources(&path, extensions, out);
             }
         } else if extensions.iter().any(|e| name.ends_with(e)) {
             let text = std::fs::read_to_string(&path).unwrap();
-            out.push((path.display().to_string(), text.lines().count()));
+            out.push((path.display().to_string(), text));
         }
     }
 }
 
-#[test]
-fn no_source_file_is_over_700_lines() {
+/// The repository's sources in every language, and its scripts without an extension, with
+/// their texts.
+fn all_sources() -> Vec<(String, String)> {
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
-    let mut counts = Vec::new();
-    let sources = [
+    let mut out = Vec::new();
+    let extensions = [
         ".rs", ".wgsl", ".py", ".sh", ".js", ".mjs", ".html", ".css", ".toml",
     ];
-    line_counts(root, &sources, &mut counts);
+    sources(root, &extensions, &mut out);
     for script in [
         ".ci/run",
         ".ci/test",
@@ -387,8 +392,17 @@ fn no_source_file_is_over_700_lines() {
         "web/test/run",
     ] {
         let text = std::fs::read_to_string(root.join(script)).unwrap();
-        counts.push((script.to_string(), text.lines().count()));
+        out.push((script.to_string(), text));
     }
+    out
+}
+
+#[test]
+fn no_source_file_is_over_700_lines() {
+    let counts: Vec<(String, usize)> = all_sources()
+        .into_iter()
+        .map(|(path, text)| (path, text.lines().count()))
+        .collect();
     // The walk sees the sources: the tracer's kernel and this file among them.
     assert!(counts.iter().any(|(p, _)| p.ends_with("wgsl/trace.wgsl")));
     assert!(
@@ -451,28 +465,13 @@ fn repeated_doc_lines(files: &[(String, String)]) -> Vec<String> {
     repeated
 }
 
-/// Every Rust file under `dir`, with its text.
-fn rust_files(dir: &Path, out: &mut Vec<(String, String)>) {
-    for entry in std::fs::read_dir(dir).unwrap() {
-        let path = entry.unwrap().path();
-        if path.is_dir() {
-            rust_files(&path, out);
-        } else if path.extension().is_some_and(|e| e == "rs") {
-            let text = std::fs::read_to_string(&path).unwrap();
-            out.push((path.display().to_string(), text));
-        }
-    }
-}
-
 /// A module's doc says what that module does: a file split off a module that keeps a copy of
 /// its parent's doc (as five once did, their copies gone stale) says what it is not.
 #[test]
 fn each_module_doc_is_its_own() {
     let mut files = Vec::new();
-    rust_files(
-        &Path::new(env!("CARGO_MANIFEST_DIR")).join("src"),
-        &mut files,
-    );
+    let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("src");
+    sources(&src, &[".rs"], &mut files);
     assert!(files.iter().any(|(p, _)| p.ends_with("src/lib.rs")));
     let repeated = repeated_doc_lines(&files);
     assert!(
@@ -492,4 +491,64 @@ fn each_module_doc_is_its_own() {
     let example = "//! ```\n//! use fisheye_rt::lens::calib::read_the_calibration_file;\n//! ```\n";
     assert!(repeated_doc_lines(&pair(example, example)).is_empty());
     assert!(repeated_doc_lines(&pair("//! Short.", "//! Short.")).is_empty());
+}
+
+/// The comment of a line of a file named `path`: after `//` in Rust, WGSL and JavaScript,
+/// after `#` elsewhere.
+fn comment<'a>(path: &str, line: &'a str) -> Option<&'a str> {
+    let slashes = [".rs", ".wgsl", ".js", ".mjs"]
+        .iter()
+        .any(|e| path.ends_with(e));
+    let mark = if slashes { "//" } else { "#" };
+    line.split_once(mark).map(|(_, c)| c)
+}
+
+/// The paths from the repository's root that a comment names (`src/trace/cpu/`), as
+/// [`paths::names_a_path`] tells them.
+fn paths_in(comment: &str) -> Vec<&str> {
+    let path_char = |c: char| c.is_alphanumeric() || "_.-/".contains(c);
+    comment
+        .split(|c: char| !path_char(c))
+        .map(|word| word.trim_end_matches('.'))
+        .filter(|word| paths::names_a_path(word))
+        .collect()
+}
+
+/// Every file or folder that a comment of the sources names from the repository's root
+/// exists, so that moving or splitting a file cannot leave a comment sending the reader to
+/// one that is gone (the calibrated models' `calibrated.rs` once, after it became a folder).
+#[test]
+fn paths_named_in_comments_exist() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let mut checked = 0;
+    let mut missing = Vec::new();
+    for (path, text) in all_sources() {
+        for (i, line) in text.lines().enumerate() {
+            for named in comment(&path, line).map(paths_in).unwrap_or_default() {
+                if !root.join(named).exists() {
+                    missing.push(format!("{path}:{}: {named}", i + 1));
+                }
+                checked += 1;
+            }
+        }
+    }
+    assert!(missing.is_empty(), "missing:\n{}", missing.join("\n"));
+    assert!(checked >= 100, "{checked} paths");
+    // What counts: a path from a top folder, not a placeholder, a URL's or a build's.
+    assert_eq!(
+        paths_in(
+            " see src/lens/calibrated.rs. and tests/docs.rs, results/NAME, bvh/binary.rs, \
+             https://example.org/src/x.rs, web/dist/x.js, web/test/node_modules, .ci/test"
+        ),
+        ["src/lens/calibrated.rs", "tests/docs.rs", ".ci/test"]
+    );
+    assert_eq!(
+        comment("a.rs", "let x = 1; // src/lib.rs"),
+        Some(" src/lib.rs")
+    );
+    assert_eq!(
+        comment("run", "cd web # web/test/run"),
+        Some(" web/test/run")
+    );
+    assert_eq!(comment("a.rs", "#[test]"), None);
 }

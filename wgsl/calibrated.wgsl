@@ -1,4 +1,4 @@
-// Calibrated camera models, the f32 twin of src/lens/calibrated.rs: see there for the
+// Calibrated camera models, the f32 twin of src/lens/calibrated/: see there for the
 // formulas, their sources and the validity domains. Model coordinates m are
 // ((u - cx)/fx, (v - cy)/fy) (Scaramuzza: then through the inverse of its affine stretch);
 // lens.r_max and lens.theta_max bound the domain, as the f64 reference computed them.
@@ -82,9 +82,10 @@ fn cal_h(lens: LensParams, x: f32, goal: f32) -> vec2<f32> {
 }
 
 // The root of h in [0, hi] (h(0) ≤ 0 ≤ h(hi)) by the guarded Newton iteration of
-// src/lens/calibrated.rs: every iteration narrows the bracket at the iterate and, if that did
-// not halve it, at its midpoint; the next iterate is Newton's step from the one of them with
-// the smaller |h| when strictly inside the bracket, else the midpoint. Tolerance hi·2⁻²², so NEWTON_STEPS iterations suffice.
+// src/lens/calibrated/mod.rs: every iteration narrows the bracket at the iterate and, if
+// that did not halve it, at its midpoint; the next iterate is Newton's step from the one of
+// them with the smaller |h| when strictly inside the bracket, else the midpoint. Tolerance
+// hi·2⁻²², so NEWTON_STEPS iterations suffice.
 fn cal_solve(lens: LensParams, goal: f32, hi_in: f32, x0: f32) -> f32 {
     var lo = 0.0;
     var hi = hi_in;
