@@ -295,17 +295,22 @@ fn readmes(folder: &Path) -> Vec<PathBuf> {
     found
 }
 
+/// The book's pages, the README and the results' READMEs.
+fn every_markdown_page() -> Vec<PathBuf> {
+    let mut pages = pages();
+    pages.push(root().join("README.md"));
+    pages.extend(readmes(&root().join("results")));
+    pages
+}
+
 /// Every relative link of the README, the book and the results' READMEs reaches a file or
 /// folder that exists, and a link to a heading (`page.md#anchor`, or `#anchor` on the same
 /// page) reaches one that the page has, so that moving a section cannot leave a link
 /// pointing nowhere.
 #[test]
 fn links_reach_their_files_and_headings() {
-    let mut pages = pages();
-    pages.push(root().join("README.md"));
-    pages.extend(readmes(&root().join("results")));
     let mut checked = 0;
-    for page in pages {
+    for page in every_markdown_page() {
         let text = std::fs::read_to_string(&page).unwrap();
         for link in prose(&text).split("](").skip(1) {
             let target = &link[..link.find(')').unwrap()];
@@ -354,11 +359,8 @@ fn named_paths(markdown: &str) -> Vec<String> {
 /// became a folder).
 #[test]
 fn paths_the_docs_name_exist() {
-    let mut pages = pages();
-    pages.push(root().join("README.md"));
-    pages.extend(readmes(&root().join("results")));
     let mut checked = 0;
-    for page in pages {
+    for page in every_markdown_page() {
         let text = std::fs::read_to_string(&page).unwrap();
         for path in named_paths(&text) {
             assert!(
