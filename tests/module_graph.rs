@@ -444,8 +444,8 @@ fn module_doc_prose(text: &str) -> Vec<String> {
 /// Lines shorter than this may well be the same in two docs.
 const DOC_LINE: usize = 40;
 
-/// Each line of module-doc prose that stands in more than one of `files` (path, text), with
-/// the first two files it stands in.
+/// Each line of module-doc prose that stands again in another of `files` (path, text), with
+/// the file it stood in first and the one it stands in again.
 fn repeated_doc_lines(files: &[(String, String)]) -> Vec<String> {
     let mut first: BTreeMap<String, &str> = BTreeMap::new();
     let mut repeated = Vec::new();
