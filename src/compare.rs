@@ -399,4 +399,35 @@ mod tests {
         let half = flip_error(size, &pattern, &masked);
         assert!((half - large).abs() < 0.2 * large, "{half} {large}");
     }
+
+    /// `compare` measures a group of setups' images on every thread at once: NVIDIA's ꟻLIP
+    /// (C++ behind the crate) gives each image the score it gives it alone, however many
+    /// run side by side.
+    #[test]
+    fn flip_scores_alike_on_many_threads_at_once() {
+        let size = ImageSize::new(48, 40).unwrap();
+        let image = |seed: u32| -> Vec<[f32; 4]> {
+            (0..48 * 40u32)
+                .map(|p| {
+                    let v = ((p * 7 + seed * 13) % 29) as f32 / 29.0;
+                    [v, (v + 0.3 * seed as f32) % 1.0, 0.5 * v, 1.0]
+                })
+                .collect()
+        };
+        let reference = image(0);
+        let mut scores: Vec<(Vec<[f32; 4]>, f64)> = (1..=16).map(|k| (image(k), -1.0)).collect();
+        let alone: Vec<f64> = scores
+            .iter()
+            .map(|(image, _)| flip_error(size, &reference, image))
+            .collect();
+        std::thread::scope(|scope| {
+            for (image, score) in &mut scores {
+                let reference = &reference;
+                scope.spawn(move || *score = flip_error(size, reference, image));
+            }
+        });
+        let together: Vec<f64> = scores.iter().map(|(_, score)| *score).collect();
+        assert_eq!(together, alone);
+        assert!(alone.iter().all(|&f| f > 0.0), "{alone:?}");
+    }
 }

@@ -4,11 +4,7 @@
 /// Calls `work(first, part)` for consecutive parts of `items`, one a thread, `first` being
 /// the index of the part's first item in `items`; returns when all are done.
 pub(crate) fn in_parts<T: Send>(items: &mut [T], work: impl Fn(usize, &mut [T]) + Sync) {
-    let threads = if cfg!(target_arch = "wasm32") {
-        1
-    } else {
-        std::thread::available_parallelism().map_or(1, |n| n.get())
-    };
+    let threads = available();
     let part = items.len().div_ceil(threads).max(1);
     if threads == 1 {
         return work(0, items);
@@ -19,4 +15,13 @@ pub(crate) fn in_parts<T: Send>(items: &mut [T], work: impl Fn(usize, &mut [T]) 
             s.spawn(move || work(k * part, items));
         }
     });
+}
+
+/// The threads [`in_parts`] splits work over: the machine's (1 in a web page).
+pub(crate) fn available() -> usize {
+    if cfg!(target_arch = "wasm32") {
+        1
+    } else {
+        std::thread::available_parallelism().map_or(1, |n| n.get())
+    }
 }

@@ -4,7 +4,7 @@
 //! a Markdown table, error maps and time-against-error plots.
 
 use std::fmt::Write as _;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
 use serde::Serialize;
@@ -12,12 +12,14 @@ use serde::Serialize;
 use super::{
     Progress, Run, Study, check_frames, file_stem, machine_lines, sig, speed_ratio, write_report,
 };
-use crate::compare::{error_map, flip_error, image_error, pareto_front};
+use crate::compare::{ImageError, error_map, flip_error, image_error, pareto_front};
 use crate::error::Result;
 use crate::gpu::median;
+use crate::lens::ImageSize;
 use crate::renderer::Method;
 use crate::renderer::{FrameTime, Setup};
 use crate::scene::Camera;
+use crate::threads;
 use crate::trace::{colour_image, save_png};
 
 mod verdicts;
@@ -183,40 +185,52 @@ pub fn compare(
             }
             done += setups.len();
         }
-        for ((&setup, renderer), times) in setups.iter().zip(&renderers).zip(times) {
-            let colour = renderer.colour(study.ctx)?;
-            let covered = colour.iter().filter(|c| c[3] > 0.0).count().max(1) as f64;
-            let rays_per_pixel = match renderer.rays_per_pixel(study.ctx)? {
-                Some(map) => Some(map.iter().map(|&n| f64::from(n)).sum::<f64>() / covered),
-                None => setup.spp().map(f64::from),
-            };
-            let samples = match renderer.cube() {
-                Some(cube) => cube.texels_rendered() as f64,
-                None => rays_per_pixel.unwrap_or(0.0) * covered,
-            };
-            save_png(
-                &error_map(size, &reference, &colour),
-                &out.join(format!("{stem}.{}.error.png", file_stem(&setup.label()))),
-            )?;
-            let gpu: Option<Vec<f64>> = times.iter().map(FrameTime::gpu_ms).collect();
-            let wall: Vec<f64> = times.iter().map(|t| t.wall_ms).collect();
-            entries.push(CompareEntry {
-                lens: lens.name.clone(),
-                setup: setup.label(),
-                method: setup.method.name(),
-                cube_size: setup.cube_size(),
-                spp: setup.spp(),
-                threshold: setup.threshold(),
-                filter: setup.cube_size().is_none().then(|| setup.filter.name()),
-                rays_per_pixel,
-                samples,
-                gpu_ms: gpu.map(|g| median(&g)),
-                wall_ms: median(&wall),
-                error: image_error(&reference, &colour),
-                flip: flip_error(size, &reference, &colour),
-                pareto: false,
-                pareto_flip: false,
+        // Each setup's last frame is read back and measured against the reference, a group
+        // of setups at a time on every thread at once (ꟻLIP takes about half a second for a
+        // 1024×768 image on one core); a group holds only as many images as there are threads.
+        let what = format!("{} errors against the reference", lens.name);
+        progress(Progress {
+            done,
+            total,
+            what: &what,
+        });
+        let mut timed = setups.iter().zip(&renderers).zip(times);
+        loop {
+            let mut group = Vec::new();
+            for ((&setup, renderer), times) in timed.by_ref().take(threads::available()) {
+                let colour = renderer.colour(study.ctx)?;
+                let covered = colour.iter().filter(|c| c[3] > 0.0).count().max(1) as f64;
+                let rays_per_pixel = match renderer.rays_per_pixel(study.ctx)? {
+                    Some(map) => Some(map.iter().map(|&n| f64::from(n)).sum::<f64>() / covered),
+                    None => setup.spp().map(f64::from),
+                };
+                let samples = match renderer.cube() {
+                    Some(cube) => cube.texels_rendered() as f64,
+                    None => rays_per_pixel.unwrap_or(0.0) * covered,
+                };
+                let error_path =
+                    out.join(format!("{stem}.{}.error.png", file_stem(&setup.label())));
+                group.push(Measured {
+                    setup,
+                    times,
+                    rays_per_pixel,
+                    samples,
+                    colour,
+                    error_path,
+                    errors: None,
+                });
+            }
+            if group.is_empty() {
+                break;
+            }
+            threads::in_parts(&mut group, |_, part| {
+                for m in part {
+                    m.measure(size, &reference);
+                }
             });
+            for m in group {
+                entries.push(m.entry(&lens.name)?);
+            }
         }
         let lens_entries = &mut entries[first..];
         for metric in [Metric::Mse, Metric::Flip] {
@@ -254,6 +268,58 @@ pub fn compare(
         ceilings,
         skipped,
     })
+}
+
+/// A setup's last frame, read back, and its errors against the reference once measured.
+struct Measured {
+    setup: Setup,
+    times: Vec<FrameTime>,
+    rays_per_pixel: Option<f64>,
+    samples: f64,
+    colour: Vec<[f32; 4]>,
+    /// Where its error map goes.
+    error_path: PathBuf,
+    /// Its MSE and the rest, and its mean ꟻLIP, once `measure` has run (or why the error
+    /// map could not be written).
+    errors: Option<Result<(ImageError, f64)>>,
+}
+
+impl Measured {
+    /// Measures the frame against `reference` and writes its error map.
+    fn measure(&mut self, size: ImageSize, reference: &[[f32; 4]]) {
+        let written = save_png(&error_map(size, reference, &self.colour), &self.error_path);
+        self.errors = Some(written.map(|()| {
+            (
+                image_error(reference, &self.colour),
+                flip_error(size, reference, &self.colour),
+            )
+        }));
+    }
+
+    /// The report's entry for it on lens `lens` (not yet marked on the Pareto fronts).
+    fn entry(self, lens: &str) -> Result<CompareEntry> {
+        let (error, flip) = self.errors.expect("measured before its entry is made")?;
+        let gpu: Option<Vec<f64>> = self.times.iter().map(FrameTime::gpu_ms).collect();
+        let wall: Vec<f64> = self.times.iter().map(|t| t.wall_ms).collect();
+        let setup = self.setup;
+        Ok(CompareEntry {
+            lens: lens.to_string(),
+            setup: setup.label(),
+            method: setup.method.name(),
+            cube_size: setup.cube_size(),
+            spp: setup.spp(),
+            threshold: setup.threshold(),
+            filter: setup.cube_size().is_none().then(|| setup.filter.name()),
+            rays_per_pixel: self.rays_per_pixel,
+            samples: self.samples,
+            gpu_ms: gpu.map(|g| median(&g)),
+            wall_ms: median(&wall),
+            error,
+            flip,
+            pareto: false,
+            pareto_flip: false,
+        })
+    }
 }
 
 /// A count of rays or texels to three significant figures, in thousands (k) or millions (M)
