@@ -267,6 +267,32 @@ const RAMP: [[f32; 3]; 5] = [
     [0.993, 0.906, 0.144],
 ];
 
+/// How the spp map's key names the colours of its ramp.
+const RAMP_NAMES: [&str; 5] = ["dark violet", "blue", "teal", "green", "yellow"];
+
+/// The key to [`spp_picture`]'s colours with `most` rays at the top: the rays each colour of
+/// its ramp stands for, `dark violet 0 (interpolated), blue 1.1, teal 3.2, green 7.7, yellow
+/// 17 rays a pixel` for 17 (a colour between two stands for rays between theirs).
+pub fn spp_key(most: u32) -> String {
+    let top = f64::from(most.max(1)).ln_1p();
+    let steps = (RAMP.len() - 1) as f64;
+    let stops: Vec<String> = RAMP_NAMES
+        .iter()
+        .enumerate()
+        .map(|(k, name)| {
+            // The ramp's colour k is at log(1 + rays) = k / steps of log(1 + most).
+            let rays = (top * k as f64 / steps).exp_m1();
+            match k {
+                0 => format!("{name} 0 (interpolated)"),
+                _ if k == RAMP.len() - 1 => format!("{name} {most}"),
+                _ if rays < 10.0 => format!("{name} {rays:.1}"),
+                _ => format!("{name} {rays:.0}"),
+            }
+        })
+        .collect();
+    format!("{} rays a pixel", stops.join(", "))
+}
+
 /// A picture of the rays each pixel took (`rays`, row-major, as
 /// [`AdaptivePass::read_rays`](super::AdaptivePass::read_rays) gives them): dark violet for
 /// none (interpolated), then along viridis to yellow at `most`, on a logarithmic scale
@@ -299,4 +325,48 @@ pub fn spp_picture(
         ]);
     }
     picture
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The key says what the picture shows: a pixel with a stop's rays (rounded to whole
+    /// rays) is drawn nearest that stop's colour of the ramp, none and the most exactly. (With
+    /// the most 16 rays and more, as `render`'s maps have by default: below that the middle
+    /// stops fall between whole rays, which no pixel takes.)
+    #[test]
+    fn the_spp_key_names_the_colours_the_picture_draws() {
+        assert_eq!(
+            spp_key(17),
+            "dark violet 0 (interpolated), blue 1.1, teal 3.2, green 7.7, yellow 17 rays a pixel"
+        );
+        let size = crate::lens::ImageSize::new(1, 1).unwrap();
+        for most in [17, 65, 257] {
+            let key = spp_key(most);
+            let counts: Vec<f64> = key
+                .trim_end_matches(" rays a pixel")
+                .split(", ")
+                .map(|stop| stop.split(' ').find_map(|w| w.parse().ok()).unwrap())
+                .collect();
+            assert_eq!(counts.len(), RAMP.len(), "{key}");
+            for (k, rays) in counts.into_iter().enumerate() {
+                let picture =
+                    spp_picture(size, &[rays.round() as u32], &[[0.0, 0.0, 0.0, 1.0]], most);
+                let drawn = picture.get_pixel(0, 0).0;
+                let distance = |c: &[f32; 3]| -> f32 {
+                    (0..3)
+                        .map(|i| (f32::from(drawn[i]) / 255.0 - c[i]).powi(2))
+                        .sum()
+                };
+                let nearest = (0..RAMP.len())
+                    .min_by(|&a, &b| distance(&RAMP[a]).total_cmp(&distance(&RAMP[b])))
+                    .unwrap();
+                assert_eq!(nearest, k, "{key}: {rays} rays drawn as {drawn:?}");
+                if k == 0 || k == RAMP.len() - 1 {
+                    assert!(distance(&RAMP[k]) < 1e-4, "{key}: {drawn:?}");
+                }
+            }
+        }
+    }
 }

@@ -313,6 +313,7 @@ fn adaptive_render_writes_its_spp_map() {
         "midpoints",
         "refine",
         "truth",
+        "room.spp.png (dark violet 0 (interpolated), blue 1.1, teal 3.2, green 7.7, yellow 17 rays a pixel)",
     ] {
         assert!(text.contains(needle), "{needle} missing from:\n{text}");
     }

@@ -13,7 +13,7 @@ use fisheye_rt::renderer::{Offscreen, Pass, SceneSet, Setup};
 use fisheye_rt::scene::{FRAME_FILL, Scene};
 use fisheye_rt::trace::{
     Channel, ColourFile, Display, GpuScene, KEY, PixelFilter, RenderOptions, Sampling, Tone,
-    auto_exposure, check_writable, save_png, spp_picture, world_directions, write_colour,
+    auto_exposure, check_writable, save_png, spp_key, spp_picture, world_directions, write_colour,
 };
 
 use crate::args::{
@@ -377,7 +377,7 @@ pub(crate) fn render(args: &RenderArgs) -> Result<()> {
             &spp_picture(output.size, &map, &output.colour, spp + 1),
             path,
         )?;
-        println!("wrote {}", path.display());
+        println!("wrote {} ({})", path.display(), spp_key(spp + 1));
     }
     println!(
         "wrote {} ({}; {:.1} s in all)",
