@@ -213,7 +213,8 @@ fn render_takes_scene_files_and_camera_poses() {
 
 /// Every `--method cube-*` renders through a cube map, names the faces it rendered, and writes
 /// a PNG with the same mask as the direct render, close to it; bad combinations are clear
-/// errors.
+/// errors, and so are options of the other family (`--spp`, `--filter` with a cube map,
+/// `--cube-size` with direct tracing), which would otherwise be ignored.
 #[test]
 fn render_through_a_cube_map() {
     let dir = std::env::temp_dir().join(format!("fisheye-cube-{}", std::process::id()));
@@ -275,6 +276,10 @@ fn render_through_a_cube_map() {
                 "--filter applies to direct tracing",
             ),
             (&["--filter", "gauss"][..], "box"),
+            (
+                &["--spp", "auto"][..],
+                "--spp auto:0.02 applies to direct tracing",
+            ),
         ] {
             let output = fisheye(&[&args[..], extra].concat(), "");
             let stderr = String::from_utf8_lossy(&output.stderr);
@@ -283,6 +288,25 @@ fn render_through_a_cube_map() {
                 "{method}: {stderr}"
             );
         }
+    }
+    // A face size is the cube maps': given to direct tracing it is refused, not ignored.
+    for method in ["rt", "rq"] {
+        let args = [
+            "render",
+            "--size",
+            "64x48",
+            "--method",
+            method,
+            "--cube-size",
+            "32",
+        ];
+        let output = fisheye(&args, "");
+        let stderr = String::from_utf8_lossy(&output.stderr);
+        assert!(
+            !output.status.success()
+                && stderr.contains("--cube-size 32 applies to the cube-map methods"),
+            "{method}: {stderr}"
+        );
     }
     let output = fisheye(
         &["render", "--method", "cube-forward", "--shadow-size", "0"],
@@ -346,23 +370,24 @@ fn render_reports_instances_and_rasterizes_them_flattened() {
     let dir = std::env::temp_dir().join(format!("fisheye-instances-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let out = dir.join("forest.png");
-    let args = [
+    let scene = [
         "render",
         "builtin:instances",
         "--size",
         "64x48",
-        "--spp",
-        "1",
         "--out",
         out.to_str().unwrap(),
     ];
-    let text = stdout(&fisheye(&args, ""));
+    let text = stdout(&fisheye(&[&scene[..], &["--spp", "1"]].concat(), ""));
     assert!(
         text.contains("100000002 triangles (100002 stored, 1000 instances)"),
         "{text}"
     );
-    let mut raster = args.to_vec();
-    raster.extend(["--method", "cube-forward", "--cube-size", "32"]);
+    let mut raster = [
+        &scene[..],
+        &["--method", "cube-forward", "--cube-size", "32"],
+    ]
+    .concat();
     let output = fisheye(&raster, "");
     let stderr = String::from_utf8_lossy(&output.stderr);
     assert!(

@@ -60,9 +60,9 @@ pub(crate) struct RenderArgs {
     /// multiview pass) rasterize them, with shadow maps and no reflection or refraction.
     #[arg(long, value_enum, default_value = "rt")]
     pub(crate) method: Method,
-    /// Face size of the cube map in texels (`cube-*` methods).
-    #[arg(long, default_value_t = 1024)]
-    pub(crate) cube_size: u32,
+    /// Face size of the cube map in texels (`cube-*` methods; 1024 unless given).
+    #[arg(long)]
+    pub(crate) cube_size: Option<u32>,
     /// Rays per pixel (direct methods): N, a square from 1 to 256, for N rays in every pixel
     /// (on a rotated grid: one in each row and column of N × N cells), their mean its colour
     /// (a box filter) and alpha the share of the pixel the lens covers; or auto,
@@ -76,8 +76,8 @@ pub(crate) struct RenderArgs {
     /// through each pixel's centre. The default, 16, chosen by measurement: on the default
     /// scene it gives 52 dB against 64 rays, where adaptive sampling stops near 49 dB (see
     /// the book's "Adaptive sampling").
-    #[arg(long, default_value = "16")]
-    pub(crate) spp: Sampling,
+    #[arg(long)]
+    pub(crate) spp: Option<Sampling>,
     /// How a pixel's colour is made from its rays (direct methods): `box`, the mean of its
     /// own rays; or `tent`, in a frame of one ray a pixel at most (--spp 1, or auto:T:1), the
     /// mean over the pixel's square of the bilinear interpolation through it and its eight
@@ -122,6 +122,11 @@ pub(crate) struct RenderArgs {
     pub(crate) format: ArrayFormat,
 }
 
+/// `render`'s rays per pixel unless `--spp` is given (chosen by measurement: see `--spp`).
+const DEFAULT_SPP: u32 = 16;
+/// `render`'s cube faces' size in texels unless `--cube-size` is given.
+const DEFAULT_CUBE_SIZE: u32 = 1024;
+
 pub(crate) fn render(args: &RenderArgs) -> Result<()> {
     let started = Instant::now();
     // Everything about the files first: a refused name costs no rendering.
@@ -163,19 +168,34 @@ pub(crate) fn render(args: &RenderArgs) -> Result<()> {
         check_writable(path)?;
     }
     let method = args.method.method();
-    // A cube map's resampler takes one bilinear sample a pixel; --spp is direct tracing's.
-    if args.filter != PixelFilter::Box && method.cube().is_some() {
+    // A cube map's resampler takes one bilinear sample a pixel; --spp is direct tracing's,
+    // and --cube-size the cube maps': each is refused with the other family, not ignored.
+    let cube = method.cube().is_some();
+    if args.filter != PixelFilter::Box && cube {
         bail!("--filter applies to direct tracing (--method rt or rq)");
     }
-    let filter = filter_for(args.filter, args.spp);
+    if let (true, Some(spp)) = (cube, args.spp) {
+        bail!(
+            "--spp {spp} applies to direct tracing (--method rt or rq): a cube map's detail is \
+             its --cube-size"
+        );
+    }
+    if let (false, Some(size)) = (cube, args.cube_size) {
+        bail!(
+            "--cube-size {size} applies to the cube-map methods (--method cube-rt, \
+             cube-forward, cube-deferred or cube-single)"
+        );
+    }
+    let sampling = args.spp.unwrap_or(Sampling::Uniform(DEFAULT_SPP));
+    let filter = filter_for(args.filter, sampling);
     let setup = match method.cube() {
-        Some(_) => Setup::cube(method, args.cube_size),
-        None => Setup::sampled(method, args.spp).filtered(filter),
+        Some(_) => Setup::cube(method, args.cube_size.unwrap_or(DEFAULT_CUBE_SIZE)),
+        None => Setup::sampled(method, sampling).filtered(filter),
     };
     // Adaptive sampling traces the hits of the pixels it interpolates only when arrays of
     // them are written.
     let ground_truth = channels.iter().any(Channel::traced);
-    let (spp, adaptive) = args.spp.options(ground_truth);
+    let (spp, adaptive) = sampling.options(ground_truth);
     let directions = DirectionSource::from(args.directions);
     if setup.method.cube().is_some() && directions == DirectionSource::Table {
         bail!("--directions table applies to direct tracing (--method rt or rq)");
@@ -261,7 +281,7 @@ pub(crate) fn render(args: &RenderArgs) -> Result<()> {
              follow the fitted chief rays above",
             glass.counts[0]
         );
-        if args.spp.options(false).0 < 16 {
+        if sampling.options(false).0 < 16 {
             eprintln!(
                 "warning: through glass each sample sees one point of the exit pupil: give \
                  --spp 16 or more for a smooth picture where it is out of focus"
