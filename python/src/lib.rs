@@ -330,7 +330,7 @@ fn look_at<'py>(
 }
 
 /// The outputs `render` can return.
-const OUTPUTS: [&str; 7] = [
+const OUTPUTS: [&str; 8] = [
     "colour",
     "srgb",
     "range",
@@ -338,6 +338,7 @@ const OUTPUTS: [&str; 7] = [
     "id",
     "direction",
     "mask",
+    "spp",
 ];
 
 /// `render`'s `spp`: a count of rays per pixel, or `"auto[:THRESHOLD[:MAX[:LEAST]]]"`.
@@ -425,7 +426,8 @@ impl Renderer {
     /// writes PNGs), and the centre ray's ground truth "range" (H×W float32), "normal"
     /// (H×W×3 float32), "id" (H×W uint32, 4294967295 for none), "direction" (H×W×3 float32,
     /// scene frame) and "mask" (H×W uint8). The same arrays `fisheye render --outputs`
-    /// writes, bit for bit. Moving objects (glTF animations, scene-file keys) are placed at
+    /// writes, bit for bit. "spp" (H×W uint32) is the rays each pixel's colour took: adaptive
+    /// sampling's count (0 where a pixel was interpolated), or `spp` at each pixel with a ray. Moving objects (glTF animations, scene-file keys) are placed at
     /// scene time `time` (seconds), as `fisheye render --time` places them, without building
     /// the meshes' BVHs again. `filter` is "box" (each pixel its own rays' mean) or "tent"
     /// (at one ray a pixel at most, each pixel blended with its neighbours, as
@@ -502,7 +504,9 @@ impl Renderer {
             ..self.options
         };
         let rays = (sampling, ground_truth);
-        let output = py.detach(|| self.trace(ctx, &camera, (&pose, time), rays, &options))?;
+        let spp_map = outputs.iter().any(|o| o == "spp");
+        let (output, spp_map) =
+            py.detach(|| self.trace(ctx, &camera, (&pose, time), rays, &options, spp_map))?;
         let dict = PyDict::new(py);
         let (h, w) = (camera.size.height as usize, camera.size.width as usize);
         // Only the direction and mask arrays read the rays (an f64 lens evaluation a pixel).
@@ -516,6 +520,9 @@ impl Renderer {
             let array = match name.as_str() {
                 "colour" => PyArray1::from_vec(py, output.colour.concat())
                     .reshape(IxDyn(&[h, w, 4]))?
+                    .into_any(),
+                "spp" => PyArray1::from_vec(py, spp_map.clone().expect("read when asked for"))
+                    .reshape(IxDyn(&[h, w]))?
                     .into_any(),
                 "srgb" => {
                     let display = Display { exposure, tone };
@@ -554,7 +561,7 @@ impl Renderer {
 impl Renderer {
     /// Traces one frame (passes per lens and sampling, made at first use; adaptive ones trace
     /// the ground truth of the pixels they interpolate where `ground_truth` says) and reads it
-    /// back.
+    /// back, with its spp map where `spp_map` asks for it.
     fn trace(
         &self,
         ctx: &GpuContext,
@@ -562,7 +569,8 @@ impl Renderer {
         (pose, time): (&Camera, f64),
         (sampling, ground_truth): (Sampling, bool),
         options: &RenderOptions,
-    ) -> PyResult<RenderOutput> {
+        spp_map: bool,
+    ) -> PyResult<(RenderOutput, Option<Vec<u32>>)> {
         let mut state = self
             .state
             .lock()
@@ -586,9 +594,14 @@ impl Renderer {
         scene
             .place_at(ctx, &self.scene, time, (0.0, 0.0))
             .map_err(raise)?;
-        passes[&key]
-            .trace(ctx, scene, pose, "rendering")
-            .map_err(raise)
+        let pass = &passes[&key];
+        let output = pass.trace(ctx, scene, pose, "rendering").map_err(raise)?;
+        let map = if spp_map {
+            Some(pass.rays_map(ctx, &output).map_err(raise)?)
+        } else {
+            None
+        };
+        Ok((output, map))
     }
 }
 

@@ -6,6 +6,7 @@ for bit, calibration files against OpenCV's own reader, and bad input as excepti
 import ast
 import inspect
 import os
+import re
 import subprocess
 import threading
 import time
@@ -173,23 +174,36 @@ def test_moving_objects_render_at_a_time_as_the_command_does(tmp_path):
 def test_adaptive_sampling_equals_the_commands_and_keeps_exact_ground_truth(tmp_path):
     """spp="auto:..." renders what `fisheye render --spp auto:...` writes, bit for bit; its
     ids are uniform sampling's (never interpolated); at threshold 0 it is uniform sampling at
-    its most rays exactly; and it spends fewer rays than that, so it differs somewhere."""
+    its most rays exactly; and it spends fewer rays than that, so it differs somewhere. Its
+    "spp" map adds up to the rays the command says it traced for the colour; uniform
+    sampling's is its count at every pixel the lens covers, and at threshold 0 each pixel
+    takes its centre's ray and then uniform sampling's."""
     out = tmp_path / "auto.png"
-    fisheye(
+    said = fisheye(
         "render", "builtin:default", "--lens", "samyang-7.5mm", "--size", "96x72", "--spp",
         "auto:0.05:4", "--outputs", "range,id", "-o", str(out),
-    )
+    ).stdout
     renderer = fr.Renderer(fr.Scene.load("builtin:default"))
     lens = fr.Lens.from_spec("samyang-7.5mm", size=(96, 72))
-    auto = renderer.render(lens, spp="auto:0.05:4", outputs=["srgb", "colour", "range", "id"])
+    auto = renderer.render(
+        lens, spp="auto:0.05:4", outputs=["srgb", "colour", "range", "id", "spp"]
+    )
     for name in ["range", "id"]:
         assert auto[name].tobytes() == np.load(tmp_path / f"auto.{name}.npy").tobytes(), name
     assert np.array_equal(auto["srgb"], np.asarray(Image.open(out).convert("RGBA")))
-    uniform = renderer.render(lens, spp=4, outputs=["colour", "id"])
+    traced = int(re.search(r"(\d+) rays for their colour", said).group(1))
+    assert auto["spp"].dtype == np.uint32 and auto["spp"].shape == (72, 96)
+    assert int(auto["spp"].sum()) == traced
+    assert (auto["spp"] == 0).any() and auto["spp"].max() == 5, np.unique(auto["spp"])
+    uniform = renderer.render(lens, spp=4, outputs=["colour", "id", "spp"])
     assert np.array_equal(auto["id"], uniform["id"])
     assert not np.array_equal(auto["colour"], uniform["colour"])
-    exact = renderer.render(lens, spp="auto:0:4", outputs=["colour"])
+    covered = uniform["colour"][..., 3] > 0
+    assert covered.all()  # the Samyang's image fills the frame
+    assert np.array_equal(uniform["spp"], np.where(covered, 4, 0).astype(np.uint32))
+    exact = renderer.render(lens, spp="auto:0:4", outputs=["colour", "spp"])
     assert exact["colour"].tobytes() == uniform["colour"].tobytes()
+    assert np.array_equal(exact["spp"], uniform["spp"] + 1)
 
 
 def test_the_tent_filter_is_the_commands(tmp_path):

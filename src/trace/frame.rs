@@ -102,16 +102,20 @@ impl FramePass {
         self.trace_pass().read(ctx)
     }
 
-    /// The rays the last frame's colour took, all pixels together: counted by adaptive
-    /// sampling (read back), `spp` for each pixel with a ray in `output` (that frame's
-    /// outputs) under uniform sampling.
+    /// The rays each pixel's colour took in the last frame, row-major (the spp map):
+    /// counted by adaptive sampling (read back); under uniform sampling `spp` at each pixel
+    /// with a ray in `output` (that frame's outputs).
+    pub fn rays_map(&self, ctx: &GpuContext, output: &RenderOutput) -> Result<Vec<u32>> {
+        match self {
+            FramePass::Uniform(pass) => Ok(output.uniform_rays(pass.samples_per_side().pow(2))),
+            FramePass::Adaptive(pass) => pass.read_rays(ctx),
+        }
+    }
+
+    /// The rays the last frame's colour took, all pixels together (see
+    /// [`FramePass::rays_map`]).
     pub fn rays(&self, ctx: &GpuContext, output: &RenderOutput) -> Result<u64> {
-        Ok(match self {
-            FramePass::Uniform(pass) => {
-                let spp = u64::from(pass.samples_per_side().pow(2));
-                output.counts().0 as u64 * spp
-            }
-            FramePass::Adaptive(pass) => pass.read_rays(ctx)?.iter().map(|&n| u64::from(n)).sum(),
-        })
+        let map = self.rays_map(ctx, output)?;
+        Ok(map.iter().map(|&n| u64::from(n)).sum())
     }
 }

@@ -50,6 +50,14 @@ impl RenderOutput {
         colour_image(self.size, &self.colour)
     }
 
+    /// The spp map of a frame of `spp` uniform rays a pixel, row-major: `spp` at each pixel
+    /// with a ray ([`RenderOutput::valid`]), 0 elsewhere.
+    pub fn uniform_rays(&self, spp: u32) -> Vec<u32> {
+        (0..self.colour.len())
+            .map(|i| if self.valid(i) { spp } else { 0 })
+            .collect()
+    }
+
     /// Number of pixels with a ray, and of those whose primary ray hit something.
     pub fn counts(&self) -> (usize, usize) {
         let valid = (0..self.colour.len()).filter(|&i| self.valid(i)).count();

@@ -389,10 +389,7 @@ pub(crate) fn render(args: &RenderArgs) -> Result<()> {
         }
     }
     if let Some(path) = &spp_map {
-        let map = adaptive_rays.unwrap_or_else(|| {
-            let covered = |c: &[f32; 4]| u32::from(c[3] > 0.0);
-            output.colour.iter().map(|c| covered(c) * spp).collect()
-        });
+        let map = adaptive_rays.unwrap_or_else(|| output.uniform_rays(spp));
         save_png(
             &spp_picture(output.size, &map, &output.colour, spp + 1),
             path,
