@@ -175,21 +175,23 @@ def test_adaptive_sampling_equals_the_commands_and_keeps_exact_ground_truth(tmp_
     """spp="auto:..." renders what `fisheye render --spp auto:...` writes, bit for bit; its
     ids are uniform sampling's (never interpolated); at threshold 0 it is uniform sampling at
     its most rays exactly; and it spends fewer rays than that, so it differs somewhere. Its
-    "spp" map adds up to the rays the command says it traced for the colour; uniform
+    "spp" map is the command's spp.npy, and adds up to the rays it says it traced; uniform
     sampling's is its count at every pixel the lens covers, and at threshold 0 each pixel
     takes its centre's ray and then uniform sampling's."""
     out = tmp_path / "auto.png"
     said = fisheye(
         "render", "builtin:default", "--lens", "samyang-7.5mm", "--size", "96x72", "--spp",
-        "auto:0.05:4", "--outputs", "range,id", "-o", str(out),
+        "auto:0.05:4", "--outputs", "range,id,spp", "-o", str(out),
     ).stdout
     renderer = fr.Renderer(fr.Scene.load("builtin:default"))
     lens = fr.Lens.from_spec("samyang-7.5mm", size=(96, 72))
     auto = renderer.render(
         lens, spp="auto:0.05:4", outputs=["srgb", "colour", "range", "id", "spp"]
     )
-    for name in ["range", "id"]:
-        assert auto[name].tobytes() == np.load(tmp_path / f"auto.{name}.npy").tobytes(), name
+    for name in ["range", "id", "spp"]:
+        written = np.load(tmp_path / f"auto.{name}.npy")
+        assert auto[name].dtype == written.dtype and auto[name].shape == written.shape, name
+        assert auto[name].tobytes() == written.tobytes(), name
     assert np.array_equal(auto["srgb"], np.asarray(Image.open(out).convert("RGBA")))
     traced = int(re.search(r"(\d+) rays for their colour", said).group(1))
     assert auto["spp"].dtype == np.uint32 and auto["spp"].shape == (72, 96)

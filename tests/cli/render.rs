@@ -332,6 +332,38 @@ fn adaptive_render_writes_its_spp_map() {
         "one colour from {least} to {most}: nothing was refined"
     );
     assert!(dir.join("room.id.npy").is_file());
+    // The counts beside the picture: they add up to the rays the command reports, and the
+    // picture draws a pixel with none dark violet and one with the most yellow.
+    let bytes = std::fs::read(dir.join("room.spp.npy")).unwrap();
+    let npy = npyz::NpyFile::new(&bytes[..]).unwrap();
+    assert_eq!(npy.shape(), [72, 96]);
+    let counts: Vec<u32> = npy.into_vec().unwrap();
+    let reported: u64 = text
+        .split(" rays for their colour")
+        .next()
+        .and_then(|head| head.rsplit(' ').next())
+        .and_then(|n| n.parse().ok())
+        .unwrap_or_else(|| panic!("no count in:\n{text}"));
+    assert_eq!(counts.iter().map(|&n| u64::from(n)).sum::<u64>(), reported);
+    let most = *counts.iter().max().unwrap();
+    assert_eq!(most, 17, "16 samples after the centre's ray");
+    for (pixel, &n) in map.pixels().zip(&counts) {
+        if pixel[3] == 255 && (n == 0 || n == most) {
+            let expected = if n == 0 { [68, 1, 84] } else { [253, 231, 37] };
+            assert_eq!(pixel.0[..3], expected, "{n} rays");
+        }
+    }
+    // As OpenEXR: the same counts, a scalar in `Y`.
+    let exr_args = [&args[..], &["--format", "exr"]].concat();
+    stdout(&fisheye(&exr_args, ""));
+    let image = exr::prelude::read_all_flat_layers_from_file(dir.join("room.spp.exr")).unwrap();
+    let channel = &image.layer_data[0].channel_data.list[0];
+    assert_eq!(channel.name.to_string(), "Y");
+    let exr::prelude::FlatSamples::F32(values) = &channel.sample_data else {
+        panic!("expected f32 samples")
+    };
+    let as_floats: Vec<f32> = counts.iter().map(|&n| n as f32).collect();
+    assert_eq!(values, &as_floats);
     let refused = fisheye(
         &["render", "--spp", "auto:x", "-o", out.to_str().unwrap()],
         "",

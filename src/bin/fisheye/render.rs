@@ -13,7 +13,8 @@ use fisheye_rt::renderer::{Offscreen, Pass, SceneSet, Setup};
 use fisheye_rt::scene::{FRAME_FILL, Scene};
 use fisheye_rt::trace::{
     Channel, ColourFile, Display, GpuScene, KEY, PixelFilter, RenderOptions, Sampling, Tone,
-    auto_exposure, check_writable, save_png, spp_key, spp_picture, world_directions, write_colour,
+    Values, auto_exposure, check_writable, save_png, spp_key, spp_picture, world_directions,
+    write_colour, write_exr, write_npy,
 };
 
 use crate::args::{
@@ -114,7 +115,8 @@ pub(crate) struct RenderArgs {
     /// Ground-truth arrays to write beside the image as OUT_STEM.NAME.npy (or .exr): range
     /// (distance to the primary hit), normal, id (triangle), direction (world-space ray), mask;
     /// and spp, a picture of the rays each pixel took (OUT_STEM.spp.png: dark where a pixel
-    /// was interpolated, brighter with more rays; transparent where the lens masks it).
+    /// was interpolated, brighter with more rays; transparent where the lens masks it) and
+    /// their counts (OUT_STEM.spp.npy, uint32, or .exr).
     #[arg(long, value_enum, value_delimiter = ',')]
     pub(crate) outputs: Vec<Output>,
     /// File format of the ground-truth arrays.
@@ -131,13 +133,12 @@ pub(crate) fn render(args: &RenderArgs) -> Result<()> {
     let started = Instant::now();
     // Everything about the files first: a refused name costs no rendering.
     let file = ColourFile::for_path(&args.out, args.bits)?;
-    let array_path = |channel: Channel| {
+    let array_path = |name: &str| {
         let extension = match args.format {
             ArrayFormat::Npy => "npy",
             ArrayFormat::Exr => "exr",
         };
-        args.out
-            .with_extension(format!("{}.{extension}", channel.name()))
+        args.out.with_extension(format!("{name}.{extension}"))
     };
     if let Some(b) = args.outputs.iter().find_map(|o| o.between()) {
         anyhow::bail!(
@@ -155,17 +156,19 @@ pub(crate) fn render(args: &RenderArgs) -> Result<()> {
         );
     }
     let channels: Vec<Channel> = args.outputs.iter().filter_map(|o| o.channel()).collect();
+    // The spp map: its picture, and its counts as an array beside the others.
     let spp_map = args
         .outputs
         .iter()
         .any(|o| matches!(o, Output::Spp))
-        .then(|| args.out.with_extension("spp.png"));
+        .then(|| (args.out.with_extension("spp.png"), array_path("spp")));
     check_writable(&args.out)?;
     for &channel in &channels {
-        check_writable(&array_path(channel))?;
+        check_writable(&array_path(channel.name()))?;
     }
-    if let Some(path) = &spp_map {
-        check_writable(path)?;
+    if let Some((picture, counts)) = &spp_map {
+        check_writable(picture)?;
+        check_writable(counts)?;
     }
     let method = args.method.method();
     // A cube map's resampler takes one bilinear sample a pixel; --spp is direct tracing's,
@@ -380,7 +383,7 @@ pub(crate) fn render(args: &RenderArgs) -> Result<()> {
     if !channels.is_empty() {
         let directions = world_directions(&camera, &scene.camera);
         for &channel in &channels {
-            let path = array_path(channel);
+            let path = array_path(channel.name());
             match args.format {
                 ArrayFormat::Npy => output.write_npy(channel, &directions, &path)?,
                 ArrayFormat::Exr => output.write_exr(channel, &directions, &path)?,
@@ -388,13 +391,26 @@ pub(crate) fn render(args: &RenderArgs) -> Result<()> {
             println!("wrote {}", path.display());
         }
     }
-    if let Some(path) = &spp_map {
+    if let Some((picture, counts)) = &spp_map {
         let map = adaptive_rays.unwrap_or_else(|| output.uniform_rays(spp));
         save_png(
             &spp_picture(output.size, &map, &output.colour, spp + 1),
-            path,
+            picture,
         )?;
-        println!("wrote {} ({})", path.display(), spp_key(spp + 1));
+        println!("wrote {} ({})", picture.display(), spp_key(spp + 1));
+        // As NPY, uint32; as OpenEXR, a scalar in channel `Y` as the range is (every count to
+        // 257 exact in float), which any viewer shows.
+        match args.format {
+            ArrayFormat::Npy => write_npy(counts, output.size, Values::U32(map))?,
+            ArrayFormat::Exr => {
+                let counts_f32 = map.into_iter().map(|n| n as f32).collect();
+                write_exr(counts, output.size, "spp", Values::F32(1, counts_f32))?
+            }
+        }
+        println!(
+            "wrote {} (the rays each pixel's colour took)",
+            counts.display()
+        );
     }
     println!(
         "wrote {} ({}; {:.1} s in all)",
