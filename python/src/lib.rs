@@ -427,9 +427,10 @@ impl Renderer {
     /// (H×W×3 float32), "id" (H×W uint32, 4294967295 for none), "direction" (H×W×3 float32,
     /// scene frame) and "mask" (H×W uint8). The same arrays `fisheye render --outputs`
     /// writes, bit for bit. "spp" (H×W uint32) is the rays each pixel's colour took: adaptive
-    /// sampling's count (0 where a pixel was interpolated), or `spp` at each pixel with a ray. Moving objects (glTF animations, scene-file keys) are placed at
-    /// scene time `time` (seconds), as `fisheye render --time` places them, without building
-    /// the meshes' BVHs again. `filter` is "box" (each pixel its own rays' mean) or "tent"
+    /// sampling's count (0 where a pixel was interpolated), or `spp` at each pixel with a ray.
+    /// Moving objects (glTF animations, scene-file keys) are placed at scene time `time`
+    /// (seconds), as `fisheye render --time` places them, without building the meshes' BVHs
+    /// again. `filter` is "box" (each pixel its own rays' mean) or "tent"
     /// (at one ray a pixel at most, each pixel blended with its neighbours, as
     /// `fisheye render --filter tent`).
     #[pyo3(signature = (lens, pose = None, spp = Spp::Count(16), outputs = vec!["colour".to_string(), "srgb".to_string()], exposure = 0.0, tone = "aces", time = 0.0, filter = "box"))]
