@@ -187,17 +187,19 @@ pub fn compare(
         }
         // Each setup's last frame is read back and measured against the reference, a group
         // of setups at a time on every thread at once (ꟻLIP takes about half a second for a
-        // 1024×768 image on one core); a group holds only as many images as there are threads.
+        // 1024×768 image on one core); a group holds as many images as there are threads, and
+        // no more than MEASURED_AT_ONCE.
         let what = format!("{} errors against the reference", lens.name);
         progress(Progress {
             done,
             total,
             what: &what,
         });
+        let group_size = threads::available().min(MEASURED_AT_ONCE);
         let mut timed = setups.iter().zip(&renderers).zip(times);
         loop {
             let mut group = Vec::new();
-            for ((&setup, renderer), times) in timed.by_ref().take(threads::available()) {
+            for ((&setup, renderer), times) in timed.by_ref().take(group_size) {
                 let colour = renderer.colour(study.ctx)?;
                 let covered = colour.iter().filter(|c| c[3] > 0.0).count().max(1) as f64;
                 let rays_per_pixel = match renderer.rays_per_pixel(study.ctx)? {
@@ -269,6 +271,10 @@ pub fn compare(
         skipped,
     })
 }
+
+/// The most setups' frames `compare` holds at once while it measures them (a 3840×2160
+/// frame's colour alone takes 133 MB, and ꟻLIP makes images of its own as large).
+const MEASURED_AT_ONCE: usize = 16;
 
 /// A setup's last frame, read back, and its errors against the reference once measured.
 struct Measured {
