@@ -28,7 +28,7 @@ use crate::lens::gpu::DirectionSource;
 use crate::scene::Scene;
 use crate::trace::{
     Channel, ColourFile, Display, FramePass, GpuScene, Motion, RenderOptions, RenderOutput,
-    moving_directions, rotated, write_colour, write_exr, write_file, write_npy,
+    moving_directions, rotated, write_colour, write_exr, write_file, write_npy, write_rays_map,
 };
 
 /// How a pose's cameras are submitted to the GPU.
@@ -72,6 +72,10 @@ pub struct Dataset {
     pub between: (Vec<Between>, FlowFile),
     /// Segmentation written beside each image (in the arrays' format), with the label map.
     pub labels: Vec<Label>,
+    /// Whether each image's spp map is written beside it (`spp`, in the arrays' format): the
+    /// rays its pixels' colours took, 0 where adaptive sampling interpolated a pixel or the
+    /// lens covers none of it ([`FramePass::rays_map`]).
+    pub spp_map: bool,
     /// A synthetic IMU on the body, whose spline the frames' poses follow too (`poses` hold
     /// them).
     pub imu: Option<Imu>,
@@ -141,6 +145,8 @@ struct Written {
     /// The camera's motion over the frame, where its shutter spreads the rays over time.
     motion: Option<Motion>,
     output: RenderOutput,
+    /// The rays each pixel took, where the spp map is written.
+    rays: Option<Vec<u32>>,
 }
 
 impl Dataset {
@@ -252,6 +258,9 @@ impl Dataset {
             let file = format!("{stem}.{name}.{ext}");
             (name, file)
         }));
+        if self.spp_map {
+            files.push(("spp".to_string(), format!("{stem}.spp.{ext}")));
+        }
         for b in &self.between.0 {
             files.extend(b.files(&stem, self.outputs.1, self.between.1));
         }
@@ -493,6 +502,7 @@ impl Dataset {
                         })
                         .collect();
                     let mut outputs = Vec::with_capacity(passes.len());
+                    let mut rays = Vec::with_capacity(passes.len());
                     gpu_scene.place_at(ctx, &scene, self.scene_time(p), window)?;
                     for group in groups {
                         let t = Instant::now();
@@ -524,20 +534,24 @@ impl Dataset {
                         let t = Instant::now();
                         for &c in &group {
                             let output = passes[c].trace_pass().read(ctx)?;
-                            report.rays += passes[c].rays(ctx, &output)?;
+                            let map = passes[c].rays_map(ctx, &output)?;
+                            report.rays += map.iter().map(|&n| u64::from(n)).sum::<u64>();
                             outputs.push(output);
+                            rays.push(self.spp_map.then_some(map));
                         }
                         report.readback_seconds += t.elapsed().as_secs_f64();
                     }
                     let views: Vec<Written> = outputs
                         .into_iter()
+                        .zip(rays)
                         .enumerate()
-                        .map(|(c, output)| Written {
+                        .map(|(c, (output, rays))| Written {
                             index: p,
                             camera: c,
                             pose: poses[c],
                             motion: motions[c].clone(),
                             output,
+                            rays,
                         })
                         .collect();
                     if sender.send((wanted, views)).is_err() {
@@ -609,6 +623,10 @@ impl Dataset {
             }
         }
         rest = &rest[self.labels.len()..];
+        if let Some(map) = &w.rays {
+            write_rays_map(&folder.join(&rest[0].1), out.size, map)?;
+            rest = &rest[1..];
+        }
         if self.between.0.is_empty() {
             return Ok(());
         }

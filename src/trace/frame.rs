@@ -111,11 +111,4 @@ impl FramePass {
             FramePass::Adaptive(pass) => pass.read_rays(ctx),
         }
     }
-
-    /// The rays the last frame's colour took, all pixels together (see
-    /// [`FramePass::rays_map`]).
-    pub fn rays(&self, ctx: &GpuContext, output: &RenderOutput) -> Result<u64> {
-        let map = self.rays_map(ctx, output)?;
-        Ok(map.iter().map(|&n| u64::from(n)).sum())
-    }
 }

@@ -36,7 +36,9 @@ pub use options::{
     Adaptive, PixelFilter, RenderOptions, SampleLanes, Sampling, Traversal, surface_constants,
     surface_id,
 };
-pub use output::{Channel, RenderOutput, Values, spp_key, spp_picture, write_exr, write_npy};
+pub use output::{
+    Channel, RenderOutput, Values, spp_key, spp_picture, write_exr, write_npy, write_rays_map,
+};
 pub use pass::TracePass;
 pub use ray_query::RayQueryScene;
 pub use tent::Tent;

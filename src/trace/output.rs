@@ -216,6 +216,18 @@ pub fn write_npy(path: &Path, size: ImageSize, values: Values) -> Result<()> {
     }
 }
 
+/// Writes an spp map (the rays each pixel's colour took, row-major) as the path's extension
+/// says: `.exr` as a float in channel `Y` of a layer named `spp`, as the range is (every
+/// count to 257 exact in float), which any viewer shows; else NPY, `uint32`.
+pub fn write_rays_map(path: &Path, size: ImageSize, map: &[u32]) -> Result<()> {
+    if path.extension().is_some_and(|e| e == "exr") {
+        let counts = map.iter().map(|&n| n as f32).collect();
+        write_exr(path, size, "spp", Values::F32(1, counts))
+    } else {
+        write_npy(path, size, Values::U32(map.to_vec()))
+    }
+}
+
 /// Writes an image's array as OpenEXR, its layer named `name`: a scalar in channel `Y` (a
 /// `u8` as float 0 to 255), a `u32` in `id`, components in `R`, `G`, `B` (as many as it has).
 pub fn write_exr(path: &Path, size: ImageSize, name: &str, values: Values) -> Result<()> {

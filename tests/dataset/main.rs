@@ -448,6 +448,104 @@ fn adaptive_datasets_keep_exact_ground_truth() {
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
+/// `--outputs spp` writes each image's spp map beside it. Adaptive sampling's add up, over the
+/// shard's images, to the rays its run record counts; they are 0 in the image's corners,
+/// outside the 180° lens's circle, and at some pixels whose centres it covers
+/// (interpolated), more than 1 at others (supersampled), and at most MAX + 1 (the centre
+/// ray the estimate adds to MAX). Uniform sampling's, as OpenEXR, are its rays at every
+/// pixel whose centre the lens covers and 0 in the corners. The plan lists the output.
+#[test]
+fn a_datasets_spp_maps_count_its_rays() {
+    let dir = temp_dir("spp");
+    let trajectory = repo("scenes/dataset/room-loop.tum");
+    let render = |spp: &str, format: &str, out: &Path| {
+        succeed(
+            fisheye()
+                .args(["dataset", "render", "--trajectory", &trajectory])
+                .args([
+                    "--lens",
+                    "canon-8-15mm@8mm",
+                    "--size",
+                    "64x48",
+                    "--spp",
+                    spp,
+                ])
+                .args(["--outputs", "mask,spp", "--format", format])
+                .args(["--shard", "0/20", "-o"])
+                .arg(out),
+        )
+    };
+    let (auto, uniform) = (dir.join("auto"), dir.join("uniform"));
+    render("auto:0.1:4", "npy", &auto);
+    render("4", "exr", &uniform);
+    let npy = |path: &Path| -> Vec<u32> {
+        let bytes = std::fs::read(path).unwrap();
+        let file = npyz::NpyFile::new(&bytes[..]).unwrap();
+        assert_eq!(file.shape(), &[48, 64], "{}", path.display());
+        file.into_vec().unwrap()
+    };
+    let (mut rays, mut maps, mut interpolated, mut supersampled) = (0u64, 0, 0, 0);
+    for (path, _) in files(&auto) {
+        let Some(stem) = path.to_str().unwrap().strip_suffix(".spp.npy") else {
+            continue;
+        };
+        let counts = npy(&auto.join(&path));
+        let mask: Vec<u8> = {
+            let bytes = std::fs::read(auto.join(format!("{stem}.mask.npy"))).unwrap();
+            npyz::NpyFile::new(&bytes[..]).unwrap().into_vec().unwrap()
+        };
+        assert_eq!(
+            (counts[0], counts[64 * 48 - 1]),
+            (0, 0),
+            "{stem}: the corners"
+        );
+        for (&n, &m) in counts.iter().zip(&mask) {
+            assert!(n <= 5, "{stem}: {n} rays, past MAX + 1");
+            interpolated += usize::from(m == 1 && n == 0);
+            supersampled += usize::from(n > 1);
+        }
+        rays += counts.iter().map(|&n| u64::from(n)).sum::<u64>();
+        maps += 1;
+    }
+    assert_eq!(maps, 5, "one map an image of the shard's 5 poses");
+    assert!(
+        interpolated > 0 && supersampled > 0,
+        "{interpolated} {supersampled}"
+    );
+    let record: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(auto.join("shards/0-of-20.json")).unwrap()).unwrap();
+    assert_eq!(record["rays"].as_u64(), Some(rays));
+    let plan: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(auto.join("plan.json")).unwrap()).unwrap();
+    assert_eq!(
+        plan["render"]["outputs"],
+        serde_json::json!(["mask", "spp"])
+    );
+
+    let channel_y = |path: PathBuf| -> Vec<f32> {
+        let image = exr::prelude::read_all_flat_layers_from_file(&path).unwrap();
+        let channel = &image.layer_data[0].channel_data.list[0];
+        assert_eq!(channel.name.to_string(), "Y", "{}", path.display());
+        let exr::prelude::FlatSamples::F32(values) = &channel.sample_data else {
+            panic!("{}: not float", path.display());
+        };
+        values.clone()
+    };
+    let (counts, mask) = (
+        channel_y(uniform.join("cam0/000000_0.0.spp.exr")),
+        channel_y(uniform.join("cam0/000000_0.0.mask.exr")),
+    );
+    assert_eq!(counts.len(), 64 * 48);
+    assert_eq!((counts[0], counts[64 * 48 - 1]), (0.0, 0.0), "the corners");
+    for (n, m) in counts.iter().zip(&mask) {
+        assert!(*n == 0.0 || *n == 4.0, "{n} rays");
+        if *m == 1.0 {
+            assert_eq!(*n, 4.0);
+        }
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
 /// `--outputs instance,semantic` names each pixel's object and class: an OBJ with objects
 /// `chair` and `table` side by side in front of the camera gives, in every frame, the
 /// chair's instance id on the left of the image and the table's on the right (as its hit's

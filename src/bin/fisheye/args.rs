@@ -358,7 +358,7 @@ pub(crate) enum Output {
     Id,
     Direction,
     Mask,
-    /// The rays each pixel took, as a picture (`render` only).
+    /// The rays each pixel took: `render`'s picture and array, a dataset's array.
     Spp,
     /// Optical flow to the next frame and its covisibility (`dataset render` only).
     Flow,
@@ -373,8 +373,8 @@ pub(crate) enum Output {
 }
 
 impl Output {
-    /// The ground-truth array of this output; `None` for the spp map, which is a picture,
-    /// and for the outputs between frames ([`Output::between`]).
+    /// The ground-truth array of this output; `None` for the spp map, which is counted
+    /// rather than traced, and for the outputs between frames ([`Output::between`]).
     pub(crate) fn channel(self) -> Option<Channel> {
         Some(match self {
             Output::Range => Channel::Range,

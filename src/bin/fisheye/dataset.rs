@@ -146,7 +146,8 @@ pub(crate) struct RenderArgs {
     #[arg(long, value_enum, default_value = "aces")]
     tone: ToneArg,
     /// Ground truth written beside each image: range, normal, id, direction, mask;
-    /// instance and semantic (each pixel's object and class, named in labels.json); and
+    /// instance and semantic (each pixel's object and class, named in labels.json); spp (the
+    /// rays each pixel's colour took: 0 where adaptive sampling interpolated it); and
     /// between frames, through the lens (and rolling shutter): flow (to the next frame, with
     /// flow_valid where it sees the point), flow-backward (from the previous), scene-flow.
     #[arg(long, value_enum, value_delimiter = ',')]
@@ -277,9 +278,6 @@ fn render(args: &RenderArgs) -> Result<()> {
         }
     }
     let scene = load_scene_with(&args.scene, args.gltf_scene)?;
-    if args.outputs.iter().any(|o| matches!(o, Output::Spp)) {
-        bail!("--outputs spp is render's (a picture of one frame's rays)");
-    }
     let channels: Vec<Channel> = args.outputs.iter().filter_map(|o| o.channel()).collect();
     let mut between: Vec<Between> = Vec::new();
     for b in args.outputs.iter().filter_map(|o| o.between()) {
@@ -311,6 +309,7 @@ fn render(args: &RenderArgs) -> Result<()> {
         stamps,
         imu,
         labels,
+        spp_map: args.outputs.iter().any(|o| matches!(o, Output::Spp)),
         cameras,
         scene_from_world,
         body_from_rig,

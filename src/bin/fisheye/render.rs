@@ -13,8 +13,8 @@ use fisheye_rt::renderer::{Offscreen, Pass, SceneSet, Setup};
 use fisheye_rt::scene::{FRAME_FILL, Scene};
 use fisheye_rt::trace::{
     Channel, ColourFile, Display, GpuScene, KEY, PixelFilter, RenderOptions, Sampling, Tone,
-    Values, auto_exposure, check_writable, save_png, spp_key, spp_picture, world_directions,
-    write_colour, write_exr, write_npy,
+    auto_exposure, check_writable, save_png, spp_key, spp_picture, world_directions, write_colour,
+    write_rays_map,
 };
 
 use crate::args::{
@@ -398,15 +398,7 @@ pub(crate) fn render(args: &RenderArgs) -> Result<()> {
             picture,
         )?;
         println!("wrote {} ({})", picture.display(), spp_key(spp + 1));
-        // As NPY, uint32; as OpenEXR, a scalar in channel `Y` as the range is (every count to
-        // 257 exact in float), which any viewer shows.
-        match args.format {
-            ArrayFormat::Npy => write_npy(counts, output.size, Values::U32(map))?,
-            ArrayFormat::Exr => {
-                let counts_f32 = map.into_iter().map(|n| n as f32).collect();
-                write_exr(counts, output.size, "spp", Values::F32(1, counts_f32))?
-            }
-        }
+        write_rays_map(counts, output.size, &map)?;
         println!(
             "wrote {} (the rays each pixel's colour took)",
             counts.display()

@@ -75,7 +75,9 @@ impl Dataset {
                            project's convention); opencv.camera_matrix puts its centre there",
                 "arrays": "range: metres to the first hit along the pixel centre's ray (0 where \
                            none); normal: world unit normal; id: scene triangle (4294967295 for \
-                           none); direction: world unit ray; mask: 1 where the lens has a ray",
+                           none); direction: world unit ray; mask: 1 where the lens has a ray; \
+                           spp: the rays the pixel's colour took (0 where adaptive sampling \
+                           interpolated it from its neighbours, or the lens covers none of it)",
                 "time": "a camera's shutter (cameras[].shutter): line v (the OpenCV row v read \
                          top to bottom, Kalibr's convention; other orders as readout says) is \
                          read at the frame's stamp + v line_delay, and exposed for \
@@ -118,6 +120,7 @@ impl Dataset {
                 },
                 "outputs": self.outputs.0.iter().map(|c| c.name())
                     .chain(self.labels.iter().map(|l| l.name()))
+                    .chain(self.spp_map.then_some("spp"))
                     .chain(self.between.0.iter().map(|b| b.name()))
                     .collect::<Vec<_>>(),
                 "flow_files": match self.between.1 {
