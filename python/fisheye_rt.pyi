@@ -103,7 +103,8 @@ class Renderer:
         them, bit for bit, and "spp" H×W uint32, the rays each pixel's colour took (adaptive
         sampling's count, 0 where a pixel was interpolated; `spp` at each pixel with a ray). Moving objects are placed at scene time `time` (seconds), as
         `fisheye render --time` places them. `filter` "tent" blends each pixel of a frame of
-        one ray a pixel at most with its neighbours, as `fisheye render --filter tent`. The GIL
+        one ray a pixel at most with its neighbours, as `fisheye render --filter tent` (with more
+        rays a `UserWarning` says each pixel keeps its rays' mean). The GIL
         is released while the GPU works."""
 
 def look_at(

@@ -23,7 +23,7 @@ use fisheye_rt::{Error, LensError};
 use glam::{DAffine3, DVec2, DVec3};
 use numpy::ndarray::IxDyn;
 use numpy::{AllowTypeChange, PyArray1, PyArrayDyn, PyArrayLikeDyn, PyArrayMethods};
-use pyo3::exceptions::{PyOSError, PyRuntimeError, PyValueError};
+use pyo3::exceptions::{PyOSError, PyRuntimeError, PyUserWarning, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
@@ -432,7 +432,7 @@ impl Renderer {
     /// (seconds), as `fisheye render --time` places them, without building the meshes' BVHs
     /// again. `filter` is "box" (each pixel its own rays' mean) or "tent"
     /// (at one ray a pixel at most, each pixel blended with its neighbours, as
-    /// `fisheye render --filter tent`).
+    /// `fisheye render --filter tent`; with more rays a `UserWarning` says it keeps the box).
     #[pyo3(signature = (lens, pose = None, spp = Spp::Count(16), outputs = vec!["colour".to_string(), "srgb".to_string()], exposure = 0.0, tone = "aces", time = 0.0, filter = "box"))]
     #[allow(clippy::too_many_arguments)]
     fn render<'py>(
@@ -462,6 +462,19 @@ impl Renderer {
             )));
         }
         let sampling = spp.sampling()?;
+        // As `fisheye render --filter` notes, a warning where the filter changes nothing.
+        let filter = if filter.applies_to(sampling) {
+            filter
+        } else {
+            let message = format!(
+                "filter={:?} changes frames of one ray a pixel; at spp={sampling} each pixel \
+                 keeps its rays' mean",
+                filter.name()
+            );
+            let message = std::ffi::CString::new(message).expect("no NUL in the message");
+            PyErr::warn(py, &py.get_type::<PyUserWarning>(), &message, 1)?;
+            PixelFilter::Box
+        };
         let ground_truth = Channel::ALL
             .iter()
             .any(|c| c.traced() && outputs.iter().any(|o| o == c.name()));

@@ -210,7 +210,8 @@ def test_adaptive_sampling_equals_the_commands_and_keeps_exact_ground_truth(tmp_
 
 def test_the_tent_filter_is_the_commands(tmp_path):
     """filter="tent" renders what `fisheye render --filter tent` writes, bit for bit, and
-    changes a one-ray image's colour but not its ground truth."""
+    changes a one-ray image's colour but not its ground truth; at more rays a pixel it warns
+    and keeps the box."""
     out = tmp_path / "tent.png"
     fisheye(
         "render", "builtin:default", "--lens", "samyang-7.5mm", "--size", "96x72", "--spp",
@@ -224,6 +225,11 @@ def test_the_tent_filter_is_the_commands(tmp_path):
     boxed = renderer.render(lens, spp="auto:0.1:1", outputs=["srgb", "id"])
     assert np.array_equal(boxed["id"], tent["id"])
     assert not np.array_equal(boxed["srgb"], tent["srgb"])
+    # With more rays than one a pixel the tent changes nothing, and a warning says so, as the
+    # command's note does; the image is the box's.
+    with pytest.warns(UserWarning, match="each pixel keeps its rays' mean"):
+        many = renderer.render(lens, spp=4, filter="tent", outputs=["srgb"])
+    assert np.array_equal(many["srgb"], renderer.render(lens, spp=4, outputs=["srgb"])["srgb"])
 
 
 def test_a_prescription_is_a_lens_as_the_command_line_has_it():
