@@ -505,3 +505,101 @@ fn marks_around_a_frame_span_its_passes() {
         );
     }
 }
+
+/// A moving scene (`scenes/dataset/sliding.toml`: a box sliding and turning over a second):
+/// after `Renderer::place_at(t)` frames show what the one-call render draws of the scene
+/// posed at `t` (`Scene::at`), bit for bit, directly and through a traced cube map, and the
+/// box moves between 0.2 s and 0.8 s; a progressive frame after a place starts again (the
+/// first frame at an unchanged pose is a new renderer's first); a rasterized cube map, which
+/// draws the scene flattened once, refuses it, saying what places moving instances.
+#[test]
+fn frames_placed_at_a_time_show_the_scene_posed_then() {
+    use fisheye_rt::cube::{CubeMap, CubeMethod, CubeSettings};
+    use fisheye_rt::raster::RasterMethod;
+    let (device, queue) = own_device();
+    let ctx = GpuContext::from_device(&device, &queue);
+    let path = format!("{}/scenes/dataset/sliding.toml", env!("CARGO_MANIFEST_DIR"));
+    let scene = fisheye_rt::scene::load(&path).unwrap().scene;
+    assert_eq!(scene.key_span(), Some((0.0, 1.0)), "the keys' times");
+    let camera = LensCamera::new(
+        parse_spec("equidistant:f=0.5,fov=180").unwrap(),
+        ImageSize::new(64, 48).unwrap(),
+    );
+    let format = wgpu::TextureFormat::Rgba32Float;
+    let options = RenderOptions {
+        spp: 4,
+        ..RenderOptions::default()
+    };
+    let draw = |renderer: &Renderer, progressive: bool| {
+        let target = renderer.target_texture(&device);
+        let mut encoder = device.create_command_encoder(&Default::default());
+        if progressive {
+            renderer.encode_progressive(&mut encoder, &scene.camera, &target)
+        } else {
+            renderer.encode(&mut encoder, &scene.camera, &target)
+        }
+        .unwrap();
+        queue.submit([encoder.finish()]);
+        ctx.read_texture(&target).unwrap()
+    };
+    let renderer = Renderer::new(&device, &queue, &scene, &camera, &options, format).unwrap();
+    let mut frames = Vec::new();
+    for t in [0.2, 0.8] {
+        renderer.place_at(&scene, t).unwrap();
+        let expected = render(&ctx, &scene.at(t), &camera, &options)
+            .unwrap()
+            .colour;
+        let frame = draw(&renderer, false);
+        assert_same(&format!("rt at {t} s"), &frame, &expected);
+        frames.push(frame);
+    }
+    let moved = frames[0].iter().zip(&frames[1]).filter(|(a, b)| a != b);
+    assert!(moved.count() > 100, "the box moved between 0.2 and 0.8 s");
+
+    let settings = CubeSettings::new(32, CubeMethod::Traced);
+    let cube = Renderer::through_cube(
+        &device, &queue, &scene, &camera, &options, &settings, format,
+    )
+    .unwrap();
+    cube.place_at(&scene, 0.8).unwrap();
+    let posed = scene.at(0.8);
+    let gpu_scene = GpuScene::new(&ctx, &posed, &options).unwrap();
+    let expected = CubeMap::new(&ctx, &camera, &gpu_scene, &settings)
+        .unwrap()
+        .render(&ctx, &gpu_scene, &scene.camera)
+        .unwrap();
+    assert_same("cube-rt at 0.8 s", &draw(&cube, false), &expected);
+
+    let adaptive = RenderOptions {
+        spp: 16,
+        adaptive: Some(Adaptive {
+            threshold: Adaptive::DEFAULT_THRESHOLD,
+            ground_truth: false,
+            every_pixel: false,
+        }),
+        ..RenderOptions::default()
+    };
+    let renderer = Renderer::new(&device, &queue, &scene, &camera, &adaptive, format).unwrap();
+    renderer.place_at(&scene, 0.2).unwrap();
+    for _ in 0..4 {
+        draw(&renderer, true);
+    }
+    renderer.place_at(&scene, 0.8).unwrap();
+    let after_place = draw(&renderer, true);
+    let fresh = Renderer::new(&device, &queue, &scene, &camera, &adaptive, format).unwrap();
+    fresh.place_at(&scene, 0.8).unwrap();
+    assert_same(
+        "the first frame after a place",
+        &after_place,
+        &draw(&fresh, true),
+    );
+
+    let raster = CubeSettings::new(32, CubeMethod::Raster(RasterMethod::Forward));
+    let flat = Renderer::through_cube(&device, &queue, &scene, &camera, &options, &raster, format)
+        .unwrap();
+    let error = flat.place_at(&scene, 0.5).unwrap_err().to_string();
+    assert!(
+        error.contains("flattened once") && error.contains("traced cube map"),
+        "{error}"
+    );
+}

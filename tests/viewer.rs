@@ -1,4 +1,4 @@
-//! The interactive viewer (`examples/viewer.rs`), run as a user runs it but under Xvfb: its
+//! The interactive viewer (`examples/viewer/`), run as a user runs it but under Xvfb: its
 //! window, after a few frames, shows what the library renders. `cargo test` builds the example
 //! next to this test's binary; `xvfb-run` comes from the `xvfb` package (which
 //! `.ci/install-lavapipe` installs).
@@ -178,4 +178,35 @@ fn the_viewer_shows_the_scene_under_xvfb() {
         20,
     );
     assert_shows("rt through glass, adaptive, still", &window, &traced);
+}
+
+/// A moving scene (`scenes/dataset/sliding.toml`: a box sliding and turning over a second)
+/// with `--time 0.8`, paused there, shows the scene posed at 0.8 s (`Scene::at`), which is not
+/// the scene as loaded (the box stands elsewhere at 0 s).
+#[test]
+fn the_viewer_shows_a_moving_scene_at_its_time() {
+    let path = format!("{}/scenes/dataset/sliding.toml", env!("CARGO_MANIFEST_DIR"));
+    let scene = fisheye_rt::scene::load(&path).unwrap().scene;
+    let lens = "canon-8-15mm@8mm";
+    let camera = LensCamera::new(parse_spec(lens).unwrap(), ImageSize::new(160, 120).unwrap());
+    let ctx = GpuContext::new().unwrap();
+    let options = RenderOptions {
+        spp: 4,
+        ..RenderOptions::default()
+    };
+    let at = |t: f64| {
+        render(&ctx, &scene.at(t), &camera, &options)
+            .unwrap()
+            .to_image()
+    };
+    let args = [&path, "--lens", lens, "--size", "160x120", "--spp", "4"];
+    let window = screenshot(&[&args[..], &["--time", "0.8"]].concat(), 4);
+    assert_shows("sliding.toml at 0.8 s", &window, &at(0.8));
+    let loaded = at(0.0);
+    let moved = window
+        .pixels()
+        .zip(loaded.pixels())
+        .filter(|(w, e)| e[3] == 255 && (0..3).any(|k| w[k].abs_diff(e[k]) > 8))
+        .count();
+    assert!(moved > 200, "{moved} pixels show the box moved");
 }

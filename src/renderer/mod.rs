@@ -261,6 +261,9 @@ pub struct Renderer {
     present_layout: wgpu::BindGroupLayout,
     format: wgpu::TextureFormat,
     camera: LensCamera,
+    /// Whether the scene was flattened for a rasterized cube map (its instances then stay
+    /// where they were loaded).
+    flattened: bool,
     /// Progressive refinement's place: the pose its steps are for and the next step's number
     /// (`None` after a whole frame).
     progress: Mutex<Option<(Camera, u32)>>,
@@ -322,7 +325,8 @@ impl Renderer {
         let ctx = GpuContext::from_device(device, queue);
         let rasterizes = cube.is_some_and(|c| matches!(c.method, CubeMethod::Raster(_)));
         let flat;
-        let scene = if rasterizes && scene.is_instanced() {
+        let flattened = rasterizes && scene.is_instanced();
+        let scene = if flattened {
             flat = scene.flattened(crate::scene::MAX_FLATTENED)?;
             &flat
         } else {
@@ -377,6 +381,7 @@ impl Renderer {
             present_layout,
             format,
             camera: *camera,
+            flattened,
             progress: Mutex::new(None),
         })
     }
@@ -406,6 +411,30 @@ impl Renderer {
     /// The scene as uploaded (its BVH statistics, bounds, features).
     pub fn scene(&self) -> &GpuScene {
         &self.scene
+    }
+
+    /// Places the scene's moving instances (glTF animations, scene-file keys) at scene time
+    /// `time` for the frames submitted from now on, where `fisheye render --time` poses them,
+    /// and starts progressive refinement again; `scene` is the one the renderer was made from.
+    /// The meshes' BVHs stay as built: only the top level is rebuilt
+    /// ([`GpuScene::place_at`]). Nothing to do where nothing moves. Refused through ray
+    /// queries and rasterized cube maps, which draw the scene flattened once, as loaded.
+    pub fn place_at(&self, scene: &Scene, time: f64) -> Result<()> {
+        if !scene.moves() {
+            return Ok(());
+        }
+        if self.flattened {
+            return Err(Error::Limit(
+                "a rasterized cube map draws the scene flattened once, as loaded; moving \
+                 instances are placed by the BVH traversal (direct tracing or a traced cube \
+                 map)"
+                    .into(),
+            ));
+        }
+        self.scene
+            .place_at(&self.ctx, scene, time, self.camera.exposure_span())?;
+        *self.progress.lock().unwrap_or_else(|e| e.into_inner()) = None;
+        Ok(())
     }
 
     /// Records one frame seen from `pose` into `encoder`, written into `target`: a 2D texture

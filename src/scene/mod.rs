@@ -321,6 +321,19 @@ impl Scene {
         self.instances.iter().any(|i| i.animation.is_some())
     }
 
+    /// The first and last key time of the scene's animations (seconds); `None` where
+    /// nothing moves. Before the first key instances stay where it puts them, and after the
+    /// last where that one does.
+    pub fn key_span(&self) -> Option<(f64, f64)> {
+        self.animations
+            .iter()
+            .flat_map(|a| a.key_times())
+            .fold(None, |span, t| match span {
+                None => Some((t, t)),
+                Some((a, b)) => Some((t.min(a), t.max(b))),
+            })
+    }
+
     /// The scene still at scene time `t` (seconds): each moving instance fixed where its
     /// animation puts it then (a placement that flattens its mesh hides it: see
     /// [`Instance::visible`]).

@@ -222,17 +222,7 @@ pub(crate) fn render(args: &RenderArgs) -> Result<()> {
     if !args.time.is_finite() {
         bail!("--time {}: a time in seconds must be finite", args.time);
     }
-    if scene.moves() {
-        let keys: Vec<f64> = scene
-            .animations
-            .iter()
-            .flat_map(|a| a.key_times())
-            .collect();
-        let (first, last) = keys
-            .iter()
-            .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &t| {
-                (a.min(t), b.max(t))
-            });
+    if let Some((first, last)) = scene.key_span().filter(|_| scene.moves()) {
         let moving = scene
             .instances
             .iter()

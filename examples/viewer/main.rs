@@ -14,6 +14,11 @@
 //! back to the scene's camera, Esc quits. The title shows the lens, the method and the frame
 //! time.
 //!
+//! A scene that moves (glTF animations, scene-file keys) plays, looping over its keys'
+//! span, with the scene time in the title; Space pauses and resumes it, and `--time T` starts
+//! it paused at T seconds. Ray queries and rasterized cube maps draw it as loaded (a note
+//! says so): they take the scene flattened once.
+//!
 //! Frames are progressive (`Renderer::encode_progressive`): with adaptive sampling, a moving
 //! camera sees the frame below one ray per pixel, and a still one sees it sharpen frame by
 //! frame (about one ray per pixel each) into the whole adaptive frame; other samplings draw
@@ -43,6 +48,9 @@ use winit::event::{DeviceEvent, ElementState, KeyEvent, MouseButton, WindowEvent
 use winit::event_loop::{ActiveEventLoop, EventLoop};
 use winit::keyboard::{KeyCode, PhysicalKey};
 use winit::window::{Window, WindowId};
+
+mod clock;
+use clock::Clock;
 
 /// The lenses L cycles through (after the one given with `--lens`).
 const LENSES: [&str; 5] = [
@@ -75,6 +83,7 @@ struct Args {
     size: PhysicalSize<u32>,
     frames: Option<u32>,
     screenshot: Option<PathBuf>,
+    time: Option<f64>,
 }
 
 fn args() -> Result<Args, String> {
@@ -86,6 +95,7 @@ fn args() -> Result<Args, String> {
         size: PhysicalSize::new(960, 720),
         frames: None,
         screenshot: None,
+        time: None,
     };
     let mut it = std::env::args().skip(1);
     while let Some(arg) = it.next() {
@@ -117,6 +127,14 @@ fn args() -> Result<Args, String> {
                 out.frames = Some(text.parse().map_err(|_| format!("--frames {text:?}"))?);
             }
             "--screenshot" => out.screenshot = Some(value("--screenshot")?.into()),
+            "--time" => {
+                let text = value("--time")?;
+                let t: f64 = text.parse().map_err(|_| format!("--time {text:?}"))?;
+                if !t.is_finite() {
+                    return Err(format!("--time {text}: a time in seconds must be finite"));
+                }
+                out.time = Some(t);
+            }
             flag if flag.starts_with("--") => return Err(format!("unknown option {flag}")),
             scene => out.scene = scene.into(),
         }
@@ -142,6 +160,8 @@ struct State {
     last_frame: Instant,
     frame_ms: f64,
     frames: u32,
+    /// The scene's time, where it moves.
+    clock: Option<Clock>,
 }
 
 /// A renderer for the current lens, method and window size, and its texture.
@@ -153,7 +173,7 @@ struct View {
 }
 
 impl State {
-    fn new(window: Arc<Window>, scene: Scene) -> Result<Self, String> {
+    fn new(window: Arc<Window>, scene: Scene, time: Option<f64>) -> Result<Self, String> {
         let instance = wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle());
         let surface = instance
             .create_surface(window.clone())
@@ -187,6 +207,8 @@ impl State {
         surface.configure(&ctx.device, &config);
         let blit = blit_pipeline(&ctx.device, format);
         let pose = scene.camera;
+        let clock = scene.key_span().filter(|_| scene.moves());
+        let clock = clock.map(|span| Clock::new(span, time));
         Ok(Self {
             window,
             ctx,
@@ -204,6 +226,7 @@ impl State {
             last_frame: Instant::now(),
             frame_ms: 0.0,
             frames: 0,
+            clock,
         })
     }
 
@@ -215,7 +238,12 @@ impl State {
                 return Ok(());
             }
             match self.make_view(&lenses[self.lens]) {
-                Ok(view) => self.view = Some(view),
+                Ok(view) => {
+                    self.view = Some(view);
+                    if let Some(clock) = &mut self.clock {
+                        (clock.placed, clock.fixed) = (None, false);
+                    }
+                }
                 Err(e) => {
                     eprintln!("{}: {e}", Method::ALL[self.method].name());
                     self.method = (self.method + 1) % Method::ALL.len();
@@ -330,6 +358,19 @@ impl State {
         self.fly(seconds.min(0.1));
         self.ensure_view(lenses)?;
         let view = self.view.as_ref().expect("made above");
+        if let Some(clock) = self.clock.as_mut().filter(|c| !c.fixed) {
+            let t = clock.now();
+            if clock.placed != Some(t) {
+                match view.renderer.place_at(&self.scene, t) {
+                    Ok(()) => clock.placed = Some(t),
+                    Err(e) => {
+                        let method = Method::ALL[self.method].name();
+                        eprintln!("note: {method} does not play the scene's motion: {e}");
+                        clock.fixed = true;
+                    }
+                }
+            }
+        }
         let surface = match self.surface.get_current_texture() {
             wgpu::CurrentSurfaceTexture::Success(t)
             | wgpu::CurrentSurfaceTexture::Suboptimal(t) => t,
@@ -393,8 +434,21 @@ impl State {
             None
         };
         self.ctx.queue.present(surface);
+        let time = match &self.clock {
+            None => String::new(),
+            Some(Clock { fixed: true, .. }) => ", the scene as loaded".into(),
+            Some(clock) => format!(
+                ", scene time {:.2} s{}",
+                clock.now(),
+                if clock.paused.is_some() {
+                    " (paused)"
+                } else {
+                    ""
+                }
+            ),
+        };
         self.window.set_title(&format!(
-            "fisheye-rt: {} triangles through {}, {}{} ({:.1} ms a frame)",
+            "fisheye-rt: {} triangles through {}, {}{}{time} ({:.1} ms a frame)",
             self.scene.len(),
             view.lens,
             Method::ALL[self.method].name(),
@@ -468,7 +522,7 @@ impl ApplicationHandler for App {
             .scene
             .take()
             .expect("the scene, loaded before the window");
-        match State::new(window, scene) {
+        match State::new(window, scene, self.args.time) {
             Ok(mut state) => {
                 state.method = self.args.method;
                 state.spp = self.args.spp;
@@ -521,6 +575,11 @@ impl ApplicationHandler for App {
                         state.view = None;
                     }
                     KeyCode::KeyR => state.pose = state.scene.camera,
+                    KeyCode::Space => {
+                        if let Some(clock) = &mut state.clock {
+                            clock.toggle();
+                        }
+                    }
                     _ => {}
                 }
             }
@@ -573,6 +632,12 @@ fn main() {
         Ok(loaded) => {
             for w in &loaded.warnings {
                 eprintln!("warning: {w}");
+            }
+            if args.time.is_some() && !loaded.scene.moves() {
+                eprintln!(
+                    "note: nothing in {} moves, so --time changes nothing",
+                    args.scene
+                );
             }
             loaded.scene
         }
