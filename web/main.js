@@ -1,8 +1,8 @@
 // The page's script: starts the wasm module on the browser's WebGPU, exposes
 // `window.fisheye` ({ready, render(opts), open(opts), lensTwin, lenses}: the contract tests
 // and other pages drive), and wires the controls:
-// scene (built-in, picked or dropped files), lens, size, rays per pixel, orbiting and flying camera,
-// the GPU time of each frame, saving the picture as PNG.
+// scene (built-in, picked or dropped files), lens, size, rays per pixel, scene time (a moving
+// scene plays), orbiting and flying camera, the GPU time of each frame, saving the picture as PNG.
 import init, { Fisheye, lenses } from "./fisheye_web.js";
 
 const $ = (id) => document.getElementById(id);
@@ -90,8 +90,8 @@ async function companion(source, name) {
 }
 
 // A view of what `opts` asks (the scene loaded, its BVH built and uploaded, the kernels
-// made), whose `frame(camera, progressive)` renders it; `steps` is the most frames a
-// progressive refinement takes. `opts` are `render`'s: {scene, name?, files?, lens, size,
+// made), whose `frame(camera, progressive, time?)` renders it; `steps` is the most frames a
+// progressive refinement takes, `key_span` a moving scene's first and last key times. `opts` are `render`'s: {scene, name?, files?, lens, size,
 // spp, camera?, calib?, calibName?, calibCamera?}; a calibration file (Kalibr, OpenCV,
 // Basalt: a URL, File or bytes) gives the lens and size, as `render --calib FILE`.
 async function open(opts = {}) {
@@ -132,11 +132,11 @@ async function open(opts = {}) {
   }
 }
 
-// Renders as `fisheye render` does; resolves to {width, height, rgba, ids, gpu_ms, timed_by,
-// wall_ms, camera, warnings}.
+// Renders as `fisheye render` does (`opts.time`: its `--time`); resolves to {width, height,
+// rgba, ids, gpu_ms, timed_by, wall_ms, camera, warnings}.
 async function render(opts = {}) {
   const view = await open(opts);
-  return await view.frame("", false);
+  return await view.frame("", false, opts.time ?? 0);
 }
 
 // The WGSL lens twin against the f64 reference (compiled to wasm) at every pixel of `lens` at
@@ -156,6 +156,19 @@ let step = 0;
 let busy = false;
 let last = null;
 let opening = 0; // which reopen() is the latest: an older one that finishes later is dropped
+let started = performance.now(); // when a moving scene's loop began
+let typed = 0; // how many times the time field changed: one changed during a frame restarts
+
+// The scene time of the next frame: the time field's, or while it is empty a moving scene's
+// loop over its keys' times; `playing` while the loop runs.
+function sceneTime(current) {
+  const typed = $("time").value.trim();
+  const span = current.key_span;
+  if (typed !== "" || !span) return { time: typed === "" ? 0 : Number(typed), playing: false };
+  const [first, last] = span;
+  const into = (performance.now() - started) / 1000;
+  return { time: last > first ? first + (into % (last - first)) : first, playing: true };
+}
 
 function show(image) {
   const canvas = $("view");
@@ -194,28 +207,37 @@ async function reopen() {
   }
   pose = "";
   step = 0;
+  started = performance.now();
   tick();
 }
 
-// The next frame while the view has steps left at this pose: the first at a pose is whole (or
-// coarse, with adaptive sampling), each later one sharpens it.
+// The next frame while the view has steps left at this pose and time (or a moving scene
+// plays): the first at a pose or time is whole (or coarse, with adaptive sampling), each later
+// one sharpens it.
 async function tick() {
   const current = view;
-  if (busy || !current || step >= current.steps) return;
+  if (busy || !current) return;
+  const { time, playing } = sceneTime(current);
+  if (step >= current.steps && !playing) return;
   busy = true;
+  const asked = typed;
   try {
-    const frame = await current.frame(pose, true);
+    const frame = await current.frame(pose, true, time);
     // A frame of a view that has been replaced meanwhile is dropped.
     if (current === view) {
       last = frame;
       pose = last.camera;
       $("view").dataset.camera = pose;
-      step++;
+      // While the scene plays each frame is the first at its time; a time typed meanwhile
+      // starts again.
+      const made = playing ? 1 : step + 1;
+      step = asked !== typed ? 0 : made;
       show(last);
       const warned = last.warnings.length ? ` (warnings: ${last.warnings.join("; ")})` : "";
-      const progress = current.steps > 1 ? `, frame ${step} of at most ${current.steps}` : "";
+      const progress = current.steps > 1 ? `, frame ${made} of at most ${current.steps}` : "";
+      const when = current.key_span ? `, scene time ${time.toFixed(2)} s` : "";
       say(
-        `${last.width}×${last.height}${progress}: ${last.gpu_ms.toFixed(1)} ms on the GPU ` +
+        `${last.width}×${last.height}${when}${progress}: ${last.gpu_ms.toFixed(1)} ms on the GPU ` +
           `(${last.timed_by}), ${last.wall_ms.toFixed(1)} ms from submission to pixels${warned}`,
       );
     }
@@ -309,8 +331,8 @@ async function setUp() {
   };
   const take = (files) => {
     const all = [...files];
-    const scene = all.find((f) => /\.(obj|gltf|glb)$/i.test(f.name));
-    if (!scene) return say("drop an .obj (with its .mtl and textures), .gltf or .glb file", true);
+    const scene = all.find((f) => /\.(obj|gltf|glb|toml)$/i.test(f.name));
+    if (!scene) return say("drop an .obj (with its .mtl and textures), .gltf, .glb or scene .toml file", true);
     picked = { scene, files: all };
     $("picked").textContent = all.map((f) => f.name).join(", ");
     reopen();
@@ -324,6 +346,13 @@ async function setUp() {
     calibration = null;
     $("calib").value = "";
     reopen();
+  };
+  // A time typed starts refining there; emptied, a moving scene plays again.
+  $("time").oninput = () => {
+    typed++;
+    step = 0;
+    started = performance.now();
+    tick();
   };
   $("scene").onchange = () => {
     picked = null;

@@ -8,14 +8,11 @@
 //! WebGPU's promises, never by polling.
 #![cfg(target_arch = "wasm32")]
 
-use std::cell::RefCell;
+use std::cell::{Cell, RefCell};
 use std::collections::HashMap;
-use std::future::Future;
 use std::path::Path;
-use std::pin::Pin;
 use std::rc::Rc;
 use std::sync::{Arc, Mutex};
-use std::task::{Context, Poll, Waker};
 
 use fisheye_rt::gpu::{GpuContext, Queries};
 use fisheye_rt::input::InputKind;
@@ -28,6 +25,9 @@ use fisheye_rt::scene::{self, Scene};
 use fisheye_rt::trace::{Display, RenderOptions, Sampling, Tone, auto_exposure, colour_image_with};
 use js_sys::{Array, Object, Reflect, Uint8Array};
 use wasm_bindgen::prelude::*;
+
+mod read;
+use read::{map_read, submit_and_read};
 
 /// The browser's WebGPU device, ready to render.
 #[wasm_bindgen]
@@ -216,16 +216,20 @@ struct ViewInner {
     timing: Option<(Queries, wgpu::Buffer)>,
     /// The frames a progressive refinement takes at most (1 where it is not progressive).
     steps: u32,
+    /// The scene time a moving scene was last placed at.
+    placed: Cell<Option<f64>>,
 }
 
 #[wasm_bindgen]
 impl View {
-    /// A frame from `camera` (`render --camera`'s forms; the view's first pose if empty):
+    /// A frame from `camera` (`render --camera`'s forms; the view's first pose if empty) at
+    /// scene `time` (seconds, 0 if not given: where `render --time` places a moving scene):
     /// the whole frame, or with `progressive` the next step of a progressive refinement
     /// (`Renderer::encode_progressive`: with adaptive sampling the first frame at a pose is
     /// the coarse one and each frame after it at the same pose sharpens it, until the whole
-    /// frame, bit for bit, after at most [`View::steps`]; a new pose starts again). Resolves
-    /// to `{width, height, rgba, ids, gpu_ms, timed_by, wall_ms, camera, warnings}`: the
+    /// frame, bit for bit, after at most [`View::steps`]; a new pose or time starts
+    /// again). Resolves to `{width, height, rgba, ids, gpu_ms, timed_by, wall_ms, camera,
+    /// warnings}`: the
     /// PNG's 8-bit sRGB pixels, the scene triangle at each pixel's centre (`--outputs id`'s,
     /// as a `Uint32Array`; with adaptive sampling only the traced pixels' are there, the rest
     /// `NO_HIT`), the frame's milliseconds on the GPU (`timed_by` `"timestamps"`: from the
@@ -234,10 +238,12 @@ impl View {
     /// milliseconds from submission to the pixels' arrival on the CPU (`wall_ms`), the pose
     /// (as `camera` takes it) and what loading the scene warned of. One frame at a time: frames share the
     /// view's read-back buffers.
-    pub fn frame(&self, camera: String, progressive: bool) -> js_sys::Promise {
+    pub fn frame(&self, camera: String, progressive: bool, time: Option<f64>) -> js_sys::Promise {
         let inner = self.inner.clone();
         wasm_bindgen_futures::future_to_promise(async move {
-            let image = inner.frame(&camera, progressive).await?;
+            let image = inner
+                .frame(&camera, progressive, time.unwrap_or(0.0))
+                .await?;
             let out = Object::new();
             let set = |key: &str, value: JsValue| Reflect::set(&out, &key.into(), &value);
             set("width", image.size.width.into())?;
@@ -264,6 +270,15 @@ impl View {
     #[wasm_bindgen(getter)]
     pub fn steps(&self) -> u32 {
         self.inner.steps
+    }
+
+    /// The first and last key times (seconds) of a scene that moves (glTF animations,
+    /// scene-file keys); `undefined` where nothing moves.
+    #[wasm_bindgen(getter)]
+    pub fn key_span(&self) -> Option<Vec<f64>> {
+        let scene = &self.inner.scene;
+        let (first, last) = scene.key_span().filter(|_| scene.moves())?;
+        Some(vec![first, last])
     }
 }
 
@@ -365,6 +380,7 @@ impl Request {
             ids_read_back: ids,
             timing,
             steps: if adaptive.is_some() { 2 + spp } else { 1 },
+            placed: Cell::new(None),
         })
     }
 
@@ -434,11 +450,22 @@ impl Request {
 }
 
 impl ViewInner {
-    async fn frame(&self, camera: &str, progressive: bool) -> Result<Image, JsValue> {
+    async fn frame(&self, camera: &str, progressive: bool, time: f64) -> Result<Image, JsValue> {
         let pose = match camera {
             "" => self.scene.camera,
             text => self.scene.parse_camera(text).map_err(error)?,
         };
+        // Moving instances placed at `time`, as `render --time` places them (a new time
+        // starts progressive refinement again).
+        if self.placed.get() != Some(time) {
+            if !time.is_finite() {
+                return Err(error(format!(
+                    "time {time}: a time in seconds must be finite"
+                )));
+            }
+            self.renderer.place_at(&self.scene, time).map_err(error)?;
+            self.placed.set(Some(time));
+        }
         let (size, row) = (self.size, self.row);
         let mut encoder = self.device.create_command_encoder(&Default::default());
         if let Some((queries, _)) = &self.timing {
@@ -532,42 +559,6 @@ fn file_key(path: &Path) -> String {
     parts.join("/")
 }
 
-/// Submits `encoder`, whose last command fills `staging` (`MAP_READ`), and resolves to
-/// `staging`'s bytes once they are on the CPU; rejects with the first WebGPU error raised
-/// meanwhile.
-async fn submit_and_read(
-    queue: &wgpu::Queue,
-    encoder: wgpu::CommandEncoder,
-    staging: &wgpu::Buffer,
-    errors: &Mutex<Vec<String>>,
-) -> Result<Vec<u8>, JsValue> {
-    queue.submit([encoder.finish()]);
-    let bytes = map_read(staging).await?;
-    if let Some(first) = errors.lock().unwrap().drain(..).next() {
-        return Err(error(format!("WebGPU: {first}")));
-    }
-    Ok(bytes)
-}
-
-/// `staging`'s bytes (`MAP_READ`, filled by work already submitted), once on the CPU.
-async fn map_read(staging: &wgpu::Buffer) -> Result<Vec<u8>, JsValue> {
-    let mapped = Mapped::default();
-    let done = mapped.clone();
-    staging
-        .slice(..)
-        .map_async(wgpu::MapMode::Read, move |result| done.set(result));
-    mapped
-        .await
-        .map_err(|e| error(format!("reading back from the GPU: {e}")))?;
-    let bytes = staging
-        .slice(..)
-        .get_mapped_range()
-        .map_err(|e| error(format!("reading back from the GPU: {e}")))?
-        .to_vec();
-    staging.unmap();
-    Ok(bytes)
-}
-
 /// The WGSL lens twin against the f64 reference in the page: every pixel's direction of
 /// `lens` (a spec) at `size` (`WxH`), computed by the lens kernel on this device and read
 /// back, compared with the library's f64 reference, compiled to wasm, by
@@ -610,43 +601,6 @@ async fn lens_twin(
     set("holds", verdict.is_ok().into())?;
     set("why", verdict.err().unwrap_or_default().into())?;
     Ok(out.into())
-}
-
-/// The outcome of `map_async`, awaited: its callback fills the slot and wakes the task.
-#[derive(Clone, Default)]
-struct Mapped(Rc<RefCell<Slot>>);
-
-type MapResult = Result<(), wgpu::BufferAsyncError>;
-
-#[derive(Default)]
-struct Slot {
-    result: Option<MapResult>,
-    waker: Option<Waker>,
-}
-
-impl Mapped {
-    fn set(&self, result: MapResult) {
-        let mut slot = self.0.borrow_mut();
-        slot.result = Some(result);
-        if let Some(waker) = slot.waker.take() {
-            waker.wake();
-        }
-    }
-}
-
-impl Future for Mapped {
-    type Output = MapResult;
-
-    fn poll(self: Pin<&mut Self>, cx: &mut Context<'_>) -> Poll<Self::Output> {
-        let mut slot = self.0.borrow_mut();
-        match slot.result.take() {
-            Some(result) => Poll::Ready(result),
-            None => {
-                slot.waker = Some(cx.waker().clone());
-                Poll::Pending
-            }
-        }
-    }
 }
 
 /// Lens specs to start from, each with what it is: the presets (real lenses), each classic

@@ -135,6 +135,7 @@ function nativeRender(scene, opts, name) {
     args.push("--lens", opts.lens, "--size", opts.size);
   }
   if (opts.camera) args.push("--camera", opts.camera);
+  if (opts.time !== undefined) args.push("--time", String(opts.time));
   // `1+tent`: the sampling, then the pixel filter (as `compare` labels setups).
   const [spp, filter] = String(opts.spp).split("+");
   args.push("--spp", spp, "--filter", filter ?? "box", "-o", out);
@@ -221,12 +222,15 @@ const cases = [
     size: "160x120",
     spp: 1,
   },
+  // A scene file whose box slides and turns over a second, at 0.8 s (`render --time 0.8`).
+  { scene: "/scenes/dataset/sliding.toml", lens: "equidistant:f=0.5,fov=180", size: "160x120", spp: 1, time: 0.8 },
 ];
 const timings = [];
 for (const [k, c] of cases.entries()) {
   const file = c.bytes ?? (c.scene.startsWith("/") ? c.scene.slice(1) : null);
   const scene = file ? path.join(repo, file) : c.scene;
-  const what = `${c.bytes ?? c.scene} through ${c.lens.split(":")[0]} at ${c.size}, spp ${c.spp}`;
+  const at = c.time === undefined ? "" : `, time ${c.time} s`;
+  const what = `${c.bytes ?? c.scene} through ${c.lens.split(":")[0]} at ${c.size}, spp ${c.spp}${at}`;
   try {
     const native = nativeRender(scene, c, `case${k}`);
     const web = await pageRender(c);
@@ -378,6 +382,33 @@ for (const spec of twinSpecs) {
   });
   const there = nativeRender("builtin:default", { lens, size: "200x150", spp: 1, camera: flown }, "flown");
   compare(there, seen, `the canvas after flying, against fisheye render --camera ${flown}`);
+
+  // A scene file picked in the page plays: while the time field is empty the status line's
+  // scene time moves from frame to frame; a time typed there holds it.
+  await picker.setInputFiles("#file", path.join(repo, "scenes/dataset/sliding.toml"));
+  const timeSaid = (not) =>
+    picker
+      .waitForFunction(
+        (n) => {
+          const m = /scene time ([0-9.]+) s/.exec(document.getElementById("status").textContent);
+          return m && m[1] !== n ? m[1] : null;
+        },
+        not,
+        { timeout: 120000 },
+      )
+      .then((h) => h.jsonValue());
+  const playing = [await timeSaid(null)];
+  playing.push(await timeSaid(playing[0]));
+  await picker.fill("#time", "0.25");
+  const held = await picker
+    .waitForFunction(() => /scene time 0\.25 s/.test(document.getElementById("status").textContent), null, {
+      timeout: 120000,
+    })
+    .then(() => true, () => false);
+  check(
+    playing[0] !== playing[1] && held,
+    `a picked scene file plays (scene time ${playing.join(" s, then ")} s); a time typed holds it (${held})`,
+  );
   await picker.close();
 }
 
@@ -426,6 +457,33 @@ compare(
   "builtin:default through samyang-7.5mm at 128x96, spp auto (adaptive)",
 );
 
+// A moving scene: a view's `key_span` is its keys' first and last times (none where nothing
+// moves); at one pose a new time starts progressive refinement again (the frame at 0.8 s after
+// frames at 0.2 s is a fresh view's first at 0.8 s, and not the one at 0.2 s); a time that is
+// not a number is refused.
+const moving = await page.evaluate(async () => {
+  const opts = { scene: "/scenes/dataset/sliding.toml", lens: "equidistant:f=0.5,fov=180", size: "160x120", spp: 1 };
+  const view = await window.fisheye.open(opts);
+  const still = await window.fisheye.open({ scene: "builtin:grid", size: "32x24", spp: 1 });
+  const same = (a, b) => a.rgba.length === b.rgba.length && a.rgba.every((v, i) => v === b.rgba[i]);
+  const early = await view.frame("", true, 0.2);
+  await view.frame("", true, 0.2);
+  const late = await view.frame("", true, 0.8);
+  const fresh = await (await window.fisheye.open(opts)).frame("", true, 0.8);
+  const refused = await view.frame("", true, NaN).then(() => "rendered", (e) => String(e.message ?? e));
+  return {
+    span: Array.from(view.key_span ?? []),
+    stillSpan: still.key_span ?? null,
+    restarted: same(late, fresh) && !same(late, early),
+    refused,
+  };
+});
+check(
+  moving.span.join() === "0,1" && moving.stillSpan === null && moving.restarted && /time NaN/.test(moving.refused),
+  `a moving scene: keys from ${moving.span.join(" to ")} s (a still one: ${moving.stillSpan}), a new ` +
+    `time restarts its frames (${moving.restarted}), a bad one is refused: ${moving.refused}`,
+);
+
 // A device with WebGPU's default limits alone (?limits=default), 8 storage buffers a stage as
 // on many phones: the tracer and adaptive sampling work within them, as natively.
 {
@@ -444,7 +502,7 @@ compare(
 
 // The MTL beside the OBJ was fetched: the Cornell box's red wall is red, as natively (the
 // comparison above); and no warning said a file was missing.
-const cornell = await pageRender(cases[2]);
+const cornell = await pageRender(cases.find((c) => c.scene?.includes("CornellBox")));
 check(cornell.warnings.length === 0, `the OBJ's MTL was fetched (warnings: ${cornell.warnings})`);
 
 // Bad input: a broken OBJ as bytes rejects with the file and line; picked in the page, its
