@@ -91,9 +91,10 @@ async function companion(source, name) {
 
 // A view of what `opts` asks (the scene loaded, its BVH built and uploaded, the kernels
 // made), whose `frame(camera, progressive, time?)` renders it; `steps` is the most frames a
-// progressive refinement takes, `key_span` a moving scene's first and last key times. `opts` are `render`'s: {scene, name?, files?, lens, size,
-// spp, camera?, calib?, calibName?, calibCamera?}; a calibration file (Kalibr, OpenCV,
-// Basalt: a URL, File or bytes) gives the lens and size, as `render --calib FILE`.
+// progressive refinement takes, `key_span` a moving scene's first and last key times. `opts`
+// are `render`'s: {scene, name?, files?, lens, size, spp, camera?, calib?, calibName?,
+// calibCamera?}; a calibration file (Kalibr, OpenCV, Basalt: a URL, File or bytes) gives the
+// lens and size, as `render --calib FILE`.
 async function open(opts = {}) {
   const device = await ready;
   const source = await sceneOf(opts);
@@ -162,9 +163,9 @@ let typed = 0; // how many times the time field changed: one changed during a fr
 // The scene time of the next frame: the time field's, or while it is empty a moving scene's
 // loop over its keys' times; `playing` while the loop runs.
 function sceneTime(current) {
-  const typed = $("time").value.trim();
+  const field = $("time").value.trim();
   const span = current.key_span;
-  if (typed !== "" || !span) return { time: typed === "" ? 0 : Number(typed), playing: false };
+  if (field !== "" || !span) return { time: field === "" ? 0 : Number(field), playing: false };
   const [first, last] = span;
   const into = (performance.now() - started) / 1000;
   return { time: last > first ? first + (into % (last - first)) : first, playing: true };

@@ -3,7 +3,7 @@
 //!
 //! ```sh
 //! cargo run --release --example viewer -- [SCENE] [--lens SPEC] [--method NAME] [--spp N]
-//!     [--size WxH]
+//!     [--size WxH] [--time T]
 //! ```
 //!
 //! Keys: W A S D (or the arrows) move, Q and E go down and up, dragging with the left button
@@ -207,8 +207,7 @@ impl State {
         surface.configure(&ctx.device, &config);
         let blit = blit_pipeline(&ctx.device, format);
         let pose = scene.camera;
-        let clock = scene.key_span().filter(|_| scene.moves());
-        let clock = clock.map(|span| Clock::new(span, time));
+        let clock = scene.key_span().map(|span| Clock::new(span, time));
         Ok(Self {
             window,
             ctx,

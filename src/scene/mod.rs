@@ -321,10 +321,13 @@ impl Scene {
         self.instances.iter().any(|i| i.animation.is_some())
     }
 
-    /// The first and last key time of the scene's animations (seconds); `None` where
-    /// nothing moves. Before the first key instances stay where it puts them, and after the
-    /// last where that one does.
+    /// The first and last key time of the animations that move its instances (seconds);
+    /// `None` where nothing moves. Before the first key instances stay where it puts them,
+    /// and after the last where that one does.
     pub fn key_span(&self) -> Option<(f64, f64)> {
+        if !self.moves() {
+            return None;
+        }
         self.animations
             .iter()
             .flat_map(|a| a.key_times())

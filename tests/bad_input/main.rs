@@ -268,27 +268,28 @@ fn lens_parameters_outside_their_domain_name_it() {
     }
 }
 
-/// Every test the book's "Bad input" table (`docs/src/limits.md`) names exists, so the table
-/// cannot drift from the tests.
+/// Every test the book's "Bad input" table (`docs/src/limits.md`) names exists (a Rust test,
+/// or one of the Python package's), so the table cannot drift from the tests.
 #[test]
 fn the_readme_table_names_tests_that_exist() {
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
     let page = std::fs::read_to_string(root.join("docs/src/limits.md")).unwrap();
     let section = page.split("\n## ").next().unwrap();
-    /// Every `.rs` file under `dir`, appended to `out`.
-    fn sources(dir: &Path, out: &mut String) {
+    /// Every file ending in `ext` under `dir`, appended to `out`.
+    fn sources(dir: &Path, ext: &str, out: &mut String) {
         for entry in std::fs::read_dir(dir).unwrap() {
             let path = entry.unwrap().path();
             if path.is_dir() {
-                sources(&path, out);
-            } else if path.extension().is_some_and(|e| e == "rs") {
+                sources(&path, ext, out);
+            } else if path.extension().is_some_and(|e| e == ext) {
                 out.push_str(&std::fs::read_to_string(path).unwrap());
             }
         }
     }
     let mut sources_text = String::new();
-    sources(&root.join("tests"), &mut sources_text);
-    sources(&root.join("src"), &mut sources_text);
+    sources(&root.join("tests"), "rs", &mut sources_text);
+    sources(&root.join("src"), "rs", &mut sources_text);
+    sources(&root.join("python/tests"), "py", &mut sources_text);
     let sources = sources_text;
     let mut rows = 0;
     for line in section.lines().filter(|l| l.starts_with('|')).skip(2) {
@@ -304,7 +305,8 @@ fn the_readme_table_names_tests_that_exist() {
         assert!(!names.is_empty(), "a row names no test: {line}");
         for name in names {
             assert!(
-                sources.contains(&format!("fn {name}(")),
+                sources.contains(&format!("fn {name}("))
+                    || sources.contains(&format!("def {name}(")),
                 "the book names a test {name} that does not exist"
             );
         }

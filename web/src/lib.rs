@@ -229,15 +229,14 @@ impl View {
     /// the coarse one and each frame after it at the same pose sharpens it, until the whole
     /// frame, bit for bit, after at most [`View::steps`]; a new pose or time starts
     /// again). Resolves to `{width, height, rgba, ids, gpu_ms, timed_by, wall_ms, camera,
-    /// warnings}`: the
-    /// PNG's 8-bit sRGB pixels, the scene triangle at each pixel's centre (`--outputs id`'s,
-    /// as a `Uint32Array`; with adaptive sampling only the traced pixels' are there, the rest
-    /// `NO_HIT`), the frame's milliseconds on the GPU (`timed_by` `"timestamps"`: from the
-    /// start of its first pass to the end of its last, by the GPU's timestamps, which browsers
-    /// quantise; or `"wall clock"` where the device has no timestamp queries, `wall_ms`), the
-    /// milliseconds from submission to the pixels' arrival on the CPU (`wall_ms`), the pose
-    /// (as `camera` takes it) and what loading the scene warned of. One frame at a time: frames share the
-    /// view's read-back buffers.
+    /// warnings}`: the PNG's 8-bit sRGB pixels, the scene triangle at each pixel's centre
+    /// (`--outputs id`'s, as a `Uint32Array`; with adaptive sampling only the traced pixels'
+    /// are there, the rest `NO_HIT`), the frame's milliseconds on the GPU (`timed_by`
+    /// `"timestamps"`: from the start of its first pass to the end of its last, by the GPU's
+    /// timestamps, which browsers quantise; or `"wall clock"` where the device has no
+    /// timestamp queries, `wall_ms`), the milliseconds from submission to the pixels' arrival
+    /// on the CPU (`wall_ms`), the pose (as `camera` takes it) and what loading the scene
+    /// warned of. One frame at a time: frames share the view's read-back buffers.
     pub fn frame(&self, camera: String, progressive: bool, time: Option<f64>) -> js_sys::Promise {
         let inner = self.inner.clone();
         wasm_bindgen_futures::future_to_promise(async move {
@@ -276,8 +275,7 @@ impl View {
     /// scene-file keys); `undefined` where nothing moves.
     #[wasm_bindgen(getter)]
     pub fn key_span(&self) -> Option<Vec<f64>> {
-        let scene = &self.inner.scene;
-        let (first, last) = scene.key_span().filter(|_| scene.moves())?;
+        let (first, last) = self.inner.scene.key_span()?;
         Some(vec![first, last])
     }
 }

@@ -222,7 +222,7 @@ pub(crate) fn render(args: &RenderArgs) -> Result<()> {
     if !args.time.is_finite() {
         bail!("--time {}: a time in seconds must be finite", args.time);
     }
-    if let Some((first, last)) = scene.key_span().filter(|_| scene.moves()) {
+    if let Some((first, last)) = scene.key_span() {
         let moving = scene
             .instances
             .iter()
