@@ -72,6 +72,10 @@ class Scene:
     @property
     def warnings(self) -> list[str]:
         """What loading repaired, one line each."""
+    @property
+    def key_span(self) -> Optional[Tuple[float, float]]:
+        """The first and last key times (seconds) of what moves it (glTF animations,
+        scene-file keys), for Renderer.render(time=...); None where nothing moves."""
 
 class Renderer:
     """A scene on the GPU (uploaded once), rendered through any lens from any pose."""

@@ -295,6 +295,13 @@ impl Scene {
         self.warnings.clone()
     }
 
+    /// The first and last key times (seconds) of what moves it (glTF animations, scene-file
+    /// keys), for `Renderer.render(time=...)`; None where nothing moves.
+    #[getter]
+    fn key_span(&self) -> Option<(f64, f64)> {
+        self.scene.key_span()
+    }
+
     fn __repr__(&self) -> String {
         format!(
             "Scene.load({:?})  # {} triangles",

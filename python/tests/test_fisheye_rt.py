@@ -152,9 +152,13 @@ def test_a_render_equals_the_commands_files_bit_for_bit(tmp_path):
 
 def test_moving_objects_render_at_a_time_as_the_command_does(tmp_path):
     """`render(time=...)` places keyed meshes where `fisheye render --time` does, bit for bit,
-    from one upload (the meshes' BVHs built once), and they move between times."""
+    from one upload (the meshes' BVHs built once), and they move between times; the scene's
+    `key_span` is its keys' first and last times (None for a scene that does not move)."""
     scene = str(ROOT / "scenes" / "dataset" / "sliding.toml")
-    renderer = fr.Renderer(fr.Scene.load(scene))
+    loaded = fr.Scene.load(scene)
+    assert loaded.key_span == (0.0, 1.0)
+    assert fr.Scene.load("builtin:default").key_span is None
+    renderer = fr.Renderer(loaded)
     lens = fr.Lens.from_spec("rectilinear:f=1.2", size=(48, 36))
     ids = {}
     for time in ("0.25", "0.75"):
