@@ -510,7 +510,8 @@ fn marks_around_a_frame_span_its_passes() {
 /// after `Renderer::place_at(t)` frames show what the one-call render draws of the scene
 /// posed at `t` (`Scene::at`), bit for bit, directly and through a traced cube map, and the
 /// box moves between 0.2 s and 0.8 s; a progressive frame after a place starts again (the
-/// first frame at an unchanged pose is a new renderer's first); a rasterized cube map, which
+/// first frame at an unchanged pose is a new renderer's first), and placing at the same time
+/// again lets refinement go on (the next frame sharpens it); a rasterized cube map, which
 /// draws the scene flattened once, refuses it, saying what places moving instances.
 #[test]
 fn frames_placed_at_a_time_show_the_scene_posed_then() {
@@ -592,6 +593,12 @@ fn frames_placed_at_a_time_show_the_scene_posed_then() {
         "the first frame after a place",
         &after_place,
         &draw(&fresh, true),
+    );
+    renderer.place_at(&scene, 0.8).unwrap();
+    let placed_again = draw(&renderer, true);
+    assert!(
+        placed_again != after_place,
+        "the same time placed again restarted the refinement"
     );
 
     let raster = CubeSettings::new(32, CubeMethod::Raster(RasterMethod::Forward));

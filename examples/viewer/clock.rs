@@ -10,8 +10,6 @@ pub(crate) struct Clock {
     started: Instant,
     /// The time it is paused at.
     pub(crate) paused: Option<f64>,
-    /// The time the view's renderer placed the scene at; `None` where it has not.
-    pub(crate) placed: Option<f64>,
     /// Whether the view's method draws the scene as loaded.
     pub(crate) fixed: bool,
 }
@@ -23,7 +21,6 @@ impl Clock {
             span,
             started: Instant::now(),
             paused,
-            placed: None,
             fixed: false,
         }
     }

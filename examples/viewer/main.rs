@@ -240,7 +240,7 @@ impl State {
                 Ok(view) => {
                     self.view = Some(view);
                     if let Some(clock) = &mut self.clock {
-                        (clock.placed, clock.fixed) = (None, false);
+                        clock.fixed = false;
                     }
                 }
                 Err(e) => {
@@ -357,18 +357,14 @@ impl State {
         self.fly(seconds.min(0.1));
         self.ensure_view(lenses)?;
         let view = self.view.as_ref().expect("made above");
-        if let Some(clock) = self.clock.as_mut().filter(|c| !c.fixed) {
-            let t = clock.now();
-            if clock.placed != Some(t) {
-                match view.renderer.place_at(&self.scene, t) {
-                    Ok(()) => clock.placed = Some(t),
-                    Err(e) => {
-                        let method = Method::ALL[self.method].name();
-                        eprintln!("note: {method} does not play the scene's motion: {e}");
-                        clock.fixed = true;
-                    }
-                }
-            }
+        // The renderer places the scene only when the time changes (a paused clock's frames
+        // go on refining).
+        if let Some(clock) = self.clock.as_mut().filter(|c| !c.fixed)
+            && let Err(e) = view.renderer.place_at(&self.scene, clock.now())
+        {
+            let method = Method::ALL[self.method].name();
+            eprintln!("note: {method} does not play the scene's motion: {e}");
+            clock.fixed = true;
         }
         let surface = match self.surface.get_current_texture() {
             wgpu::CurrentSurfaceTexture::Success(t)

@@ -267,6 +267,8 @@ pub struct Renderer {
     /// Progressive refinement's place: the pose its steps are for and the next step's number
     /// (`None` after a whole frame).
     progress: Mutex<Option<(Camera, u32)>>,
+    /// The scene time moving instances were last placed at ([`Renderer::place_at`]).
+    placed: Mutex<Option<f64>>,
 }
 
 impl Renderer {
@@ -383,6 +385,7 @@ impl Renderer {
             camera: *camera,
             flattened,
             progress: Mutex::new(None),
+            placed: Mutex::new(None),
         })
     }
 
@@ -417,10 +420,12 @@ impl Renderer {
     /// `time` for the frames submitted from now on, where `fisheye render --time` poses them,
     /// and starts progressive refinement again; `scene` is the one the renderer was made from.
     /// The meshes' BVHs stay as built: only the top level is rebuilt
-    /// ([`GpuScene::place_at`]). Nothing to do where nothing moves. Refused through ray
+    /// ([`GpuScene::place_at`]). Nothing to do where nothing moves, or at the time last
+    /// placed (refinement goes on), so a caller may place every frame. Refused through ray
     /// queries and rasterized cube maps, which draw the scene flattened once, as loaded.
     pub fn place_at(&self, scene: &Scene, time: f64) -> Result<()> {
-        if !scene.moves() {
+        let mut placed = self.placed.lock().unwrap_or_else(|e| e.into_inner());
+        if !scene.moves() || *placed == Some(time) {
             return Ok(());
         }
         if self.flattened {
@@ -433,6 +438,7 @@ impl Renderer {
         }
         self.scene
             .place_at(&self.ctx, scene, time, self.camera.exposure_span())?;
+        *placed = Some(time);
         *self.progress.lock().unwrap_or_else(|e| e.into_inner()) = None;
         Ok(())
     }

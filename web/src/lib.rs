@@ -8,7 +8,7 @@
 //! WebGPU's promises, never by polling.
 #![cfg(target_arch = "wasm32")]
 
-use std::cell::{Cell, RefCell};
+use std::cell::RefCell;
 use std::collections::HashMap;
 use std::path::Path;
 use std::rc::Rc;
@@ -216,8 +216,6 @@ struct ViewInner {
     timing: Option<(Queries, wgpu::Buffer)>,
     /// The frames a progressive refinement takes at most (1 where it is not progressive).
     steps: u32,
-    /// The scene time a moving scene was last placed at.
-    placed: Cell<Option<f64>>,
 }
 
 #[wasm_bindgen]
@@ -378,7 +376,6 @@ impl Request {
             ids_read_back: ids,
             timing,
             steps: if adaptive.is_some() { 2 + spp } else { 1 },
-            placed: Cell::new(None),
         })
     }
 
@@ -454,16 +451,13 @@ impl ViewInner {
             text => self.scene.parse_camera(text).map_err(error)?,
         };
         // Moving instances placed at `time`, as `render --time` places them (a new time
-        // starts progressive refinement again).
-        if self.placed.get() != Some(time) {
-            if !time.is_finite() {
-                return Err(error(format!(
-                    "time {time}: a time in seconds must be finite"
-                )));
-            }
-            self.renderer.place_at(&self.scene, time).map_err(error)?;
-            self.placed.set(Some(time));
+        // starts progressive refinement again; the same time changes nothing).
+        if !time.is_finite() {
+            return Err(error(format!(
+                "time {time}: a time in seconds must be finite"
+            )));
         }
+        self.renderer.place_at(&self.scene, time).map_err(error)?;
         let (size, row) = (self.size, self.row);
         let mut encoder = self.device.create_command_encoder(&Default::default());
         if let Some((queries, _)) = &self.timing {
