@@ -8,7 +8,9 @@ lists. Where a frame has `range` and `direction`, it also checks the dataset aga
 the way a user's own pipeline would: each pixel's hit point (range x direction, in the scene)
 is moved into the camera with the manifest's T_scene_camera and projected with the camera's
 OpenCV calibration (cv::fisheye's Kannala-Brandt or the pinhole model), which must land on the
-pixel's centre. It prints the largest distance in pixels.
+pixel's centre. Where it has `point` (the hit in the camera's frame), that is projected
+likewise, and its z must be the `depth` and its length the `range` where those are there too.
+It prints the largest distances in pixels.
 """
 import json
 import os
@@ -88,24 +90,49 @@ def reprojection_error(camera, view, arrays):
     return float(np.max(np.linalg.norm(pixels - centres, axis=1), initial=0.0))
 
 
+def point_error(camera, arrays):
+    """Largest distance in pixels between each hit pixel's centre and where its camera-frame
+    point projects, or None without points; checks the point against the depth and range."""
+    if "point" not in arrays:
+        return None
+    point = arrays["point"]
+    hit = np.any(point != 0, axis=2)
+    if "depth" in arrays:
+        assert np.array_equal(arrays["depth"], point[..., 2]), "depth is not the point's z"
+    if "range" in arrays:
+        length = np.linalg.norm(point.astype(np.float64), axis=2)
+        assert np.array_equal(hit, arrays["range"] > 0), "points where no range, or none where one"
+        assert np.allclose(length, arrays["range"], rtol=1e-6, atol=0), "|point| is not the range"
+    rows, cols = np.nonzero(hit)
+    pixels = project(camera, point[hit].astype(np.float64))
+    if pixels is None:
+        return None
+    centres = np.stack([cols, rows], axis=1).astype(np.float64)
+    return float(np.max(np.linalg.norm(pixels - centres, axis=1), initial=0.0))
+
+
 def main():
     if len(sys.argv) != 2:
         raise SystemExit(__doc__)
     folder = sys.argv[1]
     manifest = load(folder)
     images = 0
-    worst = None
+    worst = {"hit points": None, "camera-frame points": None}
     for frame, view, camera, arrays in frames(folder, manifest):
         colour = arrays["colour"]
         if not isinstance(colour, str):
             assert colour.shape[:2] == (camera["height"], camera["width"]), colour.shape
         images += 1
-        error = reprojection_error(camera, view, arrays)
-        if error is not None:
-            worst = error if worst is None else max(worst, error)
+        for what, error in [
+            ("hit points", reprojection_error(camera, view, arrays)),
+            ("camera-frame points", point_error(camera, arrays)),
+        ]:
+            if error is not None:
+                worst[what] = error if worst[what] is None else max(worst[what], error)
     print(f"{len(manifest['frames'])} frames, {len(manifest['cameras'])} cameras, {images} images")
-    if worst is not None:
-        print(f"hit points reproject to their pixels within {worst:.2e} px")
+    for what, error in worst.items():
+        if error is not None:
+            print(f"{what} reproject to their pixels within {error:.2e} px")
 
 
 if __name__ == "__main__":

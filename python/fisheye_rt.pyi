@@ -17,7 +17,9 @@ import numpy.typing as npt
 __version__: str
 
 PixelOrigin = Literal["corner", "opencv"]
-Output = Literal["colour", "srgb", "range", "normal", "id", "direction", "mask", "spp"]
+Output = Literal[
+    "colour", "srgb", "range", "normal", "id", "direction", "mask", "depth", "point", "spp"
+]
 
 class Lens:
     """A lens at an image size: a classic model or a calibrated camera."""
@@ -103,8 +105,9 @@ class Renderer:
         "colour" H×W×4 float32 (linear RGB, alpha the lens's coverage), "srgb" H×W×4 uint8
         (through `exposure` stops and the `tone` curve), and the centre ray's "range" H×W
         float32, "normal" H×W×3 float32, "id" H×W uint32 (4294967295: none), "direction"
-        H×W×3 float32 (scene frame), "mask" H×W uint8, as `fisheye render --outputs` writes
-        them, bit for bit, and "spp" H×W uint32, the rays each pixel's colour took (adaptive
+        H×W×3 float32 (scene frame), "mask" H×W uint8, "depth" H×W float32 (the hit's z in the
+        camera's frame) and "point" H×W×3 float32 (the hit in the camera's frame: x right, y
+        down, z forward), as `fisheye render --outputs` writes them, bit for bit, and "spp" H×W uint32, the rays each pixel's colour took (adaptive
         sampling's count, 0 where a pixel was interpolated; `spp` at each pixel with a ray). Moving objects are placed at scene time `time` (seconds), as
         `fisheye render --time` places them. `filter` "tent" blends each pixel of a frame of
         one ray a pixel at most with its neighbours, as `fisheye render --filter tent` (with more

@@ -16,8 +16,8 @@ use fisheye_rt::lens::points::{self, PixelOrigin};
 use fisheye_rt::lens::{ImageSize, LensCamera, calib};
 use fisheye_rt::scene::Camera;
 use fisheye_rt::trace::{
-    Channel, Display, FramePass, GpuScene, PixelFilter, RenderOptions, RenderOutput, Sampling,
-    Tone, Values, colour_image_with, world_directions,
+    Channel, Display, FramePass, GpuScene, PixelFilter, PixelRays, RenderOptions, RenderOutput,
+    Sampling, Tone, Values, colour_image_with, rotated,
 };
 use fisheye_rt::{Error, LensError};
 use glam::{DAffine3, DVec2, DVec3};
@@ -337,7 +337,7 @@ fn look_at<'py>(
 }
 
 /// The outputs `render` can return.
-const OUTPUTS: [&str; 8] = [
+const OUTPUTS: [&str; 10] = [
     "colour",
     "srgb",
     "range",
@@ -345,6 +345,8 @@ const OUTPUTS: [&str; 8] = [
     "id",
     "direction",
     "mask",
+    "depth",
+    "point",
     "spp",
 ];
 
@@ -432,7 +434,9 @@ impl Renderer {
     /// through `exposure` stops and the `tone` curve "aces" or "clamp", as `fisheye render`
     /// writes PNGs), and the centre ray's ground truth "range" (H×W float32), "normal"
     /// (H×W×3 float32), "id" (H×W uint32, 4294967295 for none), "direction" (H×W×3 float32,
-    /// scene frame) and "mask" (H×W uint8). The same arrays `fisheye render --outputs`
+    /// scene frame), "mask" (H×W uint8), "depth" (H×W float32: the hit's z in the camera's
+    /// frame, where range is along the ray) and "point" (H×W×3 float32: the hit in the
+    /// camera's frame, x right, y down, z forward). The same arrays `fisheye render --outputs`
     /// writes, bit for bit. "spp" (H×W uint32) is the rays each pixel's colour took: adaptive
     /// sampling's count (0 where a pixel was interpolated), or `spp` at each pixel with a ray.
     /// Moving objects (glTF animations, scene-file keys) are placed at scene time `time`
@@ -530,12 +534,25 @@ impl Renderer {
             py.detach(|| self.trace(ctx, &camera, (&pose, time), rays, &options, spp_map))?;
         let dict = PyDict::new(py);
         let (h, w) = (camera.size.height as usize, camera.size.width as usize);
-        // Only the direction and mask arrays read the rays (an f64 lens evaluation a pixel).
-        let rays = outputs.iter().any(|o| o == "direction" || o == "mask");
-        let directions = if rays {
-            world_directions(&camera, &pose)
+        // Only the arrays that read the rays evaluate the f64 lens model at every pixel.
+        let reads = |wants: fn(&Channel) -> bool| {
+            outputs
+                .iter()
+                .any(|o| Channel::ALL.iter().any(|c| c.name() == o && wants(c)))
+        };
+        let camera_rays = if reads(Channel::camera_rays) || reads(Channel::world_rays) {
+            camera.directions()
         } else {
             Vec::new()
+        };
+        let world = if reads(Channel::world_rays) {
+            rotated(&camera_rays, &pose)
+        } else {
+            Vec::new()
+        };
+        let rays = PixelRays {
+            camera: &camera_rays,
+            world: &world,
         };
         for name in &outputs {
             let array = match name.as_str() {
@@ -557,7 +574,7 @@ impl Renderer {
                         .into_iter()
                         .find(|c| c.name() == channel)
                         .expect("the names were checked");
-                    match output.values(channel, &directions) {
+                    match output.values(channel, rays) {
                         Values::F32(1, v) => PyArray1::from_vec(py, v)
                             .reshape(IxDyn(&[h, w]))?
                             .into_any(),

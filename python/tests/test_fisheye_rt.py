@@ -135,11 +135,11 @@ def test_a_render_equals_the_commands_files_bit_for_bit(tmp_path):
     out = tmp_path / "view.png"
     fisheye(
         "render", "builtin:default", "--lens", "samyang-7.5mm", "--size", "96x72", "--spp",
-        "4", "--outputs", "range,normal,id,direction,mask", "-o", str(out),
+        "4", "--outputs", "range,normal,id,direction,mask,depth,point", "-o", str(out),
     )
     renderer = fr.Renderer(fr.Scene.load("builtin:default"))
     lens = fr.Lens.from_spec("samyang-7.5mm", size=(96, 72))
-    names = ["srgb", "range", "normal", "id", "direction", "mask"]
+    names = ["srgb", "range", "normal", "id", "direction", "mask", "depth", "point"]
     arrays = renderer.render(lens, spp=4, outputs=names)
     for name in names[1:]:
         written = np.load(tmp_path / f"view.{name}.npy")
@@ -148,6 +148,16 @@ def test_a_render_equals_the_commands_files_bit_for_bit(tmp_path):
         assert arrays[name].tobytes() == written.tobytes(), name
     png = np.asarray(Image.open(out).convert("RGBA"))
     assert np.array_equal(arrays["srgb"], png)
+    # The point is the hit in the camera's frame: its length the range, its z the depth, and
+    # its direction the lens's own ray for the pixel (projected back to the pixel's centre).
+    point, rng = arrays["point"], arrays["range"]
+    hit = rng > 0
+    assert hit.sum() > 1000
+    assert np.array_equal(arrays["depth"], point[..., 2])
+    assert np.allclose(np.linalg.norm(point, axis=2), rng, rtol=1e-6, atol=0)
+    rows, cols = np.nonzero(hit)
+    pixels = lens.project(point[hit].astype(np.float64))
+    assert np.max(np.abs(pixels - np.stack([cols + 0.5, rows + 0.5], axis=1))) < 1e-3
 
 
 def test_moving_objects_render_at_a_time_as_the_command_does(tmp_path):
@@ -368,7 +378,7 @@ def test_bad_input_raises_with_the_librarys_message(tmp_path):
     shear = np.eye(4)
     shear[0, 1] = 0.5
     cases += [
-        (lambda: renderer.render(lens, outputs=["depth"]), ValueError, "depth"),
+        (lambda: renderer.render(lens, outputs=["disparity"]), ValueError, "disparity"),
         (lambda: renderer.render(lens, spp=3), ValueError, "3"),
         (lambda: renderer.render(lens, spp=0), ValueError, "0"),
         (lambda: renderer.render(lens, spp="auto:x"), ValueError, "threshold"),

@@ -27,8 +27,9 @@ use crate::lens::LensCamera;
 use crate::lens::gpu::DirectionSource;
 use crate::scene::Scene;
 use crate::trace::{
-    Channel, ColourFile, Display, FramePass, GpuScene, Motion, RenderOptions, RenderOutput,
-    moving_directions, rotated, write_colour, write_exr, write_file, write_npy, write_rays_map,
+    Channel, ColourFile, Display, FramePass, GpuScene, Motion, PixelRays, RenderOptions,
+    RenderOutput, moving_directions, rotated, write_colour, write_exr, write_file, write_npy,
+    write_rays_map,
 };
 
 /// How a pose's cameras are submitted to the GPU.
@@ -600,17 +601,21 @@ impl Dataset {
         let (channels, arrays) = &self.outputs;
         let camera_rays = directions;
         if !channels.is_empty() {
-            let directions = match &w.motion {
+            let world = match &w.motion {
                 Some(motion) => {
                     moving_directions(&self.lens_camera(w.camera), &directions[w.camera], motion)
                 }
                 None => rotated(&directions[w.camera], &w.pose),
             };
+            let rays = PixelRays {
+                camera: &directions[w.camera],
+                world: &world,
+            };
             for (&channel, (_, name)) in channels.iter().zip(&files[1..]) {
                 let path = folder.join(name);
                 match arrays {
-                    ArrayFile::Npy => out.write_npy(channel, &directions, &path)?,
-                    ArrayFile::Exr => out.write_exr(channel, &directions, &path)?,
+                    ArrayFile::Npy => out.write_npy(channel, rays, &path)?,
+                    ArrayFile::Exr => out.write_exr(channel, rays, &path)?,
                 }
             }
         }

@@ -37,7 +37,8 @@ pub use options::{
     surface_id,
 };
 pub use output::{
-    Channel, RenderOutput, Values, spp_key, spp_picture, write_exr, write_npy, write_rays_map,
+    Channel, PixelRays, RenderOutput, Values, spp_key, spp_picture, write_exr, write_npy,
+    write_rays_map,
 };
 pub use pass::TracePass;
 pub use ray_query::RayQueryScene;

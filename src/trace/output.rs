@@ -82,23 +82,56 @@ pub enum Channel {
     Direction,
     /// 1 where the pixel has a ray, 0 where the lens masks it, H×W uint8.
     Mask,
+    /// The primary hit's depth along the optical axis, the camera frame's z (a z-buffer's
+    /// depth, where range is the distance along the ray), H×W; negative for a hit behind the
+    /// camera's plane (a field beyond 180°), 0 on a miss or mask.
+    Depth,
+    /// The primary hit in the camera's frame (x right, y down, z forward: range times the
+    /// pixel's camera-frame direction), H×W×3; zero on a miss or mask.
+    Point,
+}
+
+/// Each pixel's centre ray from the f64 lens model, row-major, `None` where the lens masks
+/// the pixel: in the camera's frame ([`crate::lens::LensCamera::directions`]), which the
+/// depth and the point read, and in world space (turned by the pose, at each line's time
+/// under a rolling shutter), which the direction and the mask read. A slice no array asked
+/// for may be empty.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct PixelRays<'a> {
+    /// In the camera's frame.
+    pub camera: &'a [Option<DVec3>],
+    /// In world space.
+    pub world: &'a [Option<DVec3>],
 }
 
 impl Channel {
     /// Every channel, in the order `--outputs` lists them.
-    pub const ALL: [Channel; 5] = [
+    pub const ALL: [Channel; 7] = [
         Self::Range,
         Self::Normal,
         Self::Id,
         Self::Direction,
         Self::Mask,
+        Self::Depth,
+        Self::Point,
     ];
 
-    /// Whether the array is the centre ray's hit, traced on the GPU (range, normal, id), rather
-    /// than the lens's own (direction, mask): adaptive sampling traces the hits of the pixels
-    /// it interpolates only where one is wanted.
+    /// Whether the array is the centre ray's hit, traced on the GPU (range, normal, id, and
+    /// depth and point from the range), rather than the lens's own (direction, mask):
+    /// adaptive sampling traces the hits of the pixels it interpolates only where one is
+    /// wanted.
     pub fn traced(&self) -> bool {
-        matches!(self, Self::Range | Self::Normal | Self::Id)
+        !matches!(self, Self::Direction | Self::Mask)
+    }
+
+    /// Whether the array reads the pixels' rays in the camera's frame ([`PixelRays::camera`]).
+    pub fn camera_rays(&self) -> bool {
+        matches!(self, Self::Depth | Self::Point)
+    }
+
+    /// Whether the array reads the pixels' rays in world space ([`PixelRays::world`]).
+    pub fn world_rays(&self) -> bool {
+        matches!(self, Self::Direction | Self::Mask)
     }
 
     /// The name on the command line and in file names.
@@ -109,6 +142,8 @@ impl Channel {
             Self::Id => "id",
             Self::Direction => "direction",
             Self::Mask => "mask",
+            Self::Depth => "depth",
+            Self::Point => "point",
         }
     }
 }
@@ -148,9 +183,22 @@ pub enum Values {
 }
 
 impl RenderOutput {
-    /// The values of `channel` as the files hold them; `directions` as for
-    /// [`RenderOutput::write_npy`].
-    pub fn values(&self, channel: Channel, directions: &[Option<DVec3>]) -> Values {
+    /// The values of `channel` as the files hold them, `rays` the pixels' (the slices
+    /// `channel` reads: [`Channel::camera_rays`], [`Channel::world_rays`]).
+    pub fn values(&self, channel: Channel, rays: PixelRays) -> Values {
+        // The hit in the camera's frame: range along the f64 lens model's direction.
+        let points = || {
+            assert_eq!(
+                rays.camera.len(),
+                self.geometry.len(),
+                "the depth and the point read every pixel's camera-frame ray"
+            );
+            self.geometry.iter().zip(rays.camera).map(|(g, d)| match d {
+                Some(d) if g[3] > 0.0 => (f64::from(g[3]) * *d).as_vec3(),
+                _ => glam::Vec3::ZERO,
+            })
+        };
+        let directions = rays.world;
         match channel {
             Channel::Range => Values::F32(1, self.geometry.iter().map(|g| g[3]).collect()),
             Channel::Normal => Values::F32(
@@ -173,35 +221,20 @@ impl RenderOutput {
                 // where several rays per pixel make the colour's `w` a coverage.
                 Values::U8(directions.iter().map(|d| u8::from(d.is_some())).collect())
             }
+            Channel::Depth => Values::F32(1, points().map(|p| p.z).collect()),
+            Channel::Point => Values::F32(3, points().flat_map(|p| p.to_array()).collect()),
         }
     }
 
-    /// Writes one channel as an NPY file. `directions` gives each pixel's world-space ray
-    /// direction (`None` where the lens masks its centre: the `direction` and `mask`
-    /// channels read them).
-    pub fn write_npy(
-        &self,
-        channel: Channel,
-        directions: &[Option<DVec3>],
-        path: &Path,
-    ) -> Result<()> {
-        write_npy(path, self.size, self.values(channel, directions))
+    /// Writes one channel as an NPY file; `rays` as for [`RenderOutput::values`].
+    pub fn write_npy(&self, channel: Channel, rays: PixelRays, path: &Path) -> Result<()> {
+        write_npy(path, self.size, self.values(channel, rays))
     }
 
     /// Writes one channel as an OpenEXR file (see [`Channel`] for the channel names); the mask
     /// is stored as float 0 or 1.
-    pub fn write_exr(
-        &self,
-        channel: Channel,
-        directions: &[Option<DVec3>],
-        path: &Path,
-    ) -> Result<()> {
-        write_exr(
-            path,
-            self.size,
-            channel.name(),
-            self.values(channel, directions),
-        )
+    pub fn write_exr(&self, channel: Channel, rays: PixelRays, path: &Path) -> Result<()> {
+        write_exr(path, self.size, channel.name(), self.values(channel, rays))
     }
 }
 

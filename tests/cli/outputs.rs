@@ -13,7 +13,8 @@ fn npy<T: npyz::Deserialize>(path: &std::path::Path) -> (Vec<u64>, Vec<T>) {
 /// with the PNG's mask, and equal to the f64 reference's: ids, ranges and normals under the
 /// tolerances of `tests/common/mod.rs`, and directions that, walked for the written range from
 /// the camera, land on the written triangle in the world (which checks their frame without the
-/// camera rotation the renderer and the reference share).
+/// camera rotation the renderer and the reference share); and camera-frame points that,
+/// turned by the scene camera's pose, are those walks, and whose z is the depth.
 #[test]
 fn render_writes_ground_truth_arrays() {
     let dir = std::env::temp_dir().join(format!("fisheye-npy-{}", std::process::id()));
@@ -28,7 +29,7 @@ fn render_writes_ground_truth_arrays() {
         "--out",
         png.to_str().unwrap(),
         "--outputs",
-        "range,normal,id,direction,mask",
+        "range,normal,id,direction,mask,depth,point",
     ];
     stdout(&fisheye(&args, ""));
     let (shape, range) = npy::<f32>(&dir.join("view.range.npy"));
@@ -39,6 +40,16 @@ fn render_writes_ground_truth_arrays() {
     let (shape, direction) = npy::<f32>(&dir.join("view.direction.npy"));
     assert_eq!(shape, [48, 64, 3]);
     let (_, mask) = npy::<u8>(&dir.join("view.mask.npy"));
+    let (shape, depth) = npy::<f32>(&dir.join("view.depth.npy"));
+    assert_eq!(shape, [48, 64]);
+    let (shape, point) = npy::<f32>(&dir.join("view.point.npy"));
+    assert_eq!(shape, [48, 64, 3]);
+    // The point is the hit in the camera's frame: turned by the scene camera's pose it is
+    // the written direction walked for the written range; its z is the depth.
+    let rotation = fisheye_rt::scene::builtin::scene("default")
+        .unwrap()
+        .camera
+        .rotation();
     // The PNG's alpha is the lens's coverage of each pixel (16 rays a pixel by default); the
     // mask is its centre's. A pixel the lens covers whole has its centre inside (the image
     // circle is convex, and the centre lies among the samples), and one whose centre is
@@ -62,6 +73,14 @@ fn render_writes_ground_truth_arrays() {
             assert_eq!(length(d), 0.0);
             assert_eq!(ids[i], u32::MAX);
         }
+        let p = glam::DVec3::from_array(std::array::from_fn(|k| f64::from(point[3 * i + k])));
+        let walked =
+            glam::DVec3::from_array(std::array::from_fn(|k| f64::from(d[k]))) * f64::from(range[i]);
+        assert!(
+            (rotation * p - walked).length() <= 1e-5 * f64::from(range[i]),
+            "point at {i}: {p} turned is not {walked}"
+        );
+        assert_eq!(point[3 * i + 2], depth[i], "depth at {i}");
         // The default room is closed: every ray hits, at a positive range, with a unit normal.
         if ids[i] != u32::MAX {
             assert!(
@@ -102,9 +121,11 @@ fn render_writes_ground_truth_arrays() {
     let mask_exr = exr("view.mask.exr");
     let mask_f: Vec<f32> = mask.iter().map(|&m| f32::from(m)).collect();
     assert_eq!(floats(&mask_exr[0].1), mask_f);
+    assert_eq!(floats(&exr("view.depth.exr")[0].1), depth);
     for (name, npy) in [
         ("view.normal.exr", &normal),
         ("view.direction.exr", &direction),
+        ("view.point.exr", &point),
     ] {
         let channels = exr(name);
         // EXR lists channels alphabetically: B, G, R.

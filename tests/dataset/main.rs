@@ -115,7 +115,7 @@ fn a_rig_along_a_trajectory_gives_the_same_bytes_in_one_process_or_in_resumed_sh
             &rig,
         ])
         .args(["--t-scene-world", "z-up", "--spp", "4"])
-        .args(["--outputs", "range,normal,id,direction,mask"])
+        .args(["--outputs", "range,normal,id,direction,mask,depth,point"])
         .arg("-o")
         .arg(out);
         c
@@ -186,8 +186,8 @@ fn a_rig_along_a_trajectory_gives_the_same_bytes_in_one_process_or_in_resumed_sh
     let (a, b) = (files(&one), files(&sharded));
     let names = |f: &[(PathBuf, Vec<u8>)]| f.iter().map(|(p, _)| p.clone()).collect::<Vec<_>>();
     assert_eq!(names(&a), names(&b), "the two runs wrote different files");
-    // 4 cameras × 100 poses × (PNG + 5 arrays), the plan and the manifest.
-    assert_eq!(a.len(), 4 * 100 * 6 + 2);
+    // 4 cameras × 100 poses × (PNG + 7 arrays), the plan and the manifest.
+    assert_eq!(a.len(), 4 * 100 * 8 + 2);
     for ((path, x), (_, y)) in a.iter().zip(&b) {
         assert!(x == y, "{} differs between the runs", path.display());
     }
@@ -208,14 +208,18 @@ fn a_rig_along_a_trajectory_gives_the_same_bytes_in_one_process_or_in_resumed_sh
         String::from_utf8_lossy(&output.stderr)
     );
     assert!(text.contains("100 frames, 4 cameras, 400 images"), "{text}");
-    // f32 directions and ranges: 1e-7 relative, a few 1e-6 px at 22.5 px a radian.
-    let px: f64 = text
-        .split("within ")
-        .nth(1)
-        .and_then(|t| t.split_whitespace().next())
-        .and_then(|t| t.parse().ok())
-        .unwrap_or_else(|| panic!("no reprojection error in {text}"));
-    assert!(px < 1e-3, "hit points reproject {px} px from their pixels");
+    // f32 directions, ranges and points: 1e-7 relative, a few 1e-6 px at 22.5 px a radian.
+    // The camera-frame points are projected as they are, with no pose: they check the depth
+    // and point arrays' frame (the loader also checks them against the range).
+    for what in ["hit points", "camera-frame points"] {
+        let px: f64 = text
+            .split(&format!("{what} reproject to their pixels within "))
+            .nth(1)
+            .and_then(|t| t.split_whitespace().next())
+            .and_then(|t| t.parse().ok())
+            .unwrap_or_else(|| panic!("no reprojection error of {what} in {text}"));
+        assert!(px < 1e-3, "{what} reproject {px} px from their pixels");
+    }
 }
 
 /// Each camera of the rig at two poses sees what `fisheye render` sees through the same

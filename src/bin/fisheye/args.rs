@@ -358,6 +358,10 @@ pub(crate) enum Output {
     Id,
     Direction,
     Mask,
+    /// The hit's depth along the optical axis (the camera frame's z; range is along the ray).
+    Depth,
+    /// The hit in the camera's frame (x right, y down, z forward), H×W×3.
+    Point,
     /// The rays each pixel took: `render`'s picture and array, a dataset's array.
     Spp,
     /// Optical flow to the next frame and its covisibility (`dataset render` only).
@@ -382,6 +386,8 @@ impl Output {
             Output::Id => Channel::Id,
             Output::Direction => Channel::Direction,
             Output::Mask => Channel::Mask,
+            Output::Depth => Channel::Depth,
+            Output::Point => Channel::Point,
             Output::Spp
             | Output::Flow
             | Output::FlowBackward

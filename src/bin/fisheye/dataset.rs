@@ -145,11 +145,12 @@ pub(crate) struct RenderArgs {
     /// Tone curve of PNG images (see `render --tone`).
     #[arg(long, value_enum, default_value = "aces")]
     tone: ToneArg,
-    /// Ground truth written beside each image: range, normal, id, direction, mask;
-    /// instance and semantic (each pixel's object and class, named in labels.json); spp (the
-    /// rays each pixel's colour took: 0 where adaptive sampling interpolated it); and
-    /// between frames, through the lens (and rolling shutter): flow (to the next frame, with
-    /// flow_valid where it sees the point), flow-backward (from the previous), scene-flow.
+    /// Ground truth written beside each image: range, normal, id, direction, mask, depth
+    /// (the hit's z in the camera's frame), point (the hit in the camera's frame); instance
+    /// and semantic (each pixel's object and class, named in labels.json); spp (the rays each
+    /// pixel's colour took: 0 where adaptive sampling interpolated it); and between frames,
+    /// through the lens (and rolling shutter): flow (to the next frame, with flow_valid where
+    /// it sees the point), flow-backward (from the previous), scene-flow.
     #[arg(long, value_enum, value_delimiter = ',')]
     outputs: Vec<Output>,
     /// Optical flow's files: the arrays' --format (npy: H×W×2 float32), flo (Middlebury's,

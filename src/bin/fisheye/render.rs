@@ -12,8 +12,8 @@ use fisheye_rt::lens::gpu::DirectionSource;
 use fisheye_rt::renderer::{Offscreen, Pass, SceneSet, Setup};
 use fisheye_rt::scene::{FRAME_FILL, Scene};
 use fisheye_rt::trace::{
-    Channel, ColourFile, Display, GpuScene, KEY, PixelFilter, RenderOptions, Sampling, Tone,
-    auto_exposure, check_writable, save_png, spp_key, spp_picture, world_directions, write_colour,
+    Channel, ColourFile, Display, GpuScene, KEY, PixelFilter, PixelRays, RenderOptions, Sampling,
+    Tone, auto_exposure, check_writable, rotated, save_png, spp_key, spp_picture, write_colour,
     write_rays_map,
 };
 
@@ -113,8 +113,9 @@ pub(crate) struct RenderArgs {
     #[arg(long, value_enum, default_value = "aces")]
     pub(crate) tone: ToneArg,
     /// Ground-truth arrays to write beside the image as OUT_STEM.NAME.npy (or .exr): range
-    /// (distance to the primary hit), normal, id (triangle), direction (world-space ray), mask;
-    /// and spp, a picture of the rays each pixel took (OUT_STEM.spp.png: dark where a pixel
+    /// (distance to the primary hit), normal, id (triangle), direction (world-space ray), mask,
+    /// depth (the hit's z in the camera's frame), point (the hit in the camera's frame); and
+    /// spp, a picture of the rays each pixel took (OUT_STEM.spp.png: dark where a pixel
     /// was interpolated, brighter with more rays; transparent where the lens masks it) and
     /// their counts (OUT_STEM.spp.npy, uint32, or .exr).
     #[arg(long, value_enum, value_delimiter = ',')]
@@ -371,12 +372,17 @@ pub(crate) fn render(args: &RenderArgs) -> Result<()> {
     };
     write_colour(out, output.size, &output.colour, &display, file)?;
     if !channels.is_empty() {
-        let directions = world_directions(&camera, &scene.camera);
+        let camera_rays = camera.directions();
+        let world = rotated(&camera_rays, &scene.camera);
+        let rays = PixelRays {
+            camera: &camera_rays,
+            world: &world,
+        };
         for &channel in &channels {
             let path = array_path(channel.name());
             match args.format {
-                ArrayFormat::Npy => output.write_npy(channel, &directions, &path)?,
-                ArrayFormat::Exr => output.write_exr(channel, &directions, &path)?,
+                ArrayFormat::Npy => output.write_npy(channel, rays, &path)?,
+                ArrayFormat::Exr => output.write_exr(channel, rays, &path)?,
             }
             println!("wrote {}", path.display());
         }

@@ -76,6 +76,9 @@ impl Dataset {
                 "arrays": "range: metres to the first hit along the pixel centre's ray (0 where \
                            none); normal: world unit normal; id: scene triangle (4294967295 for \
                            none); direction: world unit ray; mask: 1 where the lens has a ray; \
+                           depth: metres along the camera's z axis to that hit (negative behind \
+                           the camera's plane, 0 where none); point: that hit in the camera's \
+                           frame, metres (range times the pixel's camera-frame unit ray); \
                            spp: the rays the pixel's colour took (0 where adaptive sampling \
                            interpolated it from its neighbours, or the lens covers none of it)",
                 "time": "a camera's shutter (cameras[].shutter): line v (the OpenCV row v read \
