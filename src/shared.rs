@@ -2,10 +2,13 @@
 //! limits, workgroup sizes, the cube's face table, and the `repr(C)` structs the kernels read
 //! (each `Pod`, its size pinned here; `shader`'s tests check every one against naga's layout
 //! of its WGSL twin). [`wgsl_constants`] lists the constants that `shader` prepends to every
-//! WGSL module, so each is defined once, here.
+//! WGSL module, so each is defined once, here (adaptive sampling's in `shared/adaptive.rs`).
 
 use bytemuck::{Pod, Zeroable};
 use glam::{DMat3, Vec3};
+
+mod adaptive;
+pub use adaptive::*;
 
 /// Side of the square workgroups of per-pixel kernels.
 pub const WORKGROUP_2D: u32 = 8;
@@ -21,36 +24,6 @@ pub const TRAVERSAL_STACK: u32 = 32;
 /// reads one ([`DirectionSource::storage_buffers`]): within WebGPU's and wgpu's default
 /// limit of 8.
 pub const TRACE_STORAGE_BUFFERS: u32 = 7;
-
-/// Storage buffers the adaptive kernels bind beyond the trace kernel's: the work buffer (the
-/// per-pixel state and the work list, `trace::AdaptivePass`). With computed directions they
-/// bind 8, WebGPU's default limit.
-pub const ADAPTIVE_STORAGE_BUFFERS: u32 = 1;
-
-/// Side of the blocks of pixels whose corners adaptive sampling traces first: one ray per
-/// `ADAPTIVE_BLOCK`² pixels where the image is smooth.
-pub const ADAPTIVE_BLOCK: u32 = 4;
-/// Pixels side by side in a row that each invocation of adaptive sampling's per-pixel listing
-/// kernels looks at: a workgroup lists `ADAPTIVE_STRIP` times as many pixels for the same
-/// barriers and global atomic.
-pub const ADAPTIVE_STRIP: u32 = 4;
-/// The `u32`s before the list in adaptive sampling's work buffer: the list's length
-/// (at `ADAPTIVE_COUNT`), the part of it `trace_list` traces (from `ADAPTIVE_FIRST` to
-/// `ADAPTIVE_END`), one unused (a 16-byte header).
-pub const ADAPTIVE_HEADER: u32 = 4;
-/// Where the work buffer holds the list's length.
-pub const ADAPTIVE_COUNT: u32 = 0;
-/// The samples per side of adaptive sampling's estimating stage (Dammertz et al.'s error
-/// estimate compares the mean of half of them with the mean of all).
-pub const ADAPTIVE_ESTIMATE_SIDE: u32 = 2;
-/// Where the work buffer holds the first list entry `trace_list` traces.
-pub const ADAPTIVE_FIRST: u32 = 1;
-/// Where the work buffer holds the end (exclusive) of the entries `trace_list` traces.
-pub const ADAPTIVE_END: u32 = 2;
-/// What a pixel's state in the work buffer keeps, in place of what its centre saw, when it
-/// demands every sample: its 2 × 2 estimating samples disagreed, or a neighbour is brighter
-/// than the display shows (`wgsl/adaptive.wgsl`'s other keys sit above it).
-pub const ADAPTIVE_KEY_MORE: u32 = 0xffff_fffc;
 
 /// The most samples per pixel side (`RenderOptions::spp` is a square of at most this).
 pub const MAX_SAMPLES_PER_SIDE: u32 = 16;
@@ -379,6 +352,13 @@ pub fn wgsl_constants() -> Vec<(String, u32)> {
         ("ADAPTIVE_ESTIMATE_SIDE", ADAPTIVE_ESTIMATE_SIDE),
         ("ADAPTIVE_FIRST", ADAPTIVE_FIRST),
         ("ADAPTIVE_END", ADAPTIVE_END),
+        ("ADAPTIVE_MODE", ADAPTIVE_MODE),
+        ("MODE_CENTRE", MODE_CENTRE),
+        ("MODE_SAMPLES", MODE_SAMPLES),
+        ("MODE_TRUTH", MODE_TRUTH),
+        ("MODE_ESTIMATE", MODE_ESTIMATE),
+        ("MODE_LATTICE", MODE_LATTICE),
+        ("MODE_EVERY_PIXEL", MODE_EVERY_PIXEL),
         ("ADAPTIVE_KEY_MORE", ADAPTIVE_KEY_MORE),
         ("NESTED_SIDE", NESTED_SIDE),
         ("NESTED_UNITS", NESTED_UNITS),

@@ -3,9 +3,10 @@
 // pixel centres (the last row and column of the image are lattice points too), each block by
 // four half-blocks, whose corners form a lattice twice as fine:
 //
-// 1. `trace_lattice` traces one shaded ray through each lattice pixel's centre (a first pass
+// 1. `trace_list` traces one shaded ray through each lattice pixel's centre (a first pass
 //    below one ray per pixel: 1/ADAPTIVE_BLOCK² of them), an invocation a lattice point, with
-//    no list (or through every pixel's, EVERY_PIXEL, and the frame goes on at step 4);
+//    no list (MODE_LATTICE; or through every pixel's, MODE_EVERY_PIXEL, and the frame goes on
+//    at step 4);
 // 2. `classify` looks at each block's four corners (Whitted 1980 subdivided a pixel whose
 //    corners disagree): where they agree (the same surface, normals and tangent planes, and
 //    displayed colour along each edge that bends by less than the threshold, see `bend`), the
@@ -78,14 +79,13 @@ struct AdaptiveParams {
 @group(0) @binding(7) var<storage, read_write> work: array<atomic<u32>>;
 @group(0) @binding(8) var<uniform> adaptive: AdaptiveParams;
 
-// What is traced of the pixels listed: centres and first hits by `trace_list` (centres by
-// `trace_lattice` too), samples and estimates by `trace_samples`; a pipeline for each (the
-// modes' kernels differ in size, and one kernel holding all four would be as slow as the
-// largest).
-const MODE_CENTRE: u32 = 0u;
-const MODE_SAMPLES: u32 = 1u;
-const MODE_TRUTH: u32 = 2u;
-const MODE_ESTIMATE: u32 = 3u;
+// What is traced of the pixels listed (MODE_*, `fisheye_rt::shared`): centres and first hits
+// by `trace_list`, a pipeline for each (the first-hit kernel is the smaller: one kernel
+// holding both would be as slow as the larger), whose centres' pipeline also traces the
+// coarse stage's points (ADAPTIVE_MODE: MODE_LATTICE, MODE_EVERY_PIXEL); samples and
+// estimates by `trace_samples`, a pipeline for each too (one kernel for both, the mode read at
+// run time, took about a tenth longer a sample on lavapipe: its samples a side, the bounds of
+// its loops and divisors of its strata, were no longer constants, and it needed a barrier).
 override LIST_MODE: u32 = MODE_CENTRE;
 // The level `classify` decides at: 0, the blocks (ADAPTIVE_BLOCK pixels a side, whose corners
 // the coarse stage traced); 1, the half-blocks of the blocks refined at level 0 (whose corners
@@ -246,36 +246,40 @@ fn trace_centre(index: u32, pixel: vec2<u32>, mode: u32) {
     set_state(index, 1u, surface_key(traced));
 }
 
-// Whether the coarse stage traces every pixel's centre (`fisheye_rt::trace::Adaptive::
-// every_pixel`, `--spp auto:T:MAX:1`) instead of the lattice's: then no pixel is
-// interpolated, and the frame goes on at step 4.
-override EVERY_PIXEL: u32 = 0u;
-
-// The coarse stage: a shaded ray through each lattice pixel's centre (or each pixel's), an
-// invocation a point, in rows (no list to make or read: the points are known).
-@compute @workgroup_size(WORKGROUP_2D, WORKGROUP_2D)
-fn trace_lattice(@builtin(global_invocation_id) id: vec3<u32>) {
-    let every = EVERY_PIXEL == 1u;
-    if any(id.xy >= select(adaptive.lattice, size(), every)) {
-        return;
-    }
-    let pixel = select(lattice_pixel(id.xy), id.xy, every);
-    trace_centre(index_of(pixel), pixel, MODE_CENTRE);
-}
-
-// Traces the centres of the listed pixels as LIST_MODE says (`trace_centre`).
+// Traces the centres of list entries ADAPTIVE_FIRST to ADAPTIVE_END as LIST_MODE says
+// (`trace_centre`), an invocation each; or (ADAPTIVE_MODE) the coarse stage's points, which
+// need no list: the lattice's (MODE_LATTICE) or every pixel's (MODE_EVERY_PIXEL:
+// `fisheye_rt::trace::Adaptive::every_pixel`, `--spp auto:T:MAX:1`; then no pixel is
+// interpolated, and the frame goes on at step 4), a WORKGROUP_2D² tile of them a workgroup,
+// in rows of tiles, as a dispatch over the points in 2D would take them.
 @compute @workgroup_size(WORKGROUP_1D)
 fn trace_list(
     @builtin(workgroup_id) group: vec3<u32>,
     @builtin(num_workgroups) groups: vec3<u32>,
     @builtin(local_invocation_index) local: u32,
 ) {
-    let i = atomicLoad(&work[ADAPTIVE_FIRST]) + (group.y * groups.x + group.x) * WORKGROUP_1D + local;
-    if i >= atomicLoad(&work[ADAPTIVE_END]) {
-        return;
+    let mode = atomicLoad(&work[ADAPTIVE_MODE]);
+    let g = group.y * groups.x + group.x;
+    var pixel: vec2<u32>;
+    if mode == MODE_LATTICE || mode == MODE_EVERY_PIXEL {
+        let every = mode == MODE_EVERY_PIXEL;
+        let points = select(adaptive.lattice, size(), every);
+        let tiles = (points.x + WORKGROUP_2D - 1u) / WORKGROUP_2D;
+        let tile = vec2<u32>(g % tiles, g / tiles);
+        let p = tile * WORKGROUP_2D + vec2<u32>(local % WORKGROUP_2D, local / WORKGROUP_2D);
+        if any(p >= points) {
+            return;
+        }
+        pixel = select(lattice_pixel(p), p, every);
+    } else {
+        let i = atomicLoad(&work[ADAPTIVE_FIRST]) + g * WORKGROUP_1D + local;
+        if i >= atomicLoad(&work[ADAPTIVE_END]) {
+            return;
+        }
+        let index = atomicLoad(&work[ADAPTIVE_HEADER + i]);
+        pixel = vec2<u32>(index % lens.width, index / lens.width);
     }
-    let index = atomicLoad(&work[ADAPTIVE_HEADER + i]);
-    trace_centre(index, vec2<u32>(index % lens.width, index / lens.width), LIST_MODE);
+    trace_centre(index_of(pixel), pixel, LIST_MODE);
 }
 
 // What a block's corner saw: its key, and its hit's normal and position (relative to the

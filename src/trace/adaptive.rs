@@ -14,8 +14,9 @@ use crate::lens::gpu::DirectionSource;
 use crate::scene::Camera;
 use crate::shader;
 use crate::shared::{
-    ADAPTIVE_BLOCK, ADAPTIVE_COUNT, ADAPTIVE_HEADER, ADAPTIVE_KEY_MORE, ADAPTIVE_STORAGE_BUFFERS,
-    ADAPTIVE_STRIP, AdaptiveParams, TRACE_STORAGE_BUFFERS, WORKGROUP_1D, WORKGROUP_2D,
+    ADAPTIVE_BLOCK, ADAPTIVE_COUNT, ADAPTIVE_HEADER, ADAPTIVE_KEY_MORE, ADAPTIVE_MODE,
+    ADAPTIVE_STORAGE_BUFFERS, ADAPTIVE_STRIP, AdaptiveParams, MODE_CENTRE, MODE_EVERY_PIXEL,
+    MODE_LATTICE, MODE_TRUTH, TRACE_STORAGE_BUFFERS, WORKGROUP_1D, WORKGROUP_2D,
 };
 
 /// Two corners' shading normals further apart than this (about 25°) are not one smooth
@@ -28,7 +29,7 @@ const PLANE_DISTANCE: f32 = 0.01;
 mod stages;
 
 pub use stages::{ALL_STAGES, Stage, stages_for};
-use stages::{lattice_points, listed_at, reused_samples, sample_lanes, samples_at};
+use stages::{lattice_points, list_mode, listed_at, reused_samples, sample_lanes, samples_at};
 
 /// A kernel of a stage the frame runs, which [`AdaptivePass`] made with the pass (it makes
 /// only those: see its `builders`).
@@ -56,8 +57,9 @@ pub struct AdaptiveSpans<'a> {
 pub struct AdaptivePass {
     trace: TracePass,
     options: Adaptive,
-    /// The coarse stage's kernel, `trace_lattice`: a ray through each lattice point.
-    lattice: wgpu::ComputePipeline,
+    /// The work buffer's header for the coarse stage, which `trace_list` traces with no list
+    /// (its points are known): `MODE_LATTICE` or `MODE_EVERY_PIXEL`.
+    coarse: wgpu::Buffer,
     /// The kernels that list the later stages' pixels: classify (the blocks), midpoints,
     /// classify (the half-blocks), select_pixels, more, untraced. Here and below, only the
     /// kernels of the stages a frame runs are made (`None` the others'): a tracing kernel
@@ -221,9 +223,9 @@ impl AdaptivePass {
                 in_file((file, source.swaps()), entry, &overrides)
             };
             let lister = |entry: &str| in_file(("adaptive_lists", &import_swaps), entry, &[]);
-            let sampler = |mode: u32, stage: Stage| {
+            let sampler = |stage: Stage| {
                 let overrides = [
-                    ("LIST_MODE", mode),
+                    ("LIST_MODE", list_mode(stage)),
                     ("SAMPLE_LANES", sample_lanes(stage, side, options, lanes)),
                     ("REUSED", reused_samples(side, options)),
                 ];
@@ -238,28 +240,25 @@ impl AdaptivePass {
             // supersamples).
             let (estimates, supersamples) = (runs(Stage::Estimate), runs(Stage::Supersample));
             let builders = [
-                runs(Stage::Midpoints).then(|| kernel("classify", 0, 0)),
+                runs(Stage::Midpoints).then(|| kernel("classify", MODE_CENTRE, 0)),
                 runs(Stage::Midpoints).then(|| lister("midpoints")),
-                runs(Stage::Refine).then(|| kernel("classify", 0, 1)),
+                runs(Stage::Refine).then(|| kernel("classify", MODE_CENTRE, 1)),
                 supersamples.then(|| lister("select_pixels")),
                 estimates.then(|| lister("more")),
                 runs(Stage::Truth).then(|| lister("untraced")),
             ];
             // The tracing kernels, each most of a second's compiling on lavapipe, made side by
-            // side: the coarse stage's, then by the modes of wgsl/adaptive.wgsl, centres
-            // (shared by the stages that trace them), estimates, samples, first hits.
-            let coarse = [("EVERY_PIXEL", u32::from(options.every_pixel))];
+            // side, by the modes of wgsl/adaptive.wgsl: centres (shared by the stages that
+            // trace them, the coarse stage's too), estimates, samples, first hits.
             let jobs: Vec<GpuJob<'_, _>> = vec![
-                Box::new(|| Some(in_file((file, source.swaps()), "trace_lattice", &coarse))),
-                Box::new(|| runs(Stage::Midpoints).then(|| kernel("trace_list", 0, 0))),
-                Box::new(|| estimates.then(|| sampler(3, Stage::Estimate))),
-                Box::new(|| supersamples.then(|| sampler(1, Stage::Supersample))),
-                Box::new(|| runs(Stage::Truth).then(|| kernel("trace_list", 2, 0))),
+                Box::new(|| Some(kernel("trace_list", MODE_CENTRE, 0))),
+                Box::new(|| estimates.then(|| sampler(Stage::Estimate))),
+                Box::new(|| supersamples.then(|| sampler(Stage::Supersample))),
+                Box::new(|| runs(Stage::Truth).then(|| kernel("trace_list", MODE_TRUTH, 0))),
             ];
             let tracers = ctx.checked_each("compiling the adaptive passes' kernels", jobs)?;
-            let [lattice, centres, estimate, samples, truth] =
-                <[_; 5]>::try_from(tracers).expect("a kernel for each job");
-            let lattice = lattice.expect("the coarse stage's kernel");
+            let [centres, estimate, samples, truth] =
+                <[_; 4]>::try_from(tracers).expect("a kernel for each job");
             let trace_lists = [centres.clone(), centres, estimate, samples, truth];
             let args_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
                 label: Some("fisheye.adaptive.args"),
@@ -270,6 +269,7 @@ impl AdaptivePass {
                 let constants = [
                     ("SLICE", f64::from(slice)),
                     ("PER_GROUP", f64::from(per_group)),
+                    ("MODE", f64::from(list_mode(stage))),
                 ];
                 shader::compute_pipeline(
                     device,
@@ -295,10 +295,22 @@ impl AdaptivePass {
                 &args_layout,
                 &[&work, &dispatch],
             );
+            let mut header = [0u32; ADAPTIVE_HEADER as usize];
+            header[ADAPTIVE_MODE as usize] = if options.every_pixel {
+                MODE_EVERY_PIXEL
+            } else {
+                MODE_LATTICE
+            };
+            let coarse = crate::gpu::buffer_init(
+                device,
+                "fisheye.adaptive.coarse",
+                bytemuck::cast_slice(&header),
+                wgpu::BufferUsages::COPY_SRC,
+            );
             Ok(Self {
                 trace,
                 options,
-                lattice,
+                coarse,
                 builders,
                 trace_lists,
                 args,
@@ -353,7 +365,7 @@ impl AdaptivePass {
     }
 
     /// Records one frame, timed by `spans`: the coarse stage one compute pass
-    /// (`trace_lattice`), each later stage two (a kernel lists pixels; then a one-invocation
+    /// (`trace_list` over its points), each later stage two (a kernel lists pixels; then a one-invocation
     /// kernel sizes the dispatch, and `trace_list` or `trace_samples` traces them).
     pub fn encode(
         &self,
@@ -374,16 +386,31 @@ impl AdaptivePass {
     }
 
     /// Records the coarse stage, a compute pass timed by `writes`: a ray through each
-    /// lattice point, an invocation each (no list: the lattice is known).
+    /// lattice point (or pixel), an invocation each in rows, by the centres' kernel with no
+    /// list (the points are known: the header says which, `coarse`).
     fn encode_coarse(
         &self,
         encoder: &mut wgpu::CommandEncoder,
         scene: &GpuScene,
         writes: Option<wgpu::ComputePassTimestampWrites<'_>>,
     ) {
-        let label = "fisheye.adaptive.coarse";
-        let size = self.coarse_points();
-        self.dispatch_2d(encoder, scene, label, &[&self.lattice], size, writes);
+        let header = 4 * u64::from(ADAPTIVE_HEADER);
+        encoder.copy_buffer_to_buffer(&self.coarse, 0, &self.work, 0, header);
+        // A tile of WORKGROUP_2D² points a workgroup (WORKGROUP_1D invocations), in rows of
+        // at most 65535 workgroups, as `wgsl/adaptive_args.wgsl` sizes a list's dispatch.
+        const _: () = assert!(WORKGROUP_1D == WORKGROUP_2D * WORKGROUP_2D);
+        let [w, h] = self.coarse_points();
+        let groups = w.div_ceil(WORKGROUP_2D) * h.div_ceil(WORKGROUP_2D);
+        let rows = groups.div_ceil(65535).max(1);
+        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+            label: Some("fisheye.adaptive.coarse"),
+            timestamp_writes: writes,
+        });
+        pass.set_pipeline(made(&self.trace_lists[listed_at(Stage::Midpoints)]));
+        for (index, group) in self.groups(scene).into_iter().enumerate() {
+            pass.set_bind_group(index as u32, group, &[]);
+        }
+        pass.dispatch_workgroups(groups.div_ceil(rows), rows, 1);
     }
 
     /// The pixels whose centres the coarse stage traces, row by row: the lattice's (where

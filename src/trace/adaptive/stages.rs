@@ -1,6 +1,9 @@
 //! The plan of an adaptive frame: its stages, which a frame runs, and what each traces.
 
-use crate::shared::{ADAPTIVE_ESTIMATE_SIDE, NESTED_SIDE, WORKGROUP_1D};
+use crate::shared::{
+    ADAPTIVE_ESTIMATE_SIDE, MODE_CENTRE, MODE_ESTIMATE, MODE_SAMPLES, MODE_TRUTH, NESTED_SIDE,
+    WORKGROUP_1D,
+};
 use crate::trace::options::{Adaptive, SampleLanes};
 
 /// A part of an adaptive frame, each its own compute pass (and its own timestamps).
@@ -77,6 +80,17 @@ pub(super) fn samples_at(stage: Stage, samples_per_side: u32, options: Adaptive)
         Stage::Estimate => ADAPTIVE_ESTIMATE_SIDE.pow(2),
         Stage::Supersample => samples_per_side.pow(2) - reused_samples(samples_per_side, options),
         Stage::Coarse | Stage::Midpoints | Stage::Refine | Stage::Truth => 1,
+    }
+}
+
+/// What the kernel tracing `stage`'s list traces of each pixel (`wgsl/adaptive.wgsl`'s
+/// MODE_*): its centre's shaded ray, its first hit alone, its estimating samples or all.
+pub(super) fn list_mode(stage: Stage) -> u32 {
+    match stage {
+        Stage::Coarse | Stage::Midpoints | Stage::Refine => MODE_CENTRE,
+        Stage::Truth => MODE_TRUTH,
+        Stage::Estimate => MODE_ESTIMATE,
+        Stage::Supersample => MODE_SAMPLES,
     }
 }
 
