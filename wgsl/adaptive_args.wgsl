@@ -15,8 +15,6 @@
 override SLICE: u32 = 0u;
 // List entries per workgroup of the kernel dispatched.
 override PER_GROUP: u32 = WORKGROUP_1D;
-// What the kernel dispatched does with them (ADAPTIVE_MODE: `adaptive.wgsl`'s MODE_*).
-override MODE: u32 = 0u;
 
 @compute @workgroup_size(1)
 fn main() {
@@ -29,7 +27,6 @@ fn main() {
     }
     work[ADAPTIVE_FIRST] = first;
     work[ADAPTIVE_END] = end;
-    work[ADAPTIVE_MODE] = MODE;
     let groups = (end - first + PER_GROUP - 1u) / PER_GROUP;
     // Rows of at most 65535 workgroups (the least limit on a dimension).
     let rows = max((groups + 65534u) / 65535u, 1u);

@@ -26,25 +26,26 @@ pub const ADAPTIVE_ESTIMATE_SIDE: u32 = 2;
 pub const ADAPTIVE_FIRST: u32 = 1;
 /// Where the work buffer holds the end (exclusive) of the entries `trace_list` traces.
 pub const ADAPTIVE_END: u32 = 2;
-/// Where the work buffer holds what the next tracing dispatch does (the `MODE_*` below),
-/// written with the dispatch's size: `trace_list` traces the coarse stage's points instead of
-/// a list at `MODE_LATTICE` or `MODE_EVERY_PIXEL`, so that the coarse stage and the stages
+/// Where the work buffer holds what `trace_list` traces: the coarse stage's points, with no
+/// list, at `MODE_LATTICE` or `MODE_EVERY_PIXEL` (written before that stage), else the list
+/// (0, as the header is cleared before each list is made). So the coarse stage and the stages
 /// that trace listed centres share one kernel, which lavapipe compiles once.
 pub const ADAPTIVE_MODE: u32 = 3;
-/// What adaptive sampling's tracing kernels trace of the pixels listed (`wgsl/adaptive.wgsl`):
-/// a shaded ray through each centre (`trace_list`'s `LIST_MODE`)...
+/// What an adaptive tracing kernel traces of each pixel (its `LIST_MODE`,
+/// `wgsl/adaptive.wgsl`): a shaded ray through the centre (`trace_list`).
 pub const MODE_CENTRE: u32 = 0;
-/// ... every sample (`trace_samples`' `LIST_MODE`) ...
+/// As [`MODE_CENTRE`]: every sample (`trace_samples`).
 pub const MODE_SAMPLES: u32 = 1;
-/// ... the centre ray's first hit alone, for the ground truth (`trace_list`) ...
+/// As [`MODE_CENTRE`]: the centre ray's first hit alone, for the ground truth (`trace_list`).
 pub const MODE_TRUTH: u32 = 2;
-/// ... or the 2 × 2 estimating samples, and the error estimate (`trace_samples`); or, with
-/// no list, the centres of the coarse stage's points (`trace_list` at `MODE_CENTRE`): the
-/// lattice's ...
+/// As [`MODE_CENTRE`]: the 2 × 2 estimating samples and their error estimate
+/// (`trace_samples`).
 pub const MODE_ESTIMATE: u32 = 3;
-/// ... (`ADAPTIVE_MODE` only) ...
+/// At [`ADAPTIVE_MODE`]: `trace_list` traces the lattice's points, the coarse stage, with no
+/// list.
 pub const MODE_LATTICE: u32 = 4;
-/// ... or every pixel's (`trace::Adaptive::every_pixel`).
+/// At [`ADAPTIVE_MODE`]: `trace_list` traces every pixel, the coarse stage of
+/// `trace::Adaptive::every_pixel`, with no list.
 pub const MODE_EVERY_PIXEL: u32 = 5;
 /// What a pixel's state in the work buffer keeps, in place of what its centre saw, when it
 /// demands every sample: its 2 × 2 estimating samples disagreed, or a neighbour is brighter

@@ -269,7 +269,6 @@ impl AdaptivePass {
                 let constants = [
                     ("SLICE", f64::from(slice)),
                     ("PER_GROUP", f64::from(per_group)),
-                    ("MODE", f64::from(list_mode(stage))),
                 ];
                 shader::compute_pipeline(
                     device,
@@ -364,8 +363,8 @@ impl AdaptivePass {
         stages_for(self.trace.samples_per_side(), self.options)
     }
 
-    /// Records one frame, timed by `spans`: the coarse stage one compute pass
-    /// (`trace_list` over its points), each later stage two (a kernel lists pixels; then a one-invocation
+    /// Records one frame, timed by `spans`: the coarse stage one compute pass (`trace_list`
+    /// over its points), each later stage two (a kernel lists pixels; then a one-invocation
     /// kernel sizes the dispatch, and `trace_list` or `trace_samples` traces them).
     pub fn encode(
         &self,
@@ -386,7 +385,7 @@ impl AdaptivePass {
     }
 
     /// Records the coarse stage, a compute pass timed by `writes`: a ray through each
-    /// lattice point (or pixel), an invocation each in rows, by the centres' kernel with no
+    /// lattice point (or pixel), an invocation each in tiles, by the centres' kernel with no
     /// list (the points are known: the header says which, `coarse`).
     fn encode_coarse(
         &self,
