@@ -79,13 +79,19 @@ def reprojection_error(camera, view, arrays):
         return None
     rng, direction = arrays["range"], arrays["direction"]
     hit = rng > 0
-    rows, cols = np.nonzero(hit)
     t = np.array(view["T_scene_camera"])
     points = t[:3, 3] + direction[hit] * rng[hit][:, None]  # hit points in the scene
     camera_points = (points - t[:3, 3]) @ t[:3, :3]  # R^T (p - t), row by row
+    return pixel_error(camera, hit, camera_points)
+
+
+def pixel_error(camera, hit, camera_points):
+    """Largest distance in pixels between the centres of the pixels where `hit` is true (in
+    row order) and where their camera-frame points project, or None without an OpenCV model."""
     pixels = project(camera, camera_points)
     if pixels is None:
         return None
+    rows, cols = np.nonzero(hit)
     centres = np.stack([cols, rows], axis=1).astype(np.float64)
     return float(np.max(np.linalg.norm(pixels - centres, axis=1), initial=0.0))
 
@@ -103,12 +109,7 @@ def point_error(camera, arrays):
         length = np.linalg.norm(point.astype(np.float64), axis=2)
         assert np.array_equal(hit, arrays["range"] > 0), "points where no range, or none where one"
         assert np.allclose(length, arrays["range"], rtol=1e-6, atol=0), "|point| is not the range"
-    rows, cols = np.nonzero(hit)
-    pixels = project(camera, point[hit].astype(np.float64))
-    if pixels is None:
-        return None
-    centres = np.stack([cols, rows], axis=1).astype(np.float64)
-    return float(np.max(np.linalg.norm(pixels - centres, axis=1), initial=0.0))
+    return pixel_error(camera, hit, point[hit].astype(np.float64))
 
 
 def main():

@@ -16,7 +16,7 @@ use crate::shader;
 use crate::shared::{
     ADAPTIVE_BLOCK, ADAPTIVE_COUNT, ADAPTIVE_HEADER, ADAPTIVE_KEY_MORE, ADAPTIVE_MODE,
     ADAPTIVE_STORAGE_BUFFERS, ADAPTIVE_STRIP, AdaptiveParams, MODE_CENTRE, MODE_EVERY_PIXEL,
-    MODE_LATTICE, MODE_TRUTH, TRACE_STORAGE_BUFFERS, WORKGROUP_1D, WORKGROUP_2D,
+    MODE_LATTICE, TRACE_STORAGE_BUFFERS, WORKGROUP_1D, WORKGROUP_2D,
 };
 
 /// Two corners' shading normals further apart than this (about 25°) are not one smooth
@@ -251,10 +251,12 @@ impl AdaptivePass {
             // side, by the modes of wgsl/adaptive.wgsl: centres (shared by the stages that
             // trace them, the coarse stage's too), estimates, samples, first hits.
             let jobs: Vec<GpuJob<'_, _>> = vec![
-                Box::new(|| Some(kernel("trace_list", MODE_CENTRE, 0))),
+                Box::new(|| Some(kernel("trace_list", list_mode(Stage::Midpoints), 0))),
                 Box::new(|| estimates.then(|| sampler(Stage::Estimate))),
                 Box::new(|| supersamples.then(|| sampler(Stage::Supersample))),
-                Box::new(|| runs(Stage::Truth).then(|| kernel("trace_list", MODE_TRUTH, 0))),
+                Box::new(|| {
+                    runs(Stage::Truth).then(|| kernel("trace_list", list_mode(Stage::Truth), 0))
+                }),
             ];
             let tracers = ctx.checked_each("compiling the adaptive passes' kernels", jobs)?;
             let [centres, estimate, samples, truth] =
